@@ -1,0 +1,31 @@
+#pragma once
+// Reading and writing images through OpenImageIO: PNG, JPEG, TIFF, EXR (and
+// whatever else OIIO knows). Multilayer EXR channels are selected by name.
+#include <string>
+#include <vector>
+
+#include "tempera/image.hpp"
+
+namespace tempera {
+
+struct ImageFileInfo {
+  int width = 0;
+  int height = 0;
+  std::vector<std::string> channel_names;
+};
+
+// Size and channel names of an image file without reading its pixels.
+ImageFileInfo inspect_image(const std::string& path);
+
+// Reads `path` as float. With `channels` empty all channels are read; otherwise
+// exactly the named channels, in the given order (FileNotFoundError / IoError /
+// ValueError naming the file and the missing channel on failure).
+Image read_image(const std::string& path, const std::vector<std::string>& channels = {});
+
+// Writes atomically: a temporary file in the same folder, then a rename, so a
+// crash or cancel never leaves a half-written `path`. 8-bit formats (PNG, JPEG)
+// get values clamped to [0, 1]; EXR and TIFF keep float.
+void write_image(const std::string& path, const ImageView& image,
+                 const std::vector<std::string>& channel_names = {});
+
+}  // namespace tempera

@@ -1,0 +1,80 @@
+// tempera._native: a thin pybind11 layer over the core library. It converts
+// numpy arrays, releases the GIL while native code runs and turns every C++
+// error into a Python exception.
+#include <pybind11/stl.h>
+
+#include "numpy_bridge.hpp"
+#include "tempera/image_io.hpp"
+
+namespace py = pybind11;
+using namespace tempera;
+using py_bridge::FloatArray;
+
+namespace {
+
+void register_exceptions(py::module_& m) {
+  static py::exception<CancelledError> cancelled(m, "Cancelled", PyExc_RuntimeError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const FileNotFoundError& e) {
+      PyErr_SetString(PyExc_FileNotFoundError, e.what());
+    } catch (const IoError& e) {
+      PyErr_SetString(PyExc_OSError, e.what());
+    } catch (const ValueError& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const CancelledError& e) {
+      cancelled(e.what());
+    } catch (const std::bad_alloc&) {
+      PyErr_SetString(PyExc_MemoryError, "tempera: out of memory");
+    }
+  });
+}
+
+void bind_io(py::module_& m) {
+  m.def(
+      "read_image",
+      [](const std::string& path, std::optional<std::vector<std::string>> channels) {
+        Image image;
+        {
+          py::gil_scoped_release release;
+          image = read_image(path, channels.value_or(std::vector<std::string>{}));
+        }
+        return py_bridge::to_numpy(std::move(image));
+      },
+      py::arg("path"), py::arg("channels") = py::none(),
+      "Read an image as a float32 (H, W, C) array; `channels` selects channels by name.");
+  m.def(
+      "image_info",
+      [](const std::string& path) {
+        ImageFileInfo info;
+        {
+          py::gil_scoped_release release;
+          info = inspect_image(path);
+        }
+        py::dict d;
+        d["width"] = info.width;
+        d["height"] = info.height;
+        d["channels"] = info.channel_names;
+        return d;
+      },
+      py::arg("path"), "Size and channel names of an image file, without reading its pixels.");
+  m.def(
+      "write_image",
+      [](const std::string& path, const FloatArray& array, std::vector<std::string> channel_names) {
+        ImageView view = py_bridge::view_of(array, "image");
+        py::gil_scoped_release release;
+        write_image(path, view, channel_names);
+      },
+      py::arg("path"), py::arg("image"), py::arg("channel_names") = std::vector<std::string>{},
+      "Write an (H, W[, C]) array atomically; 8-bit formats are clamped to [0, 1].");
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_native, m) {
+  m.doc() = "Tempera native engine";
+  m.attr("__version__") = TEMPERA_VERSION;
+  register_exceptions(m);
+  bind_io(m);
+}

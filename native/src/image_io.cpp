@@ -1,0 +1,168 @@
+#include "tempera/image_io.hpp"
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <atomic>
+#include <filesystem>
+#include <unistd.h>
+
+#include "tempera/error.hpp"
+
+namespace fs = std::filesystem;
+
+namespace tempera {
+namespace {
+
+std::unique_ptr<OIIO::ImageInput> open_input(const std::string& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw FileNotFoundError(concat("image file not found: '", path, "'"));
+  if (fs::is_directory(path, ec)) throw IoError(concat("'", path, "' is a folder, not an image file"));
+  // Keep alpha as stored (straight): guides and exemplars are data, not
+  // compositing layers, and must not be premultiplied behind our back.
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  auto input = OIIO::ImageInput::open(path, &config);
+  if (!input) {
+    std::string why = OIIO::geterror();
+    throw IoError(concat("cannot read image '", path, "': ", why.empty() ? "unknown format" : why));
+  }
+  return input;
+}
+
+// Where each channel lives: multi-part EXR files spread channels over subimages.
+struct ChannelLocation {
+  int subimage;
+  int index;
+};
+
+std::vector<std::pair<std::string, ChannelLocation>> channel_map(OIIO::ImageInput& input) {
+  std::vector<std::pair<std::string, ChannelLocation>> map;
+  for (int sub = 0; input.seek_subimage(sub, 0); ++sub) {
+    const auto& spec = input.spec();
+    for (int c = 0; c < spec.nchannels; ++c) {
+      std::string name = c < int(spec.channelnames.size()) ? spec.channelnames[c] : concat("channel", c);
+      map.push_back({name, {sub, c}});
+    }
+  }
+  input.seek_subimage(0, 0);
+  return map;
+}
+
+bool is_8bit_format(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+  return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".gif";
+}
+
+}  // namespace
+
+ImageFileInfo inspect_image(const std::string& path) {
+  auto input = open_input(path);
+  ImageFileInfo info;
+  info.width = input->spec().width;
+  info.height = input->spec().height;
+  for (auto& [name, loc] : channel_map(*input)) info.channel_names.push_back(name);
+  return info;
+}
+
+Image read_image(const std::string& path, const std::vector<std::string>& channels) {
+  auto input = open_input(path);
+  const OIIO::ImageSpec spec0 = input->spec();
+  const auto map = channel_map(*input);
+  std::vector<ChannelLocation> wanted;
+  std::vector<std::string> names;
+  if (channels.empty()) {
+    for (auto& [name, loc] : map) {
+      if (loc.subimage != 0) break;  // all channels of the first part
+      wanted.push_back(loc);
+      names.push_back(name);
+    }
+  } else {
+    for (const auto& name : channels) {
+      auto it = std::find_if(map.begin(), map.end(), [&](auto& e) { return e.first == name; });
+      if (it == map.end()) {
+        std::string available;
+        for (auto& e : map) available += (available.empty() ? "" : ", ") + e.first;
+        throw ValueError(concat("image '", path, "' has no channel '", name, "' (it has: ", available, ")"));
+      }
+      wanted.push_back(it->second);
+      names.push_back(name);
+    }
+  }
+  Image out(spec0.width, spec0.height, int(wanted.size()));
+  out.channel_names = names;
+  // Read whole subimages once, then scatter the wanted channels.
+  std::vector<float> buffer;
+  for (int sub = 0; input->seek_subimage(sub, 0); ++sub) {
+    const auto& spec = input->spec();
+    bool needed = std::any_of(wanted.begin(), wanted.end(), [&](auto& w) { return w.subimage == sub; });
+    if (!needed) continue;
+    if (spec.width != spec0.width || spec.height != spec0.height)
+      throw IoError(concat("image '", path, "': part ", sub, " has another size than part 0"));
+    buffer.resize(std::size_t(spec.width) * spec.height * spec.nchannels);
+    if (!input->read_image(sub, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, buffer.data()))
+      throw IoError(concat("cannot read pixels of '", path, "': ", input->geterror()));
+    const std::size_t n = out.pixel_count();
+    for (std::size_t w = 0; w < wanted.size(); ++w) {
+      if (wanted[w].subimage != sub) continue;
+      const int c = wanted[w].index;
+      for (std::size_t i = 0; i < n; ++i) out.data()[i * wanted.size() + w] = buffer[i * spec.nchannels + c];
+    }
+  }
+  return out;
+}
+
+void write_image(const std::string& path, const ImageView& image,
+                 const std::vector<std::string>& channel_names) {
+  require_nonempty(image, concat("image to write to '", path, "'"));
+  if (!channel_names.empty() && int(channel_names.size()) != image.channels)
+    throw ValueError(concat("writing '", path, "': ", channel_names.size(), " channel names for ",
+                            image.channels, " channels"));
+  const fs::path target(path);
+  std::error_code ec;
+  if (target.has_parent_path() && !fs::is_directory(target.parent_path(), ec))
+    throw FileNotFoundError(concat("cannot write '", path, "': folder '",
+                                   target.parent_path().string(), "' does not exist"));
+  // Same folder (so rename is atomic), same extension (so OIIO picks the format).
+  static std::atomic<int> counter{0};
+  const fs::path temp = target.parent_path() /
+                        concat(".", target.stem().string(), ".tmp", getpid(), "-", counter++,
+                               target.extension().string());
+  auto output = OIIO::ImageOutput::create(temp.string());
+  if (!output)
+    throw IoError(concat("cannot write '", path, "': no image format for extension '",
+                         target.extension().string(), "'"));
+  const bool eight_bit = is_8bit_format(path);
+  OIIO::ImageSpec spec(image.width, image.height, image.channels,
+                       eight_bit ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
+  if (!channel_names.empty()) spec.channelnames = channel_names;
+  if (eight_bit && image.channels == 4) {
+    spec.alpha_channel = 3;
+    spec.attribute("oiio:UnassociatedAlpha", 1);
+  }
+  std::vector<float> clamped;
+  const float* pixels = image.data;
+  if (eight_bit) {  // OIIO would clamp too; doing it here keeps NaN out explicitly.
+    clamped.resize(image.size());
+    for (std::size_t i = 0; i < clamped.size(); ++i) {
+      float v = image.data[i];
+      clamped[i] = v != v ? 0.0f : std::clamp(v, 0.0f, 1.0f);
+    }
+    pixels = clamped.data();
+  }
+  const bool ok = output->open(temp.string(), spec) &&
+                  output->write_image(OIIO::TypeDesc::FLOAT, pixels) && output->close();
+  if (!ok) {
+    std::string why = output->geterror();
+    fs::remove(temp, ec);
+    throw IoError(concat("cannot write '", path, "': ", why));
+  }
+  fs::rename(temp, target, ec);
+  if (ec) {
+    fs::remove(temp, ec);
+    throw IoError(concat("cannot move finished image into place at '", path, "': ", ec.message()));
+  }
+}
+
+}  // namespace tempera
