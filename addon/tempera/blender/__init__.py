@@ -1,0 +1,44 @@
+"""Tempera's Blender UI: preferences, scene settings and the Output panel.
+
+The only part of the `tempera` package that imports bpy. register() and
+unregister() are symmetric: after unregister() no Tempera class is left in
+bpy.types and Scene.tempera is gone (the values stored in .blend files stay,
+and come back when the add-on is enabled again).
+"""
+import bpy
+
+from .panels import TEMPERA_PT_output
+from .preferences import TemperaPreferences
+from .properties import TemperaSettings
+
+# Registration order: property groups before the pointers and panels using them.
+CLASSES = (
+    TemperaPreferences,
+    TemperaSettings,
+    TEMPERA_PT_output,
+)
+
+
+def register():
+    registered = []
+    try:
+        for cls in CLASSES:
+            bpy.utils.register_class(cls)
+            registered.append(cls)
+        bpy.types.Scene.tempera = bpy.props.PointerProperty(
+            type=TemperaSettings, name="Tempera", description="Tempera stylization settings"
+        )
+    except Exception:
+        # Leave nothing half-registered behind: Blender does not call
+        # unregister() when register() fails.
+        for cls in reversed(registered):
+            bpy.utils.unregister_class(cls)
+        raise
+
+
+def unregister():
+    if hasattr(bpy.types.Scene, "tempera"):
+        del bpy.types.Scene.tempera
+    for cls in reversed(CLASSES):
+        if cls.is_registered:
+            bpy.utils.unregister_class(cls)
