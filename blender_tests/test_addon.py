@@ -1,0 +1,164 @@
+"""The Tempera add-on inside Blender, installed from the add-on zip."""
+import os
+from pathlib import Path
+
+import bpy
+import numpy as np
+import pytest
+
+import tempera
+from conftest import ADDON, disable, enable, is_enabled, registered_tempera_classes
+
+EXPECTED_CLASSES = ["TEMPERA_PT_output", "TemperaPreferences", "TemperaSettings"]
+
+
+def test_addon_is_enabled_from_the_installed_zip():
+    assert is_enabled()
+    scripts_dir = Path(os.environ["TEMPERA_TEST_SCRIPTS_DIR"])
+    module_file = Path(tempera.__file__).resolve()
+    assert module_file == scripts_dir / "addons" / "tempera" / "__init__.py"
+    # The zipped copy, not the source tree (which the Python tests use).
+    repo_addon = Path(__file__).resolve().parent.parent / "addon"
+    assert repo_addon not in module_file.parents
+    assert list(module_file.parent.glob("_native*.so")), "the zip carries no compiled module"
+
+
+def test_native_module_reads_and_writes_exr(tmp_path):
+    rng = np.random.default_rng(1)
+    image = rng.random((6, 9, 3), dtype=np.float32)
+    names = ["ViewLayer.DiffCol.R", "ViewLayer.DiffCol.G", "ViewLayer.DiffCol.B"]
+    path = tmp_path / "guide.exr"
+    tempera.write_image(str(path), image, names)
+    info = tempera.image_info(str(path))
+    assert (info["width"], info["height"]) == (9, 6)
+    assert sorted(info["channels"]) == sorted(names)
+    np.testing.assert_array_equal(tempera.read_image(str(path), names), image)
+    assert tempera._native.__version__ == tempera.__version__
+
+
+def test_bl_info_matches_package_version():
+    assert tempera.bl_info["version"] == tuple(int(p) for p in tempera.__version__.split("."))
+    assert bpy.app.version >= tempera.bl_info["blender"]
+
+
+def test_classes_and_scene_settings_are_registered():
+    assert hasattr(bpy.types, "TEMPERA_PT_output")
+    assert registered_tempera_classes() == sorted(EXPECTED_CLASSES)
+    assert bpy.types.TEMPERA_PT_output.bl_context == "output"
+    assert bpy.types.TEMPERA_PT_output.bl_space_type == "PROPERTIES"
+    settings = bpy.context.scene.tempera
+    assert settings.output_dir == "//tempera/"
+    assert settings.patch_size == 5
+    assert settings.seed == 0
+    assert bpy.types.Scene.bl_rna.properties["tempera"].fixed_type.identifier == "TemperaSettings"
+
+
+def test_addon_preferences_are_registered():
+    prefs = bpy.context.preferences.addons[ADDON].preferences
+    assert prefs is not None and type(prefs).__name__ == "TemperaPreferences"
+    assert prefs.cli_path == ""
+
+
+def test_patch_size_stays_odd_and_in_range():
+    settings = bpy.context.scene.tempera
+    try:
+        settings.patch_size = 6
+        assert settings.patch_size == 7
+        settings.patch_size = 9
+        assert settings.patch_size == 9
+        settings.patch_size = 100
+        assert settings.patch_size == 15
+        settings.patch_size = 1
+        assert settings.patch_size == 3
+    finally:
+        settings.patch_size = 5
+
+
+def test_disable_leaves_no_trace():
+    disable()
+    assert not is_enabled()
+    assert registered_tempera_classes() == []
+    assert not hasattr(bpy.types, "TEMPERA_PT_output")
+    assert not hasattr(bpy.types.Scene, "tempera")
+    assert not hasattr(bpy.context.scene, "tempera")
+    assert ADDON not in bpy.context.preferences.addons
+
+
+def test_enable_disable_cycles():
+    for _ in range(2):
+        enable()
+        assert registered_tempera_classes() == sorted(EXPECTED_CLASSES)
+        assert bpy.context.scene.tempera.patch_size == 5
+        disable()
+        assert registered_tempera_classes() == []
+        assert not hasattr(bpy.types.Scene, "tempera")
+    enable()
+    assert is_enabled()
+
+
+def test_settings_survive_disable_and_enable():
+    settings = bpy.context.scene.tempera
+    settings.seed = 31
+    disable()
+    enable()
+    assert bpy.context.scene.tempera.seed == 31
+    bpy.context.scene.tempera.seed = 0
+
+
+def test_settings_survive_save_and_reload(tmp_path):
+    blend = tmp_path / "settings.blend"
+    settings = bpy.context.scene.tempera
+    settings.output_dir = "//stylized/shot_010/"
+    settings.seed = 1234
+    settings.patch_size = 9
+    bpy.ops.wm.save_as_mainfile(filepath=str(blend))
+    assert blend.is_file()
+    # Change them in memory, then load the file back: the saved values return.
+    settings.output_dir, settings.seed, settings.patch_size = "//elsewhere/", 7, 3
+    bpy.ops.wm.open_mainfile(filepath=str(blend))
+    loaded = bpy.context.scene.tempera
+    assert (loaded.output_dir, loaded.seed, loaded.patch_size) == ("//stylized/shot_010/", 1234, 9)
+    assert is_enabled()
+
+
+class _Recorder:
+    """Stands in for bpy.types.UILayout: records prop() and label() calls and
+    checks that every drawn property exists."""
+
+    def __init__(self, calls):
+        self.calls = calls
+
+    def prop(self, data, name, **kwargs):
+        assert name in data.bl_rna.properties, f"{type(data).__name__} has no property {name!r}"
+        self.calls.append(("prop", name))
+
+    def label(self, text="", **kwargs):
+        self.calls.append(("label", text))
+
+    def _sub(self, *args, **kwargs):
+        return _Recorder(self.calls)
+
+    row = column = box = split = column_flow = _sub
+
+
+def test_output_panel_draws_version_and_settings():
+    calls = []
+    fake = type("FakePanel", (), {"layout": _Recorder(calls)})()
+    bpy.types.TEMPERA_PT_output.draw(fake, bpy.context)
+    props = [name for kind, name in calls if kind == "prop"]
+    labels = [text for kind, text in calls if kind == "label"]
+    assert props == ["output_dir", "patch_size", "seed"]
+    assert f"Version {tempera.__version__}" in labels
+
+
+def test_preferences_draw_reports_the_cli(tmp_path):
+    cli = os.environ.get("TEMPERA_CLI") or str(Path(__file__).resolve().parent.parent / "build" / "bin" / "tempera")
+    prefs = bpy.context.preferences.addons[ADDON].preferences
+    for path, expected in [(cli, f"tempera {tempera.__version__} at"), (str(tmp_path / "nope"), "not found")]:
+        prefs.cli_path = path
+        calls = []
+        fake = type("FakePrefs", (), {"layout": _Recorder(calls), "cli_path": prefs.cli_path,
+                                      "bl_rna": prefs.bl_rna})()
+        type(prefs).draw(fake, bpy.context)
+        assert any(expected in text for kind, text in calls if kind == "label"), calls
+    prefs.cli_path = ""

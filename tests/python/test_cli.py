@@ -1,0 +1,71 @@
+"""The `tempera` batch command line, and tempera.cli which locates it."""
+import os
+import subprocess
+
+import pytest
+
+import tempera
+from tempera import cli
+
+
+def run(cli_path, *args):
+    return subprocess.run([str(cli_path), *args], capture_output=True, text=True, timeout=30)
+
+
+def test_version(cli_path):
+    result = run(cli_path, "--version")
+    assert result.returncode == 0, result.stderr
+    assert result.stdout == f"tempera {tempera.__version__}\n"
+
+
+def test_help(cli_path):
+    result = run(cli_path, "--help")
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith("usage: tempera")
+    assert "--version" in result.stdout
+
+
+def test_no_arguments_prints_usage_and_fails(cli_path):
+    result = run(cli_path)
+    assert result.returncode == 2
+    assert result.stdout.startswith("usage: tempera")
+
+
+def test_unknown_command_fails_naming_it(cli_path):
+    result = run(cli_path, "no-such-command")
+    assert result.returncode == 2
+    assert "no-such-command" in result.stderr
+
+
+def test_find_cli_explicit_file_and_folder(cli_path):
+    assert cli.find_cli(str(cli_path)) == cli_path.resolve()
+    assert cli.find_cli(str(cli_path.parent)) == cli_path.resolve()
+    assert cli.cli_version(cli.find_cli(str(cli_path))) == tempera.__version__
+
+
+def test_find_cli_on_path(cli_path, monkeypatch):
+    monkeypatch.setenv("PATH", str(cli_path.parent))
+    assert cli.find_cli() == cli_path.resolve()
+    monkeypatch.setenv("PATH", "")
+    with pytest.raises(cli.CliError, match="not found on PATH"):
+        cli.find_cli()
+
+
+def test_find_cli_rejects_missing_and_non_executable(tmp_path):
+    with pytest.raises(cli.CliError, match="not found"):
+        cli.find_cli(str(tmp_path / "tempera"))
+    plain = tmp_path / "tempera"
+    plain.write_text("#!/bin/sh\n")
+    os.chmod(plain, 0o644)
+    with pytest.raises(cli.CliError, match="not executable"):
+        cli.find_cli(str(plain))
+
+
+def test_cli_version_rejects_other_programs(tmp_path):
+    impostor = tmp_path / "tempera"
+    impostor.write_text("#!/bin/sh\necho 'something else entirely'\n")
+    os.chmod(impostor, 0o755)
+    with pytest.raises(cli.CliError, match="did not answer"):
+        cli.cli_version(impostor)
+    with pytest.raises(cli.CliError, match="cannot run"):
+        cli.cli_version(tmp_path / "missing")
