@@ -7,7 +7,7 @@ PYTHON   := /usr/bin/python3
 BLENDER  ?= blender
 BUILD    ?= build
 JOBS     ?= $(shell nproc)
-VERSION  := $(shell sed -n 's/^project(tempera VERSION \([0-9.]*\).*/\1/p' CMakeLists.txt)
+VERSION  := $(shell sed -n 's/^project.tempera VERSION \([0-9.]*\).*/\1/p' CMakeLists.txt)
 ADDON_ZIP := dist/tempera-addon-$(VERSION).zip
 DEMO_OUT ?= out/demo
 
