@@ -12,6 +12,7 @@ Two halves, one module so that the tests and the demo cannot drift apart:
 Scripts running inside Blender import this file by putting tools/ on sys.path.
 """
 import os
+import shutil
 import sys
 import tempfile
 from pathlib import Path
@@ -61,16 +62,26 @@ def install_addon_zip(zip_path, scripts_dir=None):
     written to the user's ~/.config/blender. Raises RuntimeError if the
     add-on does not install, does not enable, or resolves to another copy.
     """
-    import addon_utils
-    import bpy
-
     zip_path = Path(zip_path).resolve()
     if not zip_path.is_file():
         raise RuntimeError(f"add-on zip not found: {zip_path} (run 'make addon-zip')")
     hide_source_addon()
+    created = scripts_dir is None
     scripts_dir = Path(scripts_dir or tempfile.mkdtemp(prefix="tempera-blender-scripts-")).resolve()
-    (scripts_dir / "addons").mkdir(parents=True, exist_ok=True)
+    try:
+        _install_and_enable(zip_path, scripts_dir)
+    except BaseException:
+        if created:
+            shutil.rmtree(scripts_dir, ignore_errors=True)
+        raise
+    return scripts_dir
 
+
+def _install_and_enable(zip_path, scripts_dir):
+    import addon_utils
+    import bpy
+
+    (scripts_dir / "addons").mkdir(parents=True, exist_ok=True)
     filepaths = bpy.context.preferences.filepaths
     if not hasattr(filepaths, "script_directory"):
         # 3.6 replaced the single folder with a list, 4.2 installs extensions
@@ -91,4 +102,3 @@ def install_addon_zip(zip_path, scripts_dir=None):
         raise RuntimeError(f"enabling the '{ADDON_MODULE}' add-on failed: {errors[0] if errors else 'unknown error'}")
     if Path(module.__file__).resolve() != installed.resolve():
         raise RuntimeError(f"'{ADDON_MODULE}' was imported from {module.__file__}, not from the installed {installed}")
-    return scripts_dir

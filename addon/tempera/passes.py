@@ -29,7 +29,7 @@ PASSES = {
         RenderPass("GlossDir", "RGB", "use_pass_glossy_direct", "direct glossy reflection (without colour)"),
         RenderPass("GlossCol", "RGB", "use_pass_glossy_color", "glossy colour"),
         RenderPass("Normal", "XYZ", "use_pass_normal", "world-space shading normal"),
-        RenderPass("Vector", "XYZW", "use_pass_vector", "screen-space motion in pixels: XY to previous, ZW to next frame"),
+        RenderPass("Vector", "XYZW", "use_pass_vector", "motion vectors in pixels: XY relative to the previous frame, ZW to the next"),
         RenderPass("Depth", "Z", "use_pass_z", "camera distance"),
     )
 }
