@@ -7,11 +7,12 @@
 #include <string>
 #include <vector>
 
+#include "cli_args.hpp"
 #include "tempera/error.hpp"
 
 namespace {
 
-using Args = std::vector<std::string>;
+using tempera::cli::Args;
 
 struct Command {
   const char* summary;
@@ -19,22 +20,20 @@ struct Command {
 };
 
 const std::map<std::string, Command>& commands() {
-  static const std::map<std::string, Command> table = {};
+  static const std::map<std::string, Command> table = {
+      {"synth", {"guided patch synthesis of one image (StyLit / image analogies)", tempera::cli::run_synth}},
+  };
   return table;
 }
 
 void print_help() {
   std::cout << "usage: tempera [--help] [--version] <command> [options]\n\n"
                "Tempera stylizes 3D animations by example.\n\n";
-  if (commands().empty()) {
-    std::cout << "No commands are built into this version yet.\n";
-  } else {
-    std::cout << "commands:\n";
-    for (const auto& [name, command] : commands())
-      std::cout << "  " << name << std::string(16 - std::min<size_t>(15, name.size()), ' ')
-                << command.summary << "\n";
-    std::cout << "\nRun 'tempera <command> --help' for a command's options.\n";
-  }
+  std::cout << "commands:\n";
+  for (const auto& [name, command] : commands())
+    std::cout << "  " << name << std::string(16 - std::min<size_t>(15, name.size()), ' ') << command.summary
+              << "\n";
+  std::cout << "\nRun 'tempera <command> --help' for a command's options.\n";
 }
 
 }  // namespace

@@ -72,9 +72,12 @@ void bind_io(py::module_& m) {
 
 }  // namespace
 
+void bind_synthesis(py::module_& m);  // bind_synthesis.cpp
+
 PYBIND11_MODULE(_native, m) {
   m.doc() = "Tempera native engine";
   m.attr("__version__") = TEMPERA_VERSION;
   register_exceptions(m);
   bind_io(m);
+  bind_synthesis(m);
 }

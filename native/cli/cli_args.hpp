@@ -1,0 +1,49 @@
+#pragma once
+// Small command-line reader shared by the `tempera` subcommands.
+#include <charconv>
+#include <string>
+#include <vector>
+
+#include "tempera/error.hpp"
+
+namespace tempera::cli {
+
+using Args = std::vector<std::string>;
+
+class ArgReader {
+ public:
+  ArgReader(const Args& args, std::string command) : args_(args), command_(std::move(command)) {}
+  bool wants_help() const {
+    for (const auto& a : args_)
+      if (a == "--help" || a == "-h") return true;
+    return false;
+  }
+  bool more() const { return pos_ < args_.size(); }
+  std::string flag() {
+    const std::string& f = args_[pos_++];
+    if (f.rfind("--", 0) != 0) throw ValueError(concat("unexpected argument '", f, "'"));
+    return f;
+  }
+  std::string value(const std::string& flag) {
+    if (pos_ >= args_.size()) throw ValueError(concat(flag, " needs a value"));
+    return args_[pos_++];
+  }
+  template <typename T>
+  T number(const std::string& flag) {
+    const std::string text = value(flag);
+    T out{};
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), out);
+    if (ec != std::errc() || end != text.data() + text.size())
+      throw ValueError(concat(flag, " expects a number, got '", text, "'"));
+    return out;
+  }
+
+ private:
+  const Args& args_;
+  std::string command_;
+  std::size_t pos_ = 0;
+};
+
+int run_synth(const Args& args);
+
+}  // namespace tempera::cli
