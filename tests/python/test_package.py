@@ -69,3 +69,9 @@ def test_missing_native_module_says_how_to_build_it(tmp_path):
     last = result.stderr.strip().splitlines()[-1]
     assert last.startswith("ImportError:"), result.stderr
     assert "make build" in last and "tempera._native" in last
+
+
+def test_setup_py_version_comes_from_cmake():
+    result = subprocess.run([sys.executable, "setup.py", "--version"], cwd=ROOT, capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip().splitlines()[-1] == cmake_project_version()
