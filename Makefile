@@ -37,7 +37,7 @@ demo: build addon-zip
 	$(PYTHON) tools/run_demo.py --addon-zip $(ADDON_ZIP) --blender $(BLENDER) --out $(DEMO_OUT)
 
 bench: build
-	PYTHONPATH=addon $(PYTHON) bench/run_all.py
+	PYTHONPATH=addon $(PYTHON) bench/bench_synthesis.py --size 1024 --json docs/bench_synthesis_1024.json
 
 sanitize: deps
 	cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DTEMPERA_SANITIZE=ON \

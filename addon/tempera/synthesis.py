@@ -66,9 +66,10 @@ def synthesize(
     patch_size: int = 5,
     levels: int = 0,
     em_iterations: int = 6,
-    pm_iterations: int = 4,
+    pm_iterations: int = 2,
     style_weight: float = 1.0,
     penalty_weight: float = 1.0,
+    guide_variance: float = 0.999,
     budget_coverage: float = 0.95,
     budget_max_rounds: int = 16,
     seed: int = 1,
@@ -89,6 +90,8 @@ def synthesize(
     ``usage``: ``none``, ``penalty`` (occurrence penalty, ``penalty_weight``),
     ``uniform`` (every source patch used equally; per ``*_segments`` label) or
     ``budget`` (StyLit's error budget, the default).
+    ``guide_variance``: fraction of the weighted guide variance kept when the
+    guide channels are compressed by PCA (1.0 = exact matching, slower).
     Orientations are per-pixel angles in radians (direction (cos a, sin a), x
     right, y down); giving either enables rotation-aware patches.
     ``progress(fraction)`` is called during the run; returning False cancels it
@@ -112,7 +115,7 @@ def synthesize(
 
     return _native.synthesize(
         style, guide_list, usage, int(patch_size), int(levels), int(em_iterations), int(pm_iterations),
-        float(style_weight), float(penalty_weight), float(budget_coverage), int(budget_max_rounds),
+        float(style_weight), float(penalty_weight), float(guide_variance), float(budget_coverage), int(budget_max_rounds),
         int(seed), int(threads),
         _optional(source_mask, "source mask"), _optional(target_mask, "target mask"),
         _optional(source_orientation, "source orientation"), _optional(target_orientation, "target orientation"),

@@ -27,9 +27,10 @@ const char* kSynthHelp =
     "  --patch-size N          odd patch width (default 5)\n"
     "  --levels N              pyramid levels (default 0 = automatic)\n"
     "  --em-iters N            search+vote iterations per level (default 6)\n"
-    "  --pm-iters N            PatchMatch sweeps per search (default 4)\n"
+    "  --pm-iters N            PatchMatch sweeps per search (default 2)\n"
     "  --style-weight W        weight of the style term (default 1)\n"
     "  --penalty-weight W      occurrence penalty lambda for --usage penalty (default 1)\n"
+    "  --guide-variance F     guide variance kept by PCA compression (default 0.999; 1 = exact)\n"
     "  --source-mask FILE      exemplar pixels that may be copied (> 0.5)\n"
     "  --target-mask FILE      output pixels to synthesize (> 0.5)\n"
     "  --seed N                random seed (default 1)\n"
@@ -48,7 +49,8 @@ Image read_mask(const std::string& path) { return extract_channels(read_image(pa
 void write_stats(const std::string& path, const SynthesisResult& r, const SynthesisOptions& opt) {
   std::ofstream out(path + ".tmp");
   out << "{\n  \"usage\": \"" << patch_usage_name(opt.usage) << "\",\n  \"seconds\": " << r.seconds
-      << ",\n  \"source_coverage\": " << r.source_coverage << ",\n  \"levels\": [\n";
+      << ",\n  \"source_coverage\": " << r.source_coverage << ",\n  \"guide_channels\": " << r.guide_channels
+      << ",\n  \"kept_guide_variance\": " << r.kept_guide_variance << ",\n  \"levels\": [\n";
   for (std::size_t i = 0; i < r.levels.size(); ++i) {
     const auto& l = r.levels[i];
     out << "    {\"level\": " << l.level << ", \"width\": " << l.width << ", \"height\": " << l.height
@@ -94,6 +96,7 @@ int run_synth(const Args& args) {
     else if (flag == "--pm-iters") opt.pm_iterations = in.number<int>(flag);
     else if (flag == "--style-weight") opt.style_weight = in.number<float>(flag);
     else if (flag == "--penalty-weight") opt.penalty_weight = in.number<float>(flag);
+    else if (flag == "--guide-variance") opt.guide_variance = in.number<double>(flag);
     else if (flag == "--source-mask") source_mask_path = in.value(flag);
     else if (flag == "--target-mask") target_mask_path = in.value(flag);
     else if (flag == "--seed") opt.seed = in.number<std::uint64_t>(flag);

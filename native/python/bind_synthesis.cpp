@@ -53,8 +53,8 @@ py::array_t<std::int32_t> nnf_array(const Nnf& nnf) {
 
 py::tuple synthesize_py(const FloatArray& style, const std::vector<GuideArg>& guides, const std::string& usage,
                         int patch_size, int levels, int em_iterations, int pm_iterations, float style_weight,
-                        float penalty_weight, double budget_coverage, int budget_max_rounds, std::uint64_t seed,
-                        int threads, const std::optional<FloatArray>& source_mask,
+                        float penalty_weight, double guide_variance, double budget_coverage, int budget_max_rounds,
+                        std::uint64_t seed, int threads, const std::optional<FloatArray>& source_mask,
                         const std::optional<FloatArray>& target_mask,
                         const std::optional<FloatArray>& source_orientation,
                         const std::optional<FloatArray>& target_orientation,
@@ -87,6 +87,7 @@ py::tuple synthesize_py(const FloatArray& style, const std::vector<GuideArg>& gu
   opt.pm_iterations = pm_iterations;
   opt.style_weight = style_weight;
   opt.penalty_weight = penalty_weight;
+  opt.guide_variance = guide_variance;
   opt.budget_coverage = budget_coverage;
   opt.budget_max_rounds = budget_max_rounds;
   opt.seed = seed;
@@ -109,6 +110,8 @@ py::tuple synthesize_py(const FloatArray& style, const std::vector<GuideArg>& gu
   stats["seconds"] = result.seconds;
   stats["source_coverage"] = result.source_coverage;
   stats["usage"] = usage;
+  stats["guide_channels"] = result.guide_channels;
+  stats["kept_guide_variance"] = result.kept_guide_variance;
   stats["nnf"] = nnf_array(result.nnf);
   return py::make_tuple(py_bridge::to_numpy(std::move(result.image)), stats);
 }
@@ -119,7 +122,8 @@ void bind_synthesis(py::module_& m) {
   m.def(
       "synthesize",
       [](const FloatArray& style, const py::list& guides, const std::string& usage, int patch_size, int levels,
-         int em_iterations, int pm_iterations, float style_weight, float penalty_weight, double budget_coverage,
+         int em_iterations, int pm_iterations, float style_weight, float penalty_weight, double guide_variance,
+         double budget_coverage,
          int budget_max_rounds, std::uint64_t seed, int threads, std::optional<FloatArray> source_mask,
          std::optional<FloatArray> target_mask, std::optional<FloatArray> source_orientation,
          std::optional<FloatArray> target_orientation, std::optional<FloatArray> source_segments,
@@ -135,13 +139,13 @@ void bind_synthesis(py::module_& m) {
           parsed.push_back(std::move(g));
         }
         return synthesize_py(style, parsed, usage, patch_size, levels, em_iterations, pm_iterations, style_weight,
-                             penalty_weight, budget_coverage, budget_max_rounds, seed, threads, source_mask,
+                             penalty_weight, guide_variance, budget_coverage, budget_max_rounds, seed, threads, source_mask,
                              target_mask, source_orientation, target_orientation, source_segments, target_segments,
                              target_shape, progress);
       },
       py::arg("style"), py::arg("guides"), py::arg("usage"), py::arg("patch_size"), py::arg("levels"),
       py::arg("em_iterations"), py::arg("pm_iterations"), py::arg("style_weight"), py::arg("penalty_weight"),
-      py::arg("budget_coverage"), py::arg("budget_max_rounds"), py::arg("seed"), py::arg("threads"),
+      py::arg("guide_variance"), py::arg("budget_coverage"), py::arg("budget_max_rounds"), py::arg("seed"), py::arg("threads"),
       py::arg("source_mask"), py::arg("target_mask"), py::arg("source_orientation"), py::arg("target_orientation"),
       py::arg("source_segments"), py::arg("target_segments"), py::arg("target_shape"), py::arg("progress"),
       "Low-level engine entry; use tempera.synthesize().");

@@ -38,7 +38,7 @@ namespace {
 
 // Sum of squared differences over n floats; the simd pragma lets the compiler
 // keep vector partial sums (no -ffast-math needed).
-inline float ssd(const float* a, const float* b, int n) {
+[[gnu::always_inline]] inline float ssd(const float* a, const float* b, int n) {
   float sum = 0.0f;
 #pragma omp simd reduction(+ : sum)
   for (int i = 0; i < n; ++i) {
@@ -48,7 +48,7 @@ inline float ssd(const float* a, const float* b, int n) {
   return sum;
 }
 
-inline float weighted_ssd(const float* a, const float* b, const float* w, int n) {
+[[gnu::always_inline]] inline float weighted_ssd(const float* a, const float* b, const float* w, int n) {
   float sum = 0.0f;
 #pragma omp simd reduction(+ : sum)
   for (int i = 0; i < n; ++i) {
@@ -62,15 +62,18 @@ struct Window {
   int dx0, dx1, dy0, dy1;  // inclusive offsets of the target patch inside the target
 };
 
-inline Window clip(const PatchSpace& s, int tx, int ty) {
+[[gnu::always_inline]] inline Window clip(const PatchSpace& s, int tx, int ty) {
   const int r = s.radius;
   return Window{std::max(-r, -tx), std::min(r, s.target->width - 1 - tx), std::max(-r, -ty),
                 std::min(r, s.target->height - 1 - ty)};
 }
 
+// Helpers are always inlined so that they are compiled into each clone of
+// patch_distance (AVX2 and baseline).
+
 // Axis-aligned patches: each patch row is one contiguous run in both images.
 template <bool Weighted>
-float distance_aligned(const PatchSpace& s, int sx, int sy, int tx, int ty, float cutoff) {
+[[gnu::always_inline]] inline float distance_aligned(const PatchSpace& s, int sx, int sy, int tx, int ty, float cutoff) {
   const Window w = clip(s, tx, ty);
   const int n = (w.dx1 - w.dx0 + 1) * s.source->stride;
   float sum = 0.0f;
@@ -87,7 +90,7 @@ float distance_aligned(const PatchSpace& s, int sx, int sy, int tx, int ty, floa
 }
 
 // Rotated patches: the source is sampled bilinearly along rotated offsets.
-float distance_rotated(const PatchSpace& s, int sx, int sy, int tx, int ty, float cutoff) {
+[[gnu::always_inline]] inline float distance_rotated(const PatchSpace& s, int sx, int sy, int tx, int ty, float cutoff) {
   const Window w = clip(s, tx, ty);
   const int stride = s.source->stride;
   const float phi = s.rotation(sx, sy, tx, ty);

@@ -131,6 +131,17 @@ class ReversedRetrieval {
     });
   }
 
+  void prefetch_target(int qx, int qy) const {
+    if (qx < 0 || qy < 0 || qx >= tw_ || qy >= th_) return;
+    const int r = space_.radius;
+    const int x0 = std::max(0, qx - r), bytes = (2 * r + 1) * space_.target->stride * int(sizeof(float));
+    for (int dy = -r; dy <= std::min(r, 1 - r); ++dy) {
+      if (qy + dy < 0 || qy + dy >= th_) continue;
+      const char* row = reinterpret_cast<const char*>(space_.target->pixel(x0, qy + dy));
+      for (int off = 0; off < bytes; off += 64) __builtin_prefetch(row + off);
+    }
+  }
+
   void try_target(int sx, int sy, int qx, int qy, int segment, std::int32_t& best, float& best_dist) const {
     if (!open_target(qx, qy, segment)) return;
     const std::int32_t q = qy * tw_ + qx;
@@ -174,9 +185,15 @@ class ReversedRetrieval {
             try_target(sx, sy, nq % tw_ - int(std::lround(ox)), nq / tw_ - int(std::lround(oy)), segment, best,
                        best_dist);
           }
-          for (int r = max_radius; r >= 1; r /= 2)
-            try_target(sx, sy, best % tw_ + rng.between(-r, r), best / tw_ + rng.between(-r, r), segment, best,
-                       best_dist);
+          // Random search around the propagated best; candidates are drawn
+          // first and prefetched (see patchmatch.cpp).
+          int cand[64], n = 0;
+          for (int r = max_radius; r >= 1 && n < 64; r /= 2, n += 2) {
+            cand[n] = best % tw_ + rng.between(-r, r);
+            cand[n + 1] = best / tw_ + rng.between(-r, r);
+            prefetch_target(cand[n], cand[n + 1]);
+          }
+          for (int k = 0; k < n; k += 2) try_target(sx, sy, cand[k], cand[k + 1], segment, best, best_dist);
           const auto& list = unassigned_[segment];
           if (!list.empty()) {
             const std::int32_t q = list[rng.below(int(list.size()))];
@@ -367,25 +384,24 @@ ReversedRetrievalStats retrieve_with_budget(const PatchSpace& space, const Searc
   while (stats.rounds < params.max_rounds &&
          double(rr.assigned_count()) < params.coverage_goal * double(rr.active())) {
     const auto winners = rr.round(stats.rounds++);
-    // Error budget of this round: the sum of all candidate errors below the knee.
+    // The knee of this round's sorted candidate errors.
     std::vector<float> errors;
     for (std::size_t p = 0; p < rr.candidate().size(); ++p)
       if (rr.eligible()[p] && rr.candidate()[p] != kNone) errors.push_back(rr.candidate_dist()[p]);
     if (errors.empty()) break;
     std::sort(errors.begin(), errors.end());
-    const std::size_t knee = error_knee(errors);
-    const double budget = std::accumulate(errors.begin(), errors.begin() + knee, 0.0);
-    const float knee_error = errors[knee - 1];
+    const float knee_error = errors[error_knee(errors) - 1];
     // Sources whose best open target is already past the knee only get worse
     // as targets fill up: retire them.
     for (std::size_t p = 0; p < rr.candidate().size(); ++p)
       if (rr.eligible()[p] && rr.candidate()[p] != kNone && rr.candidate_dist()[p] > knee_error)
         rr.eligible()[p] = 0;
-    double spent = 0.0;
+    // The budget T is the sum of all candidate errors below the knee; the
+    // winners below the knee are a subset of those candidates, so taking all of
+    // them (best first) keeps the total under T (thesis eq. 8.4).
     std::size_t taken = 0;
     for (const auto& a : winners) {
-      if (a.dist > knee_error || spent + a.dist > budget) break;
-      spent += a.dist;
+      if (a.dist > knee_error) break;
       rr.assign(a);
       ++taken;
     }

@@ -40,6 +40,16 @@ struct Matcher {
   Matcher(const PatchSpace& s, const SearchConstraints& c)
       : space(s), cons(c), sw(s.source->width), sh(s.source->height), margin(s.source_margin()) {}
 
+  // Starts loading the first rows of the source patch at (cx, cy), if valid.
+  inline void prefetch(int cx, int cy) const {
+    if (cx < margin || cy < margin || cx >= sw - margin || cy >= sh - margin) return;
+    const int r = space.radius, bytes = (2 * r + 1) * space.source->stride * int(sizeof(float));
+    for (int dy = -r; dy <= std::min(r, 1 - r); ++dy) {
+      const char* row = reinterpret_cast<const char*>(space.source->pixel(cx - r, cy + dy));
+      for (int off = 0; off < bytes; off += 64) __builtin_prefetch(row + off);
+    }
+  }
+
   // Tries source (cx, cy) for target (tx, ty); keeps it if it lowers the cost.
   inline void try_candidate(int cx, int cy, int tx, int ty, int segment, std::int32_t& bx, std::int32_t& by,
                             float& bd, float& bcost) const {
@@ -123,13 +133,18 @@ void patchmatch(const PatchSpace& space, const SearchConstraints& cons, Nnf& nnf
             propagate_candidate(space, src.x[ni], src.y[ni], nx, ny, d[0], d[1], cx, cy);
             m.try_candidate(cx, cy, tx, ty, segment, bx, by, bd, bcost);
           }
-          // Random search in shrinking windows around the current best.
-          for (int r = max_radius; r >= 1; r /= 2) {
-            for (int k = 0; k < params.random_tries_per_scale; ++k) {
-              const int cx = bx + rng.between(-r, r), cy = by + rng.between(-r, r);
-              m.try_candidate(cx, cy, tx, ty, segment, bx, by, bd, bcost);
+          // Random search in shrinking windows around the match after
+          // propagation (Barnes et al. 2009). The candidates are drawn first
+          // and their source rows prefetched: each is a likely cache miss, and
+          // waiting for them one by one dominated the search time.
+          int cand[2 * 32], n = 0;
+          for (int r = max_radius; r >= 1 && n < 64; r /= 2)
+            for (int k = 0; k < params.random_tries_per_scale && n < 64; ++k, n += 2) {
+              cand[n] = bx + rng.between(-r, r);
+              cand[n + 1] = by + rng.between(-r, r);
+              m.prefetch(cand[n], cand[n + 1]);
             }
-          }
+          for (int k = 0; k < n; k += 2) m.try_candidate(cand[k], cand[k + 1], tx, ty, segment, bx, by, bd, bcost);
           nnf.x[i] = bx;
           nnf.y[i] = by;
           nnf.dist[i] = bd;

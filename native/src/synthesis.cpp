@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "tempera/error.hpp"
+#include "tempera/guide_compression.hpp"
 #include "tempera/pyramid.hpp"
 #include "tempera/voting.hpp"
 
@@ -28,6 +29,8 @@ void validate(const SynthesisInput& in, const SynthesisOptions& opt) {
     throw ValueError(concat("style weight must be finite and >= 0, got ", opt.style_weight));
   if (!std::isfinite(opt.penalty_weight) || opt.penalty_weight < 0)
     throw ValueError(concat("penalty weight must be finite and >= 0, got ", opt.penalty_weight));
+  if (!(opt.guide_variance > 0 && opt.guide_variance <= 1))
+    throw ValueError(concat("guide variance must be in (0, 1], got ", opt.guide_variance));
   if (!(opt.budget_coverage > 0 && opt.budget_coverage <= 1))
     throw ValueError(concat("budget coverage must be in (0, 1], got ", opt.budget_coverage));
   if (!in.guides.empty()) {
@@ -119,6 +122,18 @@ std::vector<Image> label_pyramid(const ImageView& labels, int levels) {
   return out;
 }
 
+Image scaled(const ImageView& image, float factor) {
+  Image out = Image::copy_of(image);
+  for (std::size_t i = 0; i < out.pixel_count() * out.channels(); ++i) out.data()[i] *= factor;
+  return out;
+}
+
+std::vector<ImageView> views(const std::vector<Image>& images) {
+  std::vector<ImageView> out;
+  for (const auto& img : images) out.push_back(img.view());
+  return out;
+}
+
 std::vector<Image> optional_pyramid(const ImageView& image, int levels) {
   return image.empty() ? std::vector<Image>{} : build_pyramid(image, levels);
 }
@@ -127,8 +142,8 @@ std::vector<Image> optional_pyramid(const ImageView& image, int levels) {
 struct Pyramids {
   int levels = 0;
   int style_channels = 0;
-  std::vector<int> guide_channels;
-  std::vector<float> guide_weights;
+  std::vector<int> guide_channels;  // per guide layer (one merged layer after PCA)
+  double kept_variance = 1.0;
   std::vector<Image> source, target;  // source: style + guides; target: guides
   std::vector<Image> source_mask, target_mask, source_angle, target_angle, source_label, target_label;
   std::vector<std::vector<Image>> weight_maps;  // per guide (may be empty)
@@ -143,16 +158,35 @@ Pyramids build_pyramids(const SynthesisInput& in, const SynthesisOptions& opt) {
                                    pyramid_levels_for(tw, th, min_side));
   p.levels = opt.levels > 0 ? opt.levels : auto_levels;
   p.style_channels = in.style.channels;
-  std::vector<ImageView> src{in.style}, tgt;
+  // Guides are scaled by sqrt(weight) once here; after that every feature
+  // channel but the style's has weight 1.
+  std::vector<Image> weighted_src, weighted_tgt;
   for (const auto& layer : in.guides.layers()) {
-    src.push_back(layer.source);
-    tgt.push_back(layer.target);
+    weighted_src.push_back(scaled(layer.source, std::sqrt(layer.weight)));
+    weighted_tgt.push_back(scaled(layer.target, std::sqrt(layer.weight)));
     p.guide_channels.push_back(layer.source.channels);
-    p.guide_weights.push_back(layer.weight);
   }
-  p.source = build_pyramid(stack_channels(src).view(), p.levels);
-  if (!tgt.empty()) p.target = build_pyramid(stack_channels(tgt).view(), p.levels);
-  else {
+  Image src_guides, tgt_guides;
+  if (!weighted_src.empty()) {
+    src_guides = stack_channels(views(weighted_src));
+    tgt_guides = stack_channels(views(weighted_tgt));
+    weighted_src.clear();
+    weighted_tgt.clear();
+    const bool has_maps = std::any_of(in.target_weight_maps.begin(), in.target_weight_maps.end(),
+                                      [](const ImageView& m) { return !m.empty(); });
+    if (opt.guide_variance < 1.0 && !has_maps && src_guides.channels() > 1) {
+      const GuideProjection proj = fit_guide_projection(src_guides.view(), tgt_guides.view(), opt.guide_variance);
+      src_guides = proj.apply(src_guides.view());
+      tgt_guides = proj.apply(tgt_guides.view());
+      p.guide_channels = {proj.output_channels()};
+      p.kept_variance = proj.kept_variance;
+    }
+  }
+  p.source = build_pyramid(src_guides.empty() ? in.style : stack_channels({in.style, src_guides.view()}).view(),
+                           p.levels);
+  if (!tgt_guides.empty()) {
+    p.target = build_pyramid(tgt_guides.view(), p.levels);
+  } else {
     Image blank(tw, th, 1);
     for (int l = 0; l < p.levels; ++l) {
       p.target.push_back(blank);
@@ -181,23 +215,18 @@ struct Level {
   Image style;  // A' at this level (unweighted), what voting copies
 };
 
+// Features: style channels scaled by `style_scale`, guides as they are.
 void fill_features(const Pyramids& p, int l, float style_scale, FeatureImage& source, FeatureImage& target) {
   const Image& src = p.source[l];
-  const Image& tgt = p.target[l];
   const int total = src.channels();
   source = FeatureImage(src.width(), src.height(), total);
-  target = FeatureImage(tgt.width(), tgt.height(), total);
-  const std::size_t ns = std::size_t(src.width()) * src.height(), nt = std::size_t(tgt.width()) * tgt.height();
-  std::vector<float> scale(total, style_scale);
-  for (std::size_t g = 0, c = p.style_channels; g < p.guide_channels.size(); c += p.guide_channels[g++])
-    std::fill_n(scale.begin() + c, p.guide_channels[g], std::sqrt(p.guide_weights[g]));
-  for (std::size_t i = 0; i < ns; ++i)
-    for (int c = 0; c < total; ++c) source.data[i * source.stride + c] = src.data()[i * total + c] * scale[c];
-  if (p.guide_channels.empty()) return;
-  const int tc = tgt.channels();
-  for (std::size_t i = 0; i < nt; ++i)
-    for (int c = 0; c < tc; ++c)
-      target.data[i * target.stride + p.style_channels + c] = tgt.data()[i * tc + c] * scale[p.style_channels + c];
+  target = FeatureImage(p.target[l].width(), p.target[l].height(), total);
+  source.set_channels(0, src.view(), 1.0f);
+  if (style_scale != 1.0f) {
+    Image style = extract_channels(src.view(), 0, p.style_channels);
+    source.set_channels(0, style.view(), style_scale);
+  }
+  if (!p.guide_channels.empty()) target.set_channels(p.style_channels, p.target[l].view(), 1.0f);
 }
 
 void build_level(const Pyramids& p, int l, const SynthesisOptions& opt, Level& level) {
@@ -346,6 +375,9 @@ SynthesisResult synthesize(const SynthesisInput& in, const SynthesisOptions& opt
   result.image = std::move(bprime);
   result.nnf = std::move(nnf);
   result.seconds = seconds_since(t_start);
+  result.guide_channels = 0;
+  for (int c : pyr.guide_channels) result.guide_channels += c;
+  result.kept_guide_variance = pyr.kept_variance;
   return result;
 }
 

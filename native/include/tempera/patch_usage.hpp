@@ -20,7 +20,7 @@ PatchUsage parse_patch_usage(const std::string& name);  // ValueError for unknow
 const char* patch_usage_name(PatchUsage usage);
 
 struct ReversedRetrievalParams {
-  int pm_iterations = 2;          // PatchMatch sweeps (in source space) per round
+  int pm_iterations = 1;          // PatchMatch sweeps (in source space) per round; candidates persist across rounds
   double coverage_goal = 0.95;    // budget: stop once this fraction of targets is covered
   int max_rounds = 16;            // budget: at most this many rounds
   std::uint64_t seed = 1;
