@@ -16,7 +16,7 @@ bl_info = {
     "blender": (3, 4, 0),
     "location": "Properties > Output > Tempera",
     "description": "Stylize 3D animations by example",
-    "warning": "Early development: settings and image IO only, no stylization yet",
+    "warning": "Early development: the Blender UI does not stylize yet (use tempera.synthesize / tempera synth)",
     "category": "Render",
 }
 
@@ -31,9 +31,9 @@ except ImportError as exc:  # not built, or built for another Python
         "(or install the add-on zip / wheel made by 'make addon-zip' / 'make wheel')."
     ) from exc
 
-# Python API on top of the native module. New public entry points (e.g.
-# synthesize) are imported here and listed in __all__.
+# Python API on top of the native module; public entry points are listed in __all__.
 from .contact_sheet import contact_sheet
+from .synthesis import USAGE_MODES, synthesize
 
 __all__ = [
     "__version__",
@@ -41,6 +41,8 @@ __all__ = [
     "contact_sheet",
     "image_info",
     "read_image",
+    "synthesize",
+    "USAGE_MODES",
     "write_image",
 ]
 
