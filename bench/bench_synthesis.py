@@ -66,11 +66,22 @@ def hatching_style(full, seed=1):
     return (paper * (1 - ink[..., None]) + pigment * ink[..., None] * (0.6 + 0.4 * full)).astype(np.float32)
 
 
+def guide_error(src, tgt, nnf):
+    """Quality independent of engine settings: mean squared difference, over all
+    twelve guide channels, between each target pixel and the source pixel its
+    patch was copied from (lower = the style lands where the lighting matches)."""
+    sx, sy = nnf[..., 0], nnf[..., 1]
+    return float(np.mean([((a[sy, sx] - b) ** 2).sum(-1).mean() for a, b in zip(src, tgt)]))
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--size", type=int, default=1024, help="side of the square source and target")
     parser.add_argument("--usage", default="budget")
     parser.add_argument("--threads", type=int, default=0)
+    parser.add_argument("--em-iters", type=int, default=6)
+    parser.add_argument("--pm-iters", type=int, default=2)
+    parser.add_argument("--guide-variance", type=float, default=0.999)
     parser.add_argument("--json")
     args = parser.parse_args()
     s = args.size
@@ -81,7 +92,8 @@ def main():
     style = hatching_style(src[0])
     guides = [(a, b, 1.0) for a, b in zip(src, tgt)]
     t0 = time.perf_counter()
-    image, stats = synthesize(style, guides, usage=args.usage, threads=args.threads)
+    image, stats = synthesize(style, guides, usage=args.usage, threads=args.threads, em_iterations=args.em_iters,
+                              pm_iterations=args.pm_iters, guide_variance=args.guide_variance)
     wall = time.perf_counter() - t0
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     finest = stats["levels"][-1]
@@ -91,6 +103,10 @@ def main():
         "wall_seconds": round(wall, 2),
         "peak_rss_mb": round(peak_mb, 1),
         "final_energy": finest["energy"][-1],
+        "guide_error": guide_error(src, tgt, stats["nnf"]),
+        "settings": {"em_iterations": args.em_iters, "pm_iterations": args.pm_iters,
+                     "guide_variance": args.guide_variance, "threads": args.threads},
+        "guide_channels_matched": stats["guide_channels"],
         "levels": [{k: l[k] for k in ("width", "height", "search_seconds", "usage_seconds", "vote_seconds",
                                       "usage_rounds", "energy")} for l in stats["levels"]],
         "source_coverage": stats["source_coverage"],

@@ -1,0 +1,63 @@
+#!/usr/bin/env python3
+"""Regenerates the engine pictures in docs/images/ from procedural inputs.
+
+    PYTHONPATH=addon /usr/bin/python3 docs/make_engine_figures.py
+"""
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "bench"))
+import tempera  # noqa: E402
+from bench_synthesis import hatching_style, shade_scene  # noqa: E402
+
+OUT = ROOT / "docs" / "images"
+
+
+def labelled_row(images, gap=6):
+    h = max(i.shape[0] for i in images)
+    tiles = []
+    for img in images:
+        rgb = img if img.shape[2] == 3 else np.repeat(img[..., :1], 3, -1)
+        tile = np.ones((h, rgb.shape[1], 3), np.float32)
+        tile[: rgb.shape[0]] = np.clip(rgb, 0, 1)
+        tiles += [tile, np.ones((h, gap, 3), np.float32)]
+    return np.concatenate(tiles[:-1], 1)
+
+
+def usage_modes(size=320):
+    s = size
+    src = shade_scene(s, s, [(0.5 * s, 0.5 * s, 0.28 * s, (0.9, 0.9, 0.9))])
+    tgt = shade_scene(s, s, [(0.3 * s, 0.35 * s, 0.18 * s, (0.9, 0.9, 0.9)),
+                             (0.7 * s, 0.45 * s, 0.22 * s, (0.9, 0.9, 0.9)),
+                             (0.45 * s, 0.75 * s, 0.12 * s, (0.9, 0.9, 0.9))])
+    style = hatching_style(src[0])
+    guides = [(a, b, 1.0) for a, b in zip(src, tgt)]
+    results = [tempera.synthesize(style, guides, usage=u, seed=1)[0] for u in ("none", "uniform", "budget")]
+    row = labelled_row([style, src[0] / src[0].max(), tgt[0] / tgt[0].max(), *results])
+    tempera.write_image(str(OUT / "patch_usage_modes.png"), row)
+
+
+def blue_yellow(size=96):
+    """Thesis Figure 8.7: mostly blue source, mostly yellow target."""
+    rng = np.random.default_rng(3)
+    tex = 0.15 * rng.random((size, size), dtype=np.float32)
+    src_guide = (np.arange(size)[None, :] >= int(0.84 * size)).astype(np.float32).repeat(size, 0)
+    tgt_guide = (np.arange(size)[None, :] >= int(0.25 * size)).astype(np.float32).repeat(size, 0)
+    yellow = src_guide > 0.5
+    style = np.stack([np.where(yellow, 0.85 + tex, tex), np.where(yellow, 0.85 + tex, tex),
+                      np.where(yellow, tex, 0.85 + tex)], -1).astype(np.float32)
+    guides = [(src_guide, tgt_guide, 2.0)]
+    uniform = tempera.synthesize(style, guides, usage="uniform")[0]
+    budget = tempera.synthesize(style, guides, usage="budget")[0]
+    tempera.write_image(str(OUT / "budget_vs_uniform.png"),
+                        labelled_row([style, src_guide[..., None], tgt_guide[..., None], uniform, budget]))
+
+
+if __name__ == "__main__":
+    OUT.mkdir(parents=True, exist_ok=True)
+    usage_modes()
+    blue_yellow()
+    print("wrote", *sorted(p.name for p in OUT.glob("*.png")))
