@@ -1,6 +1,8 @@
 #include "tempera/patch_usage.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <cstring>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -54,6 +56,7 @@ class ReversedRetrieval {
       : space_(space), cons_(cons), nnf_(nnf), params_(params), stream_(stream),
         sw_(space.source->width), sh_(space.source->height), tw_(nnf.width), th_(nnf.height),
         assigned_(std::size_t(tw_) * th_, 0), eligible_(std::size_t(sw_) * sh_, 0),
+        wide_search_(std::size_t(sw_) * sh_, 0),
         candidate_(std::size_t(sw_) * sh_, kNone), candidate_dist_(std::size_t(sw_) * sh_, kInf) {
     for (std::size_t i = 0; i < assigned_.size(); ++i)
       if (cons.target_active[i]) ++active_;
@@ -66,7 +69,7 @@ class ReversedRetrieval {
   const std::vector<float>& candidate_dist() const { return candidate_dist_; }
 
   // One round of retrieval: fills candidates for eligible sources and returns
-  // the collision-free (best source per target) assignments, ascending.
+  // the collision-free (best source per target) assignments, in target order.
   std::vector<Assignment> round(int round_index) {
     collect_unassigned();
     seed_candidates(round_index);
@@ -101,12 +104,15 @@ class ReversedRetrieval {
 
   // Keeps still-open candidates, adopts targets whose forward match is this
   // source (the forward NNF already knows good pairs), else picks at random.
+  // Only the random picks need the wide random search of the sweep; the
+  // others are refined by propagation alone (half the cost of a round).
   void seed_candidates(int round_index) {
     for (std::size_t p = 0; p < candidate_.size(); ++p) {
       if (!eligible_[p] || (candidate_[p] != kNone && assigned_[candidate_[p]])) {
         candidate_[p] = kNone;
         candidate_dist_[p] = kInf;
       }
+      wide_search_[p] = 0;
     }
     for (const auto& list : unassigned_) {
       for (std::int32_t q : list) {
@@ -127,6 +133,7 @@ class ReversedRetrieval {
         const std::int32_t q = list[rng.below(int(list.size()))];
         candidate_[p] = q;
         candidate_dist_[p] = patch_distance(space_, sx, sy, q % tw_, q / tw_, kInf);
+        wide_search_[p] = 1;
       }
     });
   }
@@ -188,7 +195,7 @@ class ReversedRetrieval {
           // Random search around the propagated best; candidates are drawn
           // first and prefetched (see patchmatch.cpp).
           int cand[64], n = 0;
-          for (int r = max_radius; r >= 1 && n < 64; r /= 2, n += 2) {
+          for (int r = wide_search_[p] ? max_radius : 0; r >= 1 && n < 64; r /= 2, n += 2) {
             cand[n] = best % tw_ + rng.between(-r, r);
             cand[n + 1] = best / tw_ + rng.between(-r, r);
             prefetch_target(cand[n], cand[n + 1]);
@@ -206,17 +213,30 @@ class ReversedRetrieval {
     });
   }
 
+  // Best source per target, in parallel: an atomic minimum over (distance
+  // bits, source index), so the winner does not depend on thread timing.
   std::vector<Assignment> resolve_collisions() const {
-    std::vector<std::int32_t> winner(assigned_.size(), kNone);
-    for (std::size_t p = 0; p < candidate_.size(); ++p) {
-      const std::int32_t q = candidate_[p];
-      if (!eligible_[p] || q == kNone || assigned_[q]) continue;
-      if (winner[q] == kNone || candidate_dist_[p] < candidate_dist_[winner[q]]) winner[q] = std::int32_t(p);
-    }
+    std::vector<std::atomic<std::uint64_t>> best(assigned_.size());
+    for (auto& b : best) b.store(~0ull, std::memory_order_relaxed);
+    parallel_for(sh_, params_.threads, [&](int sy) {
+      for (std::size_t p = std::size_t(sy) * sw_, end = p + sw_; p < end; ++p) {
+        const std::int32_t q = candidate_[p];
+        if (!eligible_[p] || q == kNone || assigned_[q]) continue;
+        std::uint32_t bits;
+        std::memcpy(&bits, &candidate_dist_[p], sizeof bits);  // >= 0: bits order like values
+        const std::uint64_t key = (std::uint64_t(bits) << 32) | std::uint64_t(p);
+        std::uint64_t cur = best[q].load(std::memory_order_relaxed);
+        while (key < cur && !best[q].compare_exchange_weak(cur, key, std::memory_order_relaxed)) {
+        }
+      }
+    });
     std::vector<Assignment> out;
-    for (std::size_t q = 0; q < winner.size(); ++q)
-      if (winner[q] != kNone) out.push_back({candidate_dist_[winner[q]], std::int32_t(q), winner[q]});
-    std::sort(out.begin(), out.end());
+    for (std::size_t q = 0; q < best.size(); ++q) {
+      const std::uint64_t key = best[q].load(std::memory_order_relaxed);
+      if (key == ~0ull) continue;
+      const std::int32_t p = std::int32_t(key & 0xFFFFFFFFull);
+      out.push_back({candidate_dist_[p], std::int32_t(q), p});
+    }
     return out;
   }
 
@@ -226,7 +246,7 @@ class ReversedRetrieval {
   const ReversedRetrievalParams& params_;
   std::uint64_t stream_;
   int sw_, sh_, tw_, th_;
-  std::vector<std::uint8_t> assigned_, eligible_;
+  std::vector<std::uint8_t> assigned_, eligible_, wide_search_;
   std::vector<std::int32_t> candidate_;
   std::vector<float> candidate_dist_;
   std::vector<std::vector<std::int32_t>> unassigned_;
@@ -334,7 +354,8 @@ ReversedRetrievalStats retrieve_uniform(const PatchSpace& space, const SearchCon
   const int max_rounds = 64;  // then a greedy fill finishes the last few
   while (rr.assigned_count() < rr.active() && stats.rounds < max_rounds) {
     refresh_eligible();
-    const auto winners = rr.round(stats.rounds++);
+    auto winners = rr.round(stats.rounds++);
+    std::sort(winners.begin(), winners.end());  // best first: counters fill with the best pairs
     std::size_t taken = 0;
     for (const auto& a : winners)
       if (can_take(a.source)) take(a), ++taken;
@@ -398,10 +419,10 @@ ReversedRetrievalStats retrieve_with_budget(const PatchSpace& space, const Searc
         rr.eligible()[p] = 0;
     // The budget T is the sum of all candidate errors below the knee; the
     // winners below the knee are a subset of those candidates, so taking all of
-    // them (best first) keeps the total under T (thesis eq. 8.4).
+    // them keeps the total under T (thesis eq. 8.4).
     std::size_t taken = 0;
     for (const auto& a : winners) {
-      if (a.dist > knee_error) break;
+      if (a.dist > knee_error) continue;
       rr.assign(a);
       ++taken;
     }
