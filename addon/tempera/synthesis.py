@@ -54,10 +54,6 @@ def _guide_tuple(index: int, guide) -> tuple:
     )
 
 
-def _optional(array, what):
-    return None if array is None else _as_image(array, what)
-
-
 def synthesize(
     style,
     guides: Iterable = (),
@@ -70,6 +66,7 @@ def synthesize(
     style_weight: float = 1.0,
     penalty_weight: float = 1.0,
     guide_variance: float = 0.999,
+    axial_orientation: bool = True,
     budget_coverage: float = 0.95,
     budget_max_rounds: int = 16,
     seed: int = 1,
@@ -93,13 +90,16 @@ def synthesize(
     ``guide_variance``: fraction of the weighted guide variance kept when the
     guide channels are compressed by PCA (1.0 = exact matching, slower).
     Orientations are per-pixel angles in radians (direction (cos a, sin a), x
-    right, y down); giving either enables rotation-aware patches.
+    right, y down); giving either enables rotation-aware patches. With
+    ``axial_orientation`` (default) they are taken modulo pi, like stroke
+    directions, and patches turn by the smallest angle that aligns them.
     ``progress(fraction)`` is called during the run; returning False cancels it
     (raises ``tempera.Cancelled``).
 
     Returns ``(image, stats)``: the float32 (H, W, C) result and a dict with the
     energy per level and iteration, seconds per stage, source coverage and the
     final NNF (``stats["nnf"]``, (H, W, 2) source x, y per target pixel).
+    See docs/engine.md.
     """
     if usage not in USAGE_MODES:
         raise ValueError(f"unknown patch usage '{usage}' (choose {', '.join(USAGE_MODES)})")
@@ -109,16 +109,17 @@ def synthesize(
         target_shape = (int(target_shape[0]), int(target_shape[1]))
     elif not guide_list:
         raise ValueError("give at least one guide pair or target_shape=(height, width)")
+    options = dict(usage=usage, patch_size=int(patch_size), levels=int(levels), em_iterations=int(em_iterations),
+                   pm_iterations=int(pm_iterations), style_weight=float(style_weight),
+                   penalty_weight=float(penalty_weight), guide_variance=float(guide_variance),
+                   axial_orientation=bool(axial_orientation), budget_coverage=float(budget_coverage),
+                   budget_max_rounds=int(budget_max_rounds), seed=int(seed), threads=int(threads))
+    given_maps = dict(source_mask=source_mask, target_mask=target_mask, source_orientation=source_orientation,
+                      target_orientation=target_orientation, source_segments=source_segments,
+                      target_segments=target_segments)
+    maps = {name: _as_image(m, name.replace("_", " ")) for name, m in given_maps.items() if m is not None}
 
     def report(fraction: float) -> bool:
         return True if progress is None else progress(fraction) is not False
 
-    return _native.synthesize(
-        style, guide_list, usage, int(patch_size), int(levels), int(em_iterations), int(pm_iterations),
-        float(style_weight), float(penalty_weight), float(guide_variance), float(budget_coverage), int(budget_max_rounds),
-        int(seed), int(threads),
-        _optional(source_mask, "source mask"), _optional(target_mask, "target mask"),
-        _optional(source_orientation, "source orientation"), _optional(target_orientation, "target orientation"),
-        _optional(source_segments, "source segments"), _optional(target_segments, "target segments"),
-        target_shape, report,
-    )
+    return _native.synthesize(style, guide_list, options, maps, target_shape, report)

@@ -4,6 +4,8 @@
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
+#include <map>
 #include <optional>
 
 #include "numpy_bridge.hpp"
@@ -51,15 +53,32 @@ py::array_t<std::int32_t> nnf_array(const Nnf& nnf) {
   return out;
 }
 
-py::tuple synthesize_py(const FloatArray& style, const std::vector<GuideArg>& guides, const std::string& usage,
-                        int patch_size, int levels, int em_iterations, int pm_iterations, float style_weight,
-                        float penalty_weight, double guide_variance, double budget_coverage, int budget_max_rounds,
-                        std::uint64_t seed, int threads, const std::optional<FloatArray>& source_mask,
-                        const std::optional<FloatArray>& target_mask,
-                        const std::optional<FloatArray>& source_orientation,
-                        const std::optional<FloatArray>& target_orientation,
-                        const std::optional<FloatArray>& source_segments,
-                        const std::optional<FloatArray>& target_segments,
+// Engine options from a dict of Python values; unknown keys are errors so a
+// typo never silently falls back to a default.
+SynthesisOptions parse_options(const py::dict& options) {
+  SynthesisOptions opt;
+  for (const auto& [key_obj, value] : options) {
+    const std::string key = key_obj.cast<std::string>();
+    if (key == "usage") opt.usage = parse_patch_usage(value.cast<std::string>());
+    else if (key == "patch_size") opt.patch_size = value.cast<int>();
+    else if (key == "levels") opt.levels = value.cast<int>();
+    else if (key == "em_iterations") opt.em_iterations = value.cast<int>();
+    else if (key == "pm_iterations") opt.pm_iterations = value.cast<int>();
+    else if (key == "style_weight") opt.style_weight = value.cast<float>();
+    else if (key == "penalty_weight") opt.penalty_weight = value.cast<float>();
+    else if (key == "guide_variance") opt.guide_variance = value.cast<double>();
+    else if (key == "axial_orientation") opt.axial_orientation = value.cast<bool>();
+    else if (key == "budget_coverage") opt.budget_coverage = value.cast<double>();
+    else if (key == "budget_max_rounds") opt.budget_max_rounds = value.cast<int>();
+    else if (key == "seed") opt.seed = value.cast<std::uint64_t>();
+    else if (key == "threads") opt.threads = value.cast<int>();
+    else throw ValueError(concat("unknown synthesis option '", key, "'"));
+  }
+  return opt;
+}
+
+py::tuple synthesize_py(const FloatArray& style, const std::vector<GuideArg>& guides, const py::dict& options,
+                        const std::map<std::string, FloatArray>& maps,
                         std::optional<std::pair<int, int>> target_shape,
                         const std::function<bool(double)>& progress) {
   SynthesisInput in;
@@ -69,29 +88,26 @@ py::tuple synthesize_py(const FloatArray& style, const std::vector<GuideArg>& gu
                   py_bridge::view_of(g.target, "guide '" + g.name + "' target"), g.weight);
     in.target_weight_maps.push_back(optional_view(g.target_weight_map, "target weight map"));
   }
-  in.source_mask = optional_view(source_mask, "source mask");
-  in.target_mask = optional_view(target_mask, "target mask");
-  in.source_orientation = optional_view(source_orientation, "source orientation");
-  in.target_orientation = optional_view(target_orientation, "target orientation");
-  in.source_segments = optional_view(source_segments, "source segments");
-  in.target_segments = optional_view(target_segments, "target segments");
+  const std::map<std::string, ImageView*> slots = {
+      {"source_mask", &in.source_mask},
+      {"target_mask", &in.target_mask},
+      {"source_orientation", &in.source_orientation},
+      {"target_orientation", &in.target_orientation},
+      {"source_segments", &in.source_segments},
+      {"target_segments", &in.target_segments},
+  };
+  for (const auto& [name, array] : maps) {
+    auto slot = slots.find(name);
+    if (slot == slots.end()) throw ValueError(concat("unknown map '", name, "'"));
+    std::string what = name;
+    std::replace(what.begin(), what.end(), '_', ' ');
+    *slot->second = py_bridge::view_of(array, what);
+  }
   if (target_shape) {
     in.target_height = target_shape->first;
     in.target_width = target_shape->second;
   }
-  SynthesisOptions opt;
-  opt.usage = parse_patch_usage(usage);
-  opt.patch_size = patch_size;
-  opt.levels = levels;
-  opt.em_iterations = em_iterations;
-  opt.pm_iterations = pm_iterations;
-  opt.style_weight = style_weight;
-  opt.penalty_weight = penalty_weight;
-  opt.guide_variance = guide_variance;
-  opt.budget_coverage = budget_coverage;
-  opt.budget_max_rounds = budget_max_rounds;
-  opt.seed = seed;
-  opt.threads = threads;
+  const SynthesisOptions opt = parse_options(options);
 
   ProgressCallback callback = [&](double fraction) {
     py::gil_scoped_acquire acquire;
@@ -109,7 +125,7 @@ py::tuple synthesize_py(const FloatArray& style, const std::vector<GuideArg>& gu
   stats["levels"] = lv;
   stats["seconds"] = result.seconds;
   stats["source_coverage"] = result.source_coverage;
-  stats["usage"] = usage;
+  stats["usage"] = patch_usage_name(opt.usage);
   stats["guide_channels"] = result.guide_channels;
   stats["kept_guide_variance"] = result.kept_guide_variance;
   stats["nnf"] = nnf_array(result.nnf);
@@ -121,13 +137,8 @@ py::tuple synthesize_py(const FloatArray& style, const std::vector<GuideArg>& gu
 void bind_synthesis(py::module_& m) {
   m.def(
       "synthesize",
-      [](const FloatArray& style, const py::list& guides, const std::string& usage, int patch_size, int levels,
-         int em_iterations, int pm_iterations, float style_weight, float penalty_weight, double guide_variance,
-         double budget_coverage,
-         int budget_max_rounds, std::uint64_t seed, int threads, std::optional<FloatArray> source_mask,
-         std::optional<FloatArray> target_mask, std::optional<FloatArray> source_orientation,
-         std::optional<FloatArray> target_orientation, std::optional<FloatArray> source_segments,
-         std::optional<FloatArray> target_segments, std::optional<std::pair<int, int>> target_shape,
+      [](const FloatArray& style, const py::list& guides, const py::dict& options,
+         const std::map<std::string, FloatArray>& maps, std::optional<std::pair<int, int>> target_shape,
          std::function<bool(double)> progress) {
         std::vector<GuideArg> parsed;
         for (const auto& item : guides) {
@@ -138,17 +149,10 @@ void bind_synthesis(py::module_& m) {
           if (!t[4].is_none()) g.target_weight_map = t[4].cast<FloatArray>();
           parsed.push_back(std::move(g));
         }
-        return synthesize_py(style, parsed, usage, patch_size, levels, em_iterations, pm_iterations, style_weight,
-                             penalty_weight, guide_variance, budget_coverage, budget_max_rounds, seed, threads, source_mask,
-                             target_mask, source_orientation, target_orientation, source_segments, target_segments,
-                             target_shape, progress);
+        return synthesize_py(style, parsed, options, maps, target_shape, progress);
       },
-      py::arg("style"), py::arg("guides"), py::arg("usage"), py::arg("patch_size"), py::arg("levels"),
-      py::arg("em_iterations"), py::arg("pm_iterations"), py::arg("style_weight"), py::arg("penalty_weight"),
-      py::arg("guide_variance"), py::arg("budget_coverage"), py::arg("budget_max_rounds"), py::arg("seed"), py::arg("threads"),
-      py::arg("source_mask"), py::arg("target_mask"), py::arg("source_orientation"), py::arg("target_orientation"),
-      py::arg("source_segments"), py::arg("target_segments"), py::arg("target_shape"), py::arg("progress"),
-      "Low-level engine entry; use tempera.synthesize().");
+      py::arg("style"), py::arg("guides"), py::arg("options"), py::arg("maps"), py::arg("target_shape"),
+      py::arg("progress"), "Low-level engine entry; use tempera.synthesize().");
   m.def("error_knee", [](std::vector<float> sorted_errors) {
     std::sort(sorted_errors.begin(), sorted_errors.end());
     return error_knee(sorted_errors);

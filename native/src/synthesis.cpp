@@ -90,18 +90,21 @@ Image stack_channels(const std::vector<ImageView>& parts) {
   return out;
 }
 
-// Angles downsample as unit vectors (averaging raw angles breaks at +-pi).
-std::vector<Image> angle_pyramid(const ImageView& angles, int levels) {
+// Angles downsample as unit vectors (averaging raw angles breaks at the
+// wrap-around); axial angles as doubled-angle vectors, so a and a + pi agree.
+std::vector<Image> angle_pyramid(const ImageView& angles, int levels, bool axial) {
   if (angles.empty()) return {};
+  const float k = axial ? 2.0f : 1.0f;
   Image vec(angles.width, angles.height, 2);
   for (std::size_t i = 0; i < angles.pixel_count(); ++i) {
-    vec.data()[2 * i] = std::cos(angles.data[i]);
-    vec.data()[2 * i + 1] = std::sin(angles.data[i]);
+    vec.data()[2 * i] = std::cos(k * angles.data[i]);
+    vec.data()[2 * i + 1] = std::sin(k * angles.data[i]);
   }
   std::vector<Image> out;
   for (auto& level : build_pyramid(vec.view(), levels)) {
     Image a(level.width(), level.height(), 1);
-    for (std::size_t i = 0; i < a.pixel_count(); ++i) a.data()[i] = std::atan2(level.data()[2 * i + 1], level.data()[2 * i]);
+    for (std::size_t i = 0; i < a.pixel_count(); ++i)
+      a.data()[i] = std::atan2(level.data()[2 * i + 1], level.data()[2 * i]) / k;
     out.push_back(std::move(a));
   }
   return out;
@@ -199,8 +202,8 @@ Pyramids build_pyramids(const SynthesisInput& in, const SynthesisOptions& opt) {
                             opt.patch_size, "; use fewer levels or a larger exemplar"));
   p.source_mask = optional_pyramid(in.source_mask, p.levels);
   p.target_mask = optional_pyramid(in.target_mask, p.levels);
-  p.source_angle = angle_pyramid(in.source_orientation, p.levels);
-  p.target_angle = angle_pyramid(in.target_orientation, p.levels);
+  p.source_angle = angle_pyramid(in.source_orientation, p.levels, opt.axial_orientation);
+  p.target_angle = angle_pyramid(in.target_orientation, p.levels, opt.axial_orientation);
   p.source_label = label_pyramid(in.source_segments, p.levels);
   p.target_label = label_pyramid(in.target_segments, p.levels);
   for (const auto& map : in.target_weight_maps) p.weight_maps.push_back(optional_pyramid(map, p.levels));
@@ -238,6 +241,7 @@ void build_level(const Pyramids& p, int l, const SynthesisOptions& opt, Level& l
   space.source = &level.source;
   space.target = &level.target;
   space.radius = opt.patch_size / 2;
+  space.axial = opt.axial_orientation;
   if (!p.source_angle.empty()) space.source_angle = p.source_angle[l].data();
   if (!p.target_angle.empty()) space.target_angle = p.target_angle[l].data();
   const bool weighted = std::any_of(p.weight_maps.begin(), p.weight_maps.end(), [](auto& m) { return !m.empty(); });

@@ -301,3 +301,17 @@ TEST(ErrorKnee, FindsAStepBetweenGoodAndForcedMatches) {
   EXPECT_GE(knee, 280u);
   EXPECT_LE(knee, 310u);
 }
+
+TEST(PatchSpace, AxialRotationTakesTheSmallestAngle) {
+  FeatureImage src(4, 4, 1), tgt(4, 4, 1);
+  std::vector<float> a_src(16, 0.1f), a_tgt(16, 0.1f + 3 * kPi / 2);
+  PatchSpace space;
+  space.source = &src;
+  space.target = &tgt;
+  space.source_angle = a_src.data();
+  space.target_angle = a_tgt.data();
+  // -3pi/2 turns stripes the same way as pi/2: the smallest aligning rotation.
+  EXPECT_NEAR(space.rotation(1, 1, 2, 2), kPi / 2, 1e-4);
+  space.axial = false;
+  EXPECT_NEAR(space.rotation(1, 1, 2, 2), -3 * kPi / 2, 1e-4);
+}

@@ -136,3 +136,23 @@ def test_the_gil_is_released_while_solving():
 def test_knee_of_a_step_curve():
     errors = [0.01] * 300 + [1.0 + 0.001 * i for i in range(700)]
     assert 280 <= tempera._native.error_knee(errors) <= 310
+
+
+def test_rotation_aware_patches_turn_stripes():
+    yy = np.mgrid[0:48, 0:48][0].astype(np.float32)
+    stripes = (0.5 + 0.5 * np.sin(2 * np.pi * yy / 8))[..., None]  # horizontal stripes
+    out, _ = tempera.synthesize(stripes, target_shape=(40, 40), usage="none",
+                                source_orientation=np.zeros((48, 48), np.float32),
+                                target_orientation=np.full((40, 40), np.pi / 2, np.float32))
+    core = out[4:-4, 4:-4, 0]
+    along_x = np.abs(np.diff(core, axis=1)).mean()
+    along_y = np.abs(np.diff(core, axis=0)).mean()
+    assert along_x > 4 * along_y  # vertical stripes now
+
+
+def test_unknown_map_or_option_is_rejected():
+    g = coordinate_guide(16, 16)
+    with pytest.raises(TypeError):
+        tempera.synthesize(noise(16, 16), [(g, g)], sharpness=3)
+    with pytest.raises(ValueError, match="unknown synthesis option 'sharpness'"):
+        tempera._native.synthesize(noise(16, 16), [("g", g, g, 1.0, None)], {"sharpness": 3}, {}, None, None)

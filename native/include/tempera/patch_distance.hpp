@@ -41,6 +41,10 @@ struct PatchSpace {
   int radius = 2;
   const float* source_angle = nullptr;
   const float* target_angle = nullptr;
+  // Axial orientations (defined modulo pi, like hatching or a structure
+  // tensor's): the smallest rotation that aligns the two directions is used,
+  // so there is no branch cut (Bénard et al. 2013, §3.1).
+  bool axial = true;
 
   bool rotated() const { return source_angle || target_angle; }
   // Rotation from target offsets to source offsets: phi = a_src(p) - a_tgt(q).
@@ -48,6 +52,7 @@ struct PatchSpace {
     float a = 0.0f;
     if (source_angle) a += source_angle[std::size_t(sy) * source->width + sx];
     if (target_angle) a -= target_angle[std::size_t(ty) * target->width + tx];
+    if (axial) a -= 3.14159265f * std::round(a / 3.14159265f);
     return a;
   }
   // Distance of source centers from the border so the (possibly rotated)

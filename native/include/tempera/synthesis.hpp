@@ -25,6 +25,9 @@ struct SynthesisOptions {
   // Fraction of the weighted guide variance kept by PCA compression of the
   // guide channels (1 = exact, no compression; off when weight maps are used).
   double guide_variance = 0.999;
+  // Orientations are axial (mod pi, e.g. stroke directions) rather than
+  // directed (mod 2 pi).
+  bool axial_orientation = true;
   double budget_coverage = 0.95;
   int budget_max_rounds = 16;
   std::uint64_t seed = 1;
