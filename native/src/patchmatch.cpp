@@ -22,8 +22,9 @@ void SearchConstraints::finalize(int source_width) {
   for (int s = 0; s < segments; ++s) {
     if (!used[s] || !valid_by_segment[s].empty()) continue;
     if (segments == 1)
-      throw ValueError("no usable source patches: the source mask is empty or the exemplar is smaller "
-                       "than one patch");
+      throw ValueError("no usable source patches: the source mask leaves no room for a whole patch, or the "
+                       "exemplar is too small for the patch (rotated patches need a margin of about 1.5 patch "
+                       "radii more)");
     throw ValueError(concat("target segment ", s, " has no source patches with the same label"));
   }
 }

@@ -197,9 +197,14 @@ Pyramids build_pyramids(const SynthesisInput& in, const SynthesisOptions& opt) {
     }
   }
   const auto& coarsest_source = p.source.back();
-  if (coarsest_source.width() < opt.patch_size + 2 || coarsest_source.height() < opt.patch_size + 2)
-    throw ValueError(concat("the style is too small for ", p.levels, " pyramid levels with patch size ",
-                            opt.patch_size, "; use fewer levels or a larger exemplar"));
+  if (coarsest_source.width() < opt.patch_size + 2 || coarsest_source.height() < opt.patch_size + 2) {
+    if (p.levels == 1)
+      throw ValueError(concat("the style is ", in.style.width, "x", in.style.height, " pixels; patch size ",
+                              opt.patch_size, " needs at least ", opt.patch_size + 2, "x", opt.patch_size + 2));
+    throw ValueError(concat("the style (", in.style.width, "x", in.style.height, ") is too small for ", p.levels,
+                            " pyramid levels with patch size ", opt.patch_size,
+                            "; use fewer levels (0 = automatic) or a larger exemplar"));
+  }
   p.source_mask = optional_pyramid(in.source_mask, p.levels);
   p.target_mask = optional_pyramid(in.target_mask, p.levels);
   p.source_angle = angle_pyramid(in.source_orientation, p.levels, opt.axial_orientation);
