@@ -1,0 +1,16 @@
+#pragma once
+// Bounded distance to lines, the guide D(I) of Bénard et al. 2013's distance
+// transform term (§3.2): far from any line the guide saturates so that
+// synthesis there falls back to the other goals.
+#include "tempera/image.hpp"
+
+namespace tempera {
+
+// Exact Euclidean distance from each pixel centre to the nearest line pixel
+// of a 1-channel mask (value > 0.5 = line), by Felzenszwalb & Huttenlocher's
+// separable lower-envelope algorithm (2012), returned as
+// min(distance, d_max) / d_max in [0, 1]: 0 on lines, 1 at d_max and beyond.
+// A mask without line pixels gives all 1.
+Image line_distance(const ImageView& mask, float d_max = 10.0f);
+
+}  // namespace tempera

@@ -1,0 +1,87 @@
+#include "tempera/distance_transform.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "tempera/error.hpp"
+#include "tempera/parallel.hpp"
+
+namespace tempera {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// 1D squared distance transform d(q) = min_p (q - p)² + f(p) (F&H, alg. 1):
+// the lower envelope of the parabolas rooted at (p, f(p)). Infinite samples
+// (no line in that column) are left out instead of being given a large
+// finite value, which keeps the intersection arithmetic exact; if every
+// sample is infinite, so is the result. `v` and `z` are scratch buffers.
+void squared_distance_1d(const double* f, double* d, int n, std::vector<int>& v, std::vector<double>& z) {
+  v.resize(n);
+  z.resize(n + 1);
+  int k = -1;  // index of the rightmost parabola in the envelope
+  for (int q = 0; q < n; ++q) {
+    if (f[q] == kInf) continue;
+    double s = -kInf;
+    // Drop the parabolas that the new one hides.
+    while (k >= 0) {
+      const int p = v[k];
+      s = ((f[q] + double(q) * q) - (f[p] + double(p) * p)) / (2.0 * (q - p));
+      if (s > z[k]) break;
+      --k;
+    }
+    ++k;
+    v[k] = q;
+    z[k] = k == 0 ? -kInf : s;
+    z[k + 1] = kInf;
+  }
+  if (k < 0) {
+    std::fill_n(d, n, kInf);
+    return;
+  }
+  for (int q = 0, j = 0; q < n; ++q) {
+    while (z[j + 1] < q) ++j;
+    const double dq = q - v[j];
+    d[q] = dq * dq + f[v[j]];
+  }
+}
+
+}  // namespace
+
+Image line_distance(const ImageView& mask, float d_max) {
+  require_nonempty(mask, "line mask");
+  if (mask.channels != 1)
+    throw ValueError(concat("line mask must have 1 channel, got ", mask.channels));
+  require_finite(mask, "line mask");
+  if (!(d_max > 0.0f) || !std::isfinite(d_max))
+    throw ValueError(concat("d_max must be a positive finite number, got ", d_max));
+  const int w = mask.width, h = mask.height;
+  // Squared distances, column pass then row pass (exact: the Euclidean
+  // distance squared separates into the two axes).
+  std::vector<double> sq(mask.pixel_count());
+  for (std::size_t i = 0; i < sq.size(); ++i) sq[i] = mask.data[i] > 0.5f ? 0.0 : kInf;
+  if (std::find(sq.begin(), sq.end(), 0.0) == sq.end()) return Image(w, h, 1, 1.0f);
+
+  parallel_for(w, 0, [&](int x) {
+    std::vector<double> f(h), d(h), z;
+    std::vector<int> v;
+    for (int y = 0; y < h; ++y) f[y] = sq[std::size_t(y) * w + x];
+    squared_distance_1d(f.data(), d.data(), h, v, z);
+    for (int y = 0; y < h; ++y) sq[std::size_t(y) * w + x] = d[y];
+  });
+  Image out(w, h, 1);
+  parallel_for(h, 0, [&](int y) {
+    std::vector<double> d(w), z;
+    std::vector<int> v;
+    double* row = sq.data() + std::size_t(y) * w;
+    squared_distance_1d(row, d.data(), w, v, z);
+    for (int x = 0; x < w; ++x)
+      out.at(x, y, 0) = float(std::min(std::sqrt(d[x]), double(d_max)) / d_max);
+  });
+  return out;
+}
+
+}  // namespace tempera
