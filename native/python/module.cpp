@@ -73,6 +73,7 @@ void bind_io(py::module_& m) {
 }  // namespace
 
 void bind_synthesis(py::module_& m);  // bind_synthesis.cpp
+void bind_guides(py::module_& m);     // bind_guides.cpp
 
 PYBIND11_MODULE(_native, m) {
   m.doc() = "Tempera native engine";
@@ -80,4 +81,5 @@ PYBIND11_MODULE(_native, m) {
   register_exceptions(m);
   bind_io(m);
   bind_synthesis(m);
+  bind_guides(m);
 }
