@@ -66,6 +66,15 @@ def hatching_style(full, seed=1):
     return (paper * (1 - ink[..., None]) + pigment * ink[..., None] * (0.6 + 0.4 * full)).astype(np.float32)
 
 
+def benchmark_scene(s):
+    """Source guides (one sphere), target guides (three spheres), style."""
+    src = shade_scene(s, s, [(0.5 * s, 0.5 * s, 0.28 * s, (0.9, 0.9, 0.9))])
+    tgt = shade_scene(s, s, [(0.3 * s, 0.35 * s, 0.18 * s, (0.9, 0.9, 0.9)),
+                             (0.7 * s, 0.45 * s, 0.22 * s, (0.9, 0.9, 0.9)),
+                             (0.45 * s, 0.75 * s, 0.12 * s, (0.9, 0.9, 0.9))])
+    return src, tgt, hatching_style(src[0])
+
+
 def guide_error(src, tgt, nnf):
     """Quality independent of engine settings: mean squared difference, over all
     twelve guide channels, between each target pixel and the source pixel its
@@ -85,11 +94,7 @@ def main():
     parser.add_argument("--json")
     args = parser.parse_args()
     s = args.size
-    src = shade_scene(s, s, [(0.5 * s, 0.5 * s, 0.28 * s, (0.9, 0.9, 0.9))])
-    tgt = shade_scene(s, s, [(0.3 * s, 0.35 * s, 0.18 * s, (0.9, 0.9, 0.9)),
-                             (0.7 * s, 0.45 * s, 0.22 * s, (0.9, 0.9, 0.9)),
-                             (0.45 * s, 0.75 * s, 0.12 * s, (0.9, 0.9, 0.9))])
-    style = hatching_style(src[0])
+    src, tgt, style = benchmark_scene(s)
     guides = [(a, b, 1.0) for a, b in zip(src, tgt)]
     t0, cpu0 = time.perf_counter(), time.process_time()
     image, stats = synthesize(style, guides, usage=args.usage, threads=args.threads, em_iterations=args.em_iters,

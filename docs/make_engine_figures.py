@@ -11,7 +11,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "bench"))
 import tempera  # noqa: E402
-from bench_synthesis import hatching_style, shade_scene  # noqa: E402
+from bench_synthesis import benchmark_scene  # noqa: E402
 
 OUT = ROOT / "docs" / "images"
 
@@ -28,12 +28,7 @@ def labelled_row(images, gap=6):
 
 
 def usage_modes(size=320):
-    s = size
-    src = shade_scene(s, s, [(0.5 * s, 0.5 * s, 0.28 * s, (0.9, 0.9, 0.9))])
-    tgt = shade_scene(s, s, [(0.3 * s, 0.35 * s, 0.18 * s, (0.9, 0.9, 0.9)),
-                             (0.7 * s, 0.45 * s, 0.22 * s, (0.9, 0.9, 0.9)),
-                             (0.45 * s, 0.75 * s, 0.12 * s, (0.9, 0.9, 0.9))])
-    style = hatching_style(src[0])
+    src, tgt, style = benchmark_scene(size)
     guides = [(a, b, 1.0) for a, b in zip(src, tgt)]
     results = [tempera.synthesize(style, guides, usage=u, seed=1)[0] for u in ("none", "uniform", "budget")]
     row = labelled_row([style, src[0] / src[0].max(), tgt[0] / tgt[0].max(), *results])

@@ -5,6 +5,7 @@
 
 #include "tempera/error.hpp"
 #include "tempera/parallel.hpp"
+#include "tempera/patch_distance.hpp"  // sample_bilinear
 
 namespace tempera {
 
@@ -22,20 +23,9 @@ void require_epsilon(float epsilon) {
     throw ValueError(concat("occlusion epsilon must be a positive finite number, got ", epsilon));
 }
 
-// Bilinear sample of all channels at (x, y), the position clamped to the
-// pixel centres so that the border pixels extend outwards.
+// Bilinear sample of all channels at (x, y); border pixels extend outwards.
 void sample_bilinear(const ImageView& img, float x, float y, float* out) {
-  x = std::clamp(x, 0.0f, float(img.width - 1));
-  y = std::clamp(y, 0.0f, float(img.height - 1));
-  const int x0 = int(x), y0 = int(y);  // floor: x, y >= 0
-  const int x1 = std::min(x0 + 1, img.width - 1), y1 = std::min(y0 + 1, img.height - 1);
-  const float fx = x - float(x0), fy = y - float(y0);
-  const float *a = img.pixel(x0, y0), *b = img.pixel(x1, y0), *c = img.pixel(x0, y1), *d = img.pixel(x1, y1);
-  for (int k = 0; k < img.channels; ++k) {
-    const float top = a[k] + fx * (b[k] - a[k]);
-    const float bottom = c[k] + fx * (d[k] - c[k]);
-    out[k] = top + fy * (bottom - top);
-  }
+  tempera::sample_bilinear(img.data, img.width, img.height, img.channels, img.channels, x, y, out);
 }
 
 // Shared by χ- and χ+: follow `here` (sign -1: backward, +1: forward) to the
