@@ -1,18 +1,28 @@
 """Tempera's demo job, run inside background Blender by tools/run_demo.py:
+an end-to-end StyLit stylization (Fišer et al. 2016, thesis ch. 8).
 
     blender -b --factory-startup --python-exit-code 1 --python scenes/demo_scene.py \
         -- --out out/demo [--addon-zip dist/tempera-addon-X.Y.Z.zip]
 
-1. builds a small animated scene in code: a sphere rolling across a table
-   past a box, lit by one area light;
-2. renders frames 1-4 with Cycles into one multilayer EXR per frame
-   (OUT/guides/frame_####.exr) holding the guide passes Tempera uses;
-3. reads the passes back through the native module and writes a derived
-   image per frame (OUT/frames/frame_####.png), then OUT/contact_sheet.png.
+1. exemplar (A, A'): builds StyLit's "sphere on a table" scene
+   (scenes/exemplar_kit.py), renders its guide passes into
+   OUT/exemplar/guides.exr and paints a hatched drawing of it with
+   tempera.exemplar_paint (OUT/exemplar/style.png), standing in for the
+   artist's painting;
+2. target (B): builds the animated scene, a sphere rolling across a table
+   past a box under the same light, and renders FRAMES into one multilayer
+   EXR per frame (OUT/guides/frame_####.exr);
+3. synthesis (B'): for every frame, tempera.synthesize(style, guides) with
+   the light-path guides FULL, LDE, LSE and L.*DDE (tempera.stylit_guides)
+   of the exemplar and of the frame, StyLit's error-budget patch usage and
+   a fixed seed, into OUT/frames/frame_####.png;
+4. OUT/contact_sheet.png: the exemplar render above its drawing in the
+   first column, then every frame's render above its stylized frame; and
+   OUT/exemplar_sheet.png: the exemplar render, its four guides and the drawing.
 
-Step 3 is where stylization will plug in; steps 1 and 2 stay the same.
 With --addon-zip the add-on is installed from the zip into a temporary
 folder first (as the tests do); without it, the installed `tempera` is used.
+Every image is written atomically (a temporary file, then a rename).
 """
 import argparse
 import math
@@ -23,74 +33,48 @@ from pathlib import Path
 
 import bmesh
 import bpy
-from mathutils import Vector
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tools"))
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent / "tools"))
+sys.path.insert(0, str(HERE))
 import blender_env  # noqa: E402
+import exemplar_kit  # noqa: E402
+import scene_kit  # noqa: E402
 
-FRAMES = range(1, 5)
-RESOLUTION = (160, 120)
-SAMPLES = 16
-# Render passes written to the guide EXRs (names as in tempera.passes.PASSES).
-GUIDE_PASSES = ("Combined", "DiffDir", "DiffCol", "GlossDir", "GlossCol", "DiffInd", "Vector", "Normal")
-
-
-# --------------------------------------------------------------------------- scene
-
-def clear_scene(scene):
-    for obj in list(scene.collection.all_objects):
-        bpy.data.objects.remove(obj)
-    for collection in (bpy.data.meshes, bpy.data.materials, bpy.data.lights, bpy.data.cameras):
-        for block in list(collection):
-            if block.users == 0:
-                collection.remove(block)
-
-
-def material(name, color, roughness):
-    mat = bpy.data.materials.new(name)
-    mat.use_nodes = True
-    bsdf = mat.node_tree.nodes["Principled BSDF"]
-    bsdf.inputs["Base Color"].default_value = (*color, 1.0)
-    bsdf.inputs["Roughness"].default_value = roughness
-    return mat
-
-
-def mesh_object(scene, name, build, mat, location, smooth=False):
-    bm = bmesh.new()
-    build(bm)
-    mesh = bpy.data.meshes.new(name)
-    bm.to_mesh(mesh)
-    bm.free()
-    for polygon in mesh.polygons:
-        polygon.use_smooth = smooth
-    mesh.materials.append(mat)
-    obj = bpy.data.objects.new(name, mesh)
-    obj.location = location
-    scene.collection.objects.link(obj)
-    return obj
+FRAMES = range(1, 9)  # tools/run_demo.py checks for these
+RESOLUTION = (320, 240)  # exemplar and frames alike: strokes keep their size
+SAMPLES = 32  # per frame; no denoising, the synthesis averages noise out
+EXEMPLAR_SAMPLES = 64
+SEED = 7  # the drawing and the synthesis of every frame
+# Render passes written to the frame EXRs (names as in tempera.passes.PASSES):
+# the ones the StyLit guides need, plus Vector and Normal for temporal guides.
+GUIDE_PASSES = exemplar_kit.EXEMPLAR_PASSES + ("Vector", "Normal")
+# Synthesis settings: the weight of each StyLit guide (all are tone-mapped
+# alike, see tempera.stylit_guides, so the weights compare) and of the style
+# term (A'/B' colours) against them. LDE counts double: the direct diffuse
+# shading is what the drawing's stroke density follows. L.*DDE counts half:
+# at SAMPLES it is the noisiest pass. (Measured on the contact sheet: equal
+# weights look alike but blur the box's lit and shaded faces together;
+# style_weight 2 makes strokes a little crisper and the shading less faithful.)
+GUIDE_WEIGHTS = {"FULL": 1.0, "LDE": 2.0, "LSE": 1.0, "L.*DDE": 0.5}
+STYLE_WEIGHT = 1.0
+# Target guides are padded by this many pixels (edge replicated) and the
+# result cropped back: the budget patch usage tends to put poorly matching
+# patches on a target's outermost pixels (stray marks along the frame border
+# on the contact sheet, about 0-90 pixels per frame), which the margin absorbs.
+TARGET_MARGIN = 4
+FRAMES_PER_ROW = 4  # on the contact sheet
 
 
-def look_at(obj, target):
-    direction = Vector(target) - obj.location
-    obj.rotation_euler = direction.to_track_quat("-Z", "Y").to_euler()
-
+# --------------------------------------------------------------------------- target scene
 
 def build_scene(scene):
-    """Table, a sphere rolling across it in FRAMES, a box, an area light, a camera."""
-    clear_scene(scene)
+    """Table, a sphere rolling across it in FRAMES, a box, the key light, a camera."""
+    scene_kit.clear_scene(scene)
+    scene_kit.add_table(scene, half_x=1.6, half_y=1.1)
 
-    def table(bm):
-        for x, y in ((-1.6, -1.1), (1.6, -1.1), (1.6, 1.1), (-1.6, 1.1)):
-            bm.verts.new((x, y, 0.0))
-        bm.faces.new(bm.verts)
-
-    mesh_object(scene, "Table", table, material("Table", (0.62, 0.55, 0.45), 0.55), (0, 0, 0))
-
-    radius = 0.3
-    sphere = mesh_object(
-        scene, "Sphere",
-        lambda bm: bmesh.ops.create_uvsphere(bm, u_segments=48, v_segments=24, radius=radius),
-        material("Sphere", (0.8, 0.12, 0.08), 0.25), (0, 0, radius), smooth=True)
+    radius = scene_kit.SPHERE_RADIUS
+    sphere = scene_kit.add_sphere(scene, (0, 0, radius))
     start_x, end_x = -0.9, 0.9
     for i, frame in enumerate(FRAMES):
         x = start_x + (end_x - start_x) * i / (len(FRAMES) - 1)
@@ -102,100 +86,111 @@ def build_scene(scene):
         for key in fcurve.keyframe_points:
             key.interpolation = "LINEAR"
 
-    box = mesh_object(
+    box = scene_kit.mesh_object(
         scene, "Box", lambda bm: bmesh.ops.create_cube(bm, size=0.5),
-        material("Box", (0.12, 0.28, 0.7), 0.45), (0.35, 0.55, 0.25))
+        scene_kit.material("Box", (0.12, 0.28, 0.7), 0.45), (0.35, 0.55, 0.25))
     box.rotation_euler = (0, 0, math.radians(30))
 
-    light = bpy.data.objects.new("Key", bpy.data.lights.new("Key", type="AREA"))
-    light.data.energy = 120.0
-    light.data.size = 1.2
-    light.location = (-1.6, -1.2, 2.4)
-    look_at(light, (0, 0, 0))
-    scene.collection.objects.link(light)
-
-    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-    camera.data.lens = 35
-    camera.location = (0.0, -3.3, 1.7)
-    look_at(camera, (0, 0.1, 0.2))
-    scene.collection.objects.link(camera)
-    scene.camera = camera
-
-    world = scene.world or bpy.data.worlds.new("World")
-    scene.world = world
-    world.use_nodes = True
-    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.05, 0.06, 0.08, 1.0)
+    scene_kit.add_key_light(scene)
+    scene_kit.add_camera(scene, location=(0.0, -3.3, 1.7), target=(0, 0.1, 0.2), lens=35)
+    scene_kit.set_world(scene)
 
 
-def configure_render(scene, guides_dir):
-    from tempera.passes import PASSES
+# --------------------------------------------------------------------------- steps
 
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.samples = SAMPLES
-    scene.cycles.use_adaptive_sampling = False
-    scene.cycles.use_denoising = False
-    scene.cycles.sample_clamp_indirect = 0.0
-    scene.cycles.seed = 0
-    scene.render.use_motion_blur = False  # the Vector pass needs it off
-    scene.render.resolution_x, scene.render.resolution_y = RESOLUTION
-    scene.render.resolution_percentage = 100
-    scene.render.film_transparent = False
-    scene.view_settings.view_transform = "Standard"  # match the plain sRGB PNGs below
-    scene.frame_start, scene.frame_end = FRAMES[0], FRAMES[-1]
+def read_guides(exr, scene, what):
+    """(passes, guides) of one rendered EXR; fails if the render is black."""
+    import tempera
+    from tempera.passes import channel_names
+    from tempera.stylit_guides import read_stylit_passes, stylit_guides
 
-    view_layer = scene.view_layers[0]
-    for render_pass in PASSES.values():
-        setattr(view_layer, render_pass.view_layer_property, render_pass.name in GUIDE_PASSES)
-
-    settings = scene.render.image_settings
-    settings.file_format = "OPEN_EXR_MULTILAYER"
-    settings.color_depth = "32"
-    settings.exr_codec = "ZIP"
-    scene.render.filepath = str(guides_dir / "frame_####")
-    scene.render.use_file_extension = True
-
-
-def render_guides(scene):
-    """Renders FRAMES; returns the multilayer EXR of each frame."""
-    bpy.ops.render.render(animation=True, scene=scene.name)
-    paths = [Path(scene.render.frame_path(frame=frame)) for frame in FRAMES]
-    missing = [str(p) for p in paths if not p.is_file()]
+    view_layer = scene_kit.view_layer_name(scene)
+    available = set(tempera.image_info(str(exr))["channels"])
+    missing = [c for name in exemplar_kit.EXEMPLAR_PASSES for c in channel_names(name, view_layer) if c not in available]
     if missing:
-        raise RuntimeError(f"Blender did not write {', '.join(missing)}")
-    return paths
+        raise RuntimeError(f"{exr} lacks channels {missing} (it has {sorted(available)})")
+    passes = read_stylit_passes(exr, view_layer)
+    if passes["Combined"][:, :, :3].mean() < 0.02:
+        raise RuntimeError(f"{what} came out black ({exr}); check the scene lighting")
+    return passes, stylit_guides(passes)
 
 
-# --------------------------------------------------------------------------- processing
-
-def derived_frame(exr):
-    """The direct diffuse light path (LDE in Bénard et al. 2013): DiffDir * DiffCol,
-    sRGB-encoded for display."""
+def make_exemplar(out):
+    """Renders and paints the exemplar; returns (render sRGB, style, guides)."""
     import tempera
     from tempera.color import linear_to_srgb
-    from tempera.passes import channel_names, read_pass
+    from tempera.exemplar_paint import paint_hatching
 
-    view_layer = bpy.context.scene.view_layers[0].name
-    available = set(tempera.image_info(str(exr))["channels"])
-    for name in GUIDE_PASSES:
-        missing = [c for c in channel_names(name, view_layer) if c not in available]
-        if missing:
-            raise RuntimeError(f"{exr} lacks channels {missing} (it has {sorted(available)})")
-    lde = read_pass(exr, "DiffDir", view_layer) * read_pass(exr, "DiffCol", view_layer)
-    return linear_to_srgb(lde)
+    started = time.monotonic()
+    scene = exemplar_kit.build_exemplar_scene()
+    exr = exemplar_kit.render_exemplar(scene, out / "exemplar" / "guides.exr", RESOLUTION, EXEMPLAR_SAMPLES)
+    rendered = time.monotonic()
+    passes, guides = read_guides(exr, scene, "the exemplar")
+    style = paint_hatching(passes["Combined"], passes["DiffCol"], seed=SEED)
+    tempera.write_image(str(out / "exemplar" / "style.png"), style)
+    render = linear_to_srgb(passes["Combined"][:, :, :3])
+    tempera.write_image(str(out / "exemplar" / "render.png"), render)
+    print(f"exemplar: rendered in {rendered - started:.1f} s, painted in {time.monotonic() - rendered:.1f} s", flush=True)
+    return render, style, guides
 
 
-def process_frames(exrs, frames_dir):
+def render_frames(out):
+    """Renders FRAMES of the animated scene; returns (scene, EXR paths)."""
+    scene = bpy.context.scene
+    build_scene(scene)
+    scene_kit.configure_render(scene, RESOLUTION, SAMPLES, GUIDE_PASSES, FRAMES)
+    exrs = []
+    for i, frame in enumerate(FRAMES, 1):
+        started = time.monotonic()
+        exrs.append(scene_kit.render_exr(scene, out / "guides" / f"frame_{frame:04d}.exr", frame=frame))
+        print(f"render frame {i}/{len(FRAMES)}: {time.monotonic() - started:.1f} s", flush=True)
+    return scene, exrs
+
+
+def stylize_frames(out, scene, exrs, style, exemplar_guides):
+    """tempera.synthesize per frame; returns (renders sRGB, stylized frames)."""
+    import numpy as np
+    import tempera
+    from tempera.color import linear_to_srgb
+    from tempera.synthesis import synthesize
+
+    renders, stylized = [], []
+    for i, (frame, exr) in enumerate(zip(FRAMES, exrs), 1):
+        started = time.monotonic()
+        passes, guides = read_guides(exr, scene, f"frame {frame}")
+        m = TARGET_MARGIN
+        pairs = [(source, np.pad(target, ((m, m), (m, m), (0, 0)), mode="edge"), GUIDE_WEIGHTS[name])
+                 for (name, source), (_, target) in zip(exemplar_guides, guides)]
+        image, stats = synthesize(style, guides=pairs, style_weight=STYLE_WEIGHT, seed=SEED)
+        image = np.ascontiguousarray(image[m:image.shape[0] - m, m:image.shape[1] - m])
+        tempera.write_image(str(out / "frames" / f"frame_{frame:04d}.png"), image)
+        renders.append(linear_to_srgb(passes["Combined"][:, :, :3]))
+        stylized.append(image)
+        print(f"stylize frame {i}/{len(FRAMES)}: {time.monotonic() - started:.1f} s "
+              f"(synthesis {stats.get('seconds', 0):.1f} s, source coverage {stats.get('source_coverage', 0):.0%})",
+              flush=True)
+    return renders, stylized
+
+
+def contact_sheets(out, exemplar_render, style, exemplar_guides, renders, stylized):
+    """OUT/contact_sheet.png and OUT/exemplar_sheet.png."""
+    import numpy as np
     import tempera
 
-    images = []
-    for frame, exr in zip(FRAMES, exrs):
-        image = derived_frame(exr)
-        if image.mean() < 0.02:
-            raise RuntimeError(f"frame {frame} came out black ({exr}); check the scene lighting")
-        tempera.write_image(str(frames_dir / f"frame_{frame:04d}.png"), image)
-        images.append(image)
-    return images
+    blank = np.ones_like(style)
+    cells = []
+    for first in range(0, len(renders), FRAMES_PER_ROW):
+        band = slice(first, first + FRAMES_PER_ROW)
+        pad = [blank] * (FRAMES_PER_ROW - len(renders[band]))
+        head = (exemplar_render, style) if first == 0 else (blank, blank)
+        cells += [head[0], *renders[band], *pad, head[1], *stylized[band], *pad]
+    sheet = out / "contact_sheet.png"
+    tempera.write_image(str(sheet), tempera.contact_sheet(cells, columns=FRAMES_PER_ROW + 1, gap=4, margin=4, background=1.0))
+
+    exemplar_cells = [exemplar_render] + [guide for _, guide in exemplar_guides] + [style]
+    exemplar_sheet = out / "exemplar_sheet.png"
+    tempera.write_image(str(exemplar_sheet), tempera.contact_sheet(exemplar_cells, columns=3, gap=4, margin=4, background=1.0))
+    return sheet, exemplar_sheet
 
 
 # --------------------------------------------------------------------------- main
@@ -224,24 +219,27 @@ def main():
 def run(out, started):
     import tempera
 
-    guides_dir, frames_dir = out / "guides", out / "frames"
-    remove_stale(guides_dir, "frame_*.exr")
-    remove_stale(frames_dir, "frame_*.png")
+    remove_stale(out / "exemplar", "*.exr*")
+    remove_stale(out / "exemplar", "*.png")
+    remove_stale(out / "guides", "*frame_*.exr*")
+    remove_stale(out / "frames", "frame_*.png")
 
-    scene = bpy.context.scene
-    build_scene(scene)
-    configure_render(scene, guides_dir)
-    exrs = render_guides(scene)
+    exemplar_render, style, exemplar_guides = make_exemplar(out)
+    exemplar_done = time.monotonic()
+    scene, exrs = render_frames(out)
     rendered = time.monotonic()
-    images = process_frames(exrs, frames_dir)
-    sheet = out / "contact_sheet.png"
-    tempera.write_image(str(sheet), tempera.contact_sheet(images, gap=4, margin=4, background=1.0))
+    renders, stylized = stylize_frames(out, scene, exrs, style, exemplar_guides)
+    stylized_done = time.monotonic()
+    sheet, exemplar_sheet = contact_sheets(out, exemplar_render, style, exemplar_guides, renders, stylized)
 
     print(f"tempera {tempera.__version__} (from {Path(tempera.__file__).parent})")
-    print(f"guides:        {guides_dir}/frame_####.exr ({len(exrs)} frames, {', '.join(GUIDE_PASSES)})")
-    print(f"frames:        {frames_dir}/frame_####.png (DiffDir * DiffCol)")
-    print(f"contact sheet: {sheet}")
-    print(f"render {rendered - started:.1f} s, processing {time.monotonic() - rendered:.1f} s")
+    print(f"exemplar:       {out / 'exemplar'}/ (guides.exr, render.png, style.png)")
+    print(f"guides:         {out / 'guides'}/frame_####.exr ({len(exrs)} frames, {', '.join(GUIDE_PASSES)})")
+    print(f"frames:         {out / 'frames'}/frame_####.png (stylized)")
+    print(f"contact sheet:  {sheet}")
+    print(f"exemplar sheet: {exemplar_sheet}")
+    print(f"exemplar {exemplar_done - started:.1f} s, render {rendered - exemplar_done:.1f} s, "
+          f"stylize {stylized_done - rendered:.1f} s, total {time.monotonic() - started:.1f} s")
 
 
 if __name__ == "__main__":

@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Runs Tempera's demo job: scenes/demo_scene.py in background Blender, with
 the add-on installed from its zip (see tools/blender_env.py), then checks
-that the expected images exist and prints where they are.
+that the expected images exist and prints where they are. The job renders
+StyLit's "sphere on a table" exemplar, paints a hatched drawing of it,
+renders the animated scene and stylizes every frame after the drawing.
 
     /usr/bin/python3 tools/run_demo.py --addon-zip dist/tempera-addon-X.Y.Z.zip \
         --blender blender --out out/demo
@@ -15,7 +17,7 @@ from pathlib import Path
 import blender_env
 
 SCENE = blender_env.ROOT / "scenes" / "demo_scene.py"
-FRAMES = 4  # scenes/demo_scene.py renders frames 1-4
+FRAMES = 8  # scenes/demo_scene.py renders and stylizes frames 1-8 (its FRAMES)
 
 
 def main():
@@ -36,17 +38,20 @@ def main():
         print(f"demo: Blender failed (exit code {rc}) after {elapsed:.1f} s", file=sys.stderr)
         return 1
 
-    expected = [out / "guides" / f"frame_{f:04d}.exr" for f in range(1, FRAMES + 1)]
+    expected = [out / "exemplar" / name for name in ("guides.exr", "render.png", "style.png")]
+    expected += [out / "guides" / f"frame_{f:04d}.exr" for f in range(1, FRAMES + 1)]
     expected += [out / "frames" / f"frame_{f:04d}.png" for f in range(1, FRAMES + 1)]
-    expected.append(out / "contact_sheet.png")
+    expected += [out / "contact_sheet.png", out / "exemplar_sheet.png"]
     missing = [str(p) for p in expected if not p.is_file()]
     if missing:
         print(f"demo: missing outputs: {', '.join(missing)}", file=sys.stderr)
         return 1
     print(f"\ndemo finished in {elapsed:.1f} s")
+    print(f"  exemplar       {out / 'exemplar'}  (guides.exr, render.png, style.png: the hatched drawing)")
     print(f"  guide passes   {out / 'guides'}  ({FRAMES} multilayer EXR)")
-    print(f"  frames         {out / 'frames'}  ({FRAMES} PNG)")
-    print(f"  contact sheet  {out / 'contact_sheet.png'}")
+    print(f"  frames         {out / 'frames'}  ({FRAMES} stylized PNG)")
+    print(f"  contact sheet  {out / 'contact_sheet.png'}  (renders above stylized frames)")
+    print(f"  exemplar sheet {out / 'exemplar_sheet.png'}  (render, FULL, LDE, LSE, L.*DDE, drawing)")
     return 0
 
 

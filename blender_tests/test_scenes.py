@@ -1,0 +1,89 @@
+"""The scenes built in code (scenes/scene_kit.py, exemplar_kit.py, demo_scene.py)."""
+import sys
+from pathlib import Path
+
+import bpy
+import pytest
+
+SCENES = Path(__file__).resolve().parent.parent / "scenes"
+sys.path.insert(0, str(SCENES))
+import demo_scene  # noqa: E402
+import exemplar_kit  # noqa: E402
+import scene_kit  # noqa: E402
+
+
+@pytest.fixture
+def exemplar_scene():
+    scene = exemplar_kit.build_exemplar_scene("Test exemplar")
+    yield scene
+    scene_kit.clear_scene(scene)
+    bpy.data.scenes.remove(scene)
+
+
+@pytest.fixture
+def demo():
+    scene = bpy.data.scenes.new("Test demo")
+    demo_scene.build_scene(scene)
+    yield scene
+    scene_kit.clear_scene(scene)
+    bpy.data.scenes.remove(scene)
+
+
+def objects(scene, kind):
+    return [o for o in scene.collection.all_objects if o.type == kind]
+
+
+def test_exemplar_is_a_sphere_on_a_table(exemplar_scene):
+    names = sorted(o.name for o in objects(exemplar_scene, "MESH"))
+    assert len(names) == 2 and names[0].startswith("Sphere") and names[1].startswith("Table")
+    lights = objects(exemplar_scene, "LIGHT")
+    assert len(lights) == 1 and lights[0].data.type == "AREA"
+    assert exemplar_scene.camera is not None
+    sphere = next(o for o in objects(exemplar_scene, "MESH") if o.name.startswith("Sphere"))
+    assert sphere.location.z == pytest.approx(scene_kit.SPHERE_RADIUS)  # resting on the table
+
+
+def test_exemplar_light_is_placed_like_the_demo_light(exemplar_scene, demo):
+    """Same light, same direction as seen from the sphere (at rest in the exemplar,
+    mid-roll in the demo), so the shading and shadows of both scenes agree."""
+    def light_from_sphere(scene):
+        light = objects(scene, "LIGHT")[0]
+        sphere = next(o for o in objects(scene, "MESH") if o.name.startswith("Sphere"))
+        return light, (light.location - sphere.location).normalized()
+
+    demo.frame_set(demo_scene.FRAMES[len(demo_scene.FRAMES) // 2])
+    ex_light, ex_dir = light_from_sphere(exemplar_scene)
+    demo_light, demo_dir = light_from_sphere(demo)
+    assert ex_dir.angle(demo_dir) < 0.25
+    assert ex_light.data.energy == demo_light.data.energy
+    assert ex_light.data.size == demo_light.data.size
+    assert (ex_light.rotation_euler.to_quaternion().rotation_difference(
+        demo_light.rotation_euler.to_quaternion()).angle) < 1e-4
+
+
+def test_render_settings(exemplar_scene):
+    scene_kit.configure_render(exemplar_scene, (40, 30), 2, exemplar_kit.EXEMPLAR_PASSES)
+    cycles = exemplar_scene.cycles
+    assert exemplar_scene.render.engine == "CYCLES"
+    assert not cycles.use_denoising and cycles.sample_clamp_indirect == 0.0
+    assert not exemplar_scene.render.use_motion_blur
+    layer = exemplar_scene.view_layers[0]
+    assert layer.use_pass_diffuse_direct and layer.use_pass_glossy_color and layer.use_pass_diffuse_indirect
+    assert not layer.use_pass_vector
+    with pytest.raises(ValueError, match="unknown render passes"):
+        scene_kit.configure_render(exemplar_scene, (40, 30), 2, ("Combined", "Nope"))
+
+
+def test_exemplar_renders_to_guides(exemplar_scene, tmp_path):
+    from tempera.stylit_guides import GUIDE_NAMES, read_stylit_passes, stylit_guides
+
+    path = exemplar_kit.render_exemplar(exemplar_scene, tmp_path / "exemplar" / "guides.exr", (48, 36), 2)
+    assert path == tmp_path / "exemplar" / "guides.exr" and path.is_file()
+    assert [p.name for p in path.parent.iterdir()] == ["guides.exr"]  # no partial file left
+    passes = read_stylit_passes(path, scene_kit.view_layer_name(exemplar_scene))
+    guides = dict(stylit_guides(passes))
+    assert list(guides) == list(GUIDE_NAMES)
+    assert all(g.shape == (36, 48, 3) for g in guides.values())
+    assert guides["FULL"].mean() > 0.1 and guides["LDE"].max() > 0.3  # lit, not black
+    # The sphere (red albedo) is in the middle of the frame.
+    assert passes["DiffCol"][18, 24, 0] > 2 * passes["DiffCol"][18, 24, 1]
