@@ -243,7 +243,7 @@ def paint_hatching(render, albedo=None, *, mask=None, seed=0, linear=True, white
 
     angle_field = _direction_field(rng, dark, albedo, mask)
     regions = _regions(albedo, mask)
-    canvas = _Canvas(image, tooth, regions, hi)
+    canvas = _Canvas(image, tooth, regions, mask > 0.5, hi)
 
     for start, floor, ramp, angle_offset, tint, spacing, opacity in _LAYERS:
         # Candidate stroke centres, kept with a probability that grows with darkness.
@@ -297,8 +297,10 @@ def _outline(albedo, mask):
 class _Canvas:
     """Paper being drawn on: strokes are splatted per batch and laid over it."""
 
-    def __init__(self, image, tooth, regions, max_length):
-        self.image, self.tooth, self.regions = image, tooth, regions
+    def __init__(self, image, tooth, regions, inside, max_length):
+        self.image, self.tooth, self.regions, self.inside = image, tooth, regions, inside
+        # Ink may spread a pixel past the mask (line width), no further.
+        self.reach = _blur(inside.astype(np.float64), 1, passes=1) > 0.0
         self.samples = int(np.ceil(max_length * 1.2 / 0.5)) + 1
         self.u = np.linspace(-0.5, 0.5, self.samples)
 
@@ -322,14 +324,19 @@ class _Canvas:
         wobble = 1.0 + 0.15 * np.sin(rng.uniform(0, 2 * np.pi, n)[:, None] + u[None, :] * rng.uniform(4, 9, n)[:, None])
         step = length / (samples - 1)
         weights = (pressure * step)[:, None] * profile[None, :] * wobble
+        # No ink on the background (outside the mask): there the guides are
+        # all alike, and any mark could be copied anywhere into a target's
+        # background. With stay_inside, strokes mostly stay inside the
+        # region (material) they start in: into a neighbouring one only a
+        # faint overshoot remains.
+        sx = np.clip(np.round(xs).astype(np.int64), 0, width - 1)
+        sy = np.clip(np.round(ys).astype(np.int64), 0, height - 1)
+        keep = self.inside[sy, sx].astype(np.float64)
         if stay_inside:
-            # Strokes mostly stay inside the region (material) they start in:
-            # past its outline only a faint overshoot remains.
             ix = np.clip(np.asarray(cx).astype(np.int64), 0, width - 1)
             iy = np.clip(np.asarray(cy).astype(np.int64), 0, height - 1)
-            sx = np.clip(np.round(xs).astype(np.int64), 0, width - 1)
-            sy = np.clip(np.round(ys).astype(np.int64), 0, height - 1)
-            weights = weights * np.where(self.regions[sy, sx] == self.regions[iy, ix][:, None], 1.0, 0.12)
+            keep *= np.where(self.regions[sy, sx] == self.regions[iy, ix][:, None], 1.0, 0.12)
+        weights = weights * keep
         # A little colour variation from stroke to stroke.
         colour = colour * (1.0 + rng.normal(0.0, 0.05, (n, 3))) * rng.uniform(0.92, 1.06, n)[:, None]
         colour = np.clip(colour, 0.0, 1.0)
@@ -337,5 +344,5 @@ class _Canvas:
         acc, col = _splat(height, width, xs.ravel(), ys.ravel(), weights.ravel(), np.repeat(colour, samples, axis=0))
         acc, col = _widen(acc), _widen(col)  # strokes about two pixels wide
         ink = col / np.maximum(acc, 1e-9)[:, :, None]
-        alpha = opacity * (1.0 - np.exp(-4.0 * acc)) * self.tooth
+        alpha = opacity * (1.0 - np.exp(-4.0 * acc)) * self.tooth * self.reach
         self.image = self.image * (1.0 - alpha[:, :, None] * (1.0 - ink))

@@ -75,7 +75,7 @@ def test_background_and_highlights_stay_paper():
     render = albedo * 0.1  # in shadow
     render[40:, 50:] = 5.0  # a blinding highlight
     coverage = ink(paint_hatching(render, albedo, seed=6))
-    assert coverage[:8].mean() < 0.02  # background, away from the table's edge
+    assert coverage[:18].max() == 0.0  # no ink on the background, bar a pixel's fringe (the edge is row 20)
     assert coverage[46:, 56:].mean() < 0.05  # inside the highlight
     assert coverage[26:36, 5:45].mean() > 0.3  # the shadowed table
 
