@@ -58,11 +58,6 @@ GUIDE_PASSES = exemplar_kit.EXEMPLAR_PASSES + ("Vector", "Normal")
 # style_weight 2 makes strokes a little crisper and the shading less faithful.)
 GUIDE_WEIGHTS = {"FULL": 1.0, "LDE": 2.0, "LSE": 1.0, "L.*DDE": 0.5}
 STYLE_WEIGHT = 1.0
-# Target guides are padded by this many pixels (edge replicated) and the
-# result cropped back: the budget patch usage tends to put poorly matching
-# patches on a target's outermost pixels (stray marks along the frame border
-# on the contact sheet, about 0-90 pixels per frame), which the margin absorbs.
-TARGET_MARGIN = 4
 FRAMES_PER_ROW = 4  # on the contact sheet
 
 
@@ -149,7 +144,6 @@ def render_frames(out):
 
 def stylize_frames(out, scene, exrs, style, exemplar_guides):
     """tempera.synthesize per frame; returns (renders sRGB, stylized frames)."""
-    import numpy as np
     import tempera
     from tempera.color import linear_to_srgb
     from tempera.synthesis import synthesize
@@ -158,11 +152,9 @@ def stylize_frames(out, scene, exrs, style, exemplar_guides):
     for i, (frame, exr) in enumerate(zip(FRAMES, exrs), 1):
         started = time.monotonic()
         passes, guides = read_guides(exr, scene, f"frame {frame}")
-        m = TARGET_MARGIN
-        pairs = [(source, np.pad(target, ((m, m), (m, m), (0, 0)), mode="edge"), GUIDE_WEIGHTS[name])
+        pairs = [(source, target, GUIDE_WEIGHTS[name])
                  for (name, source), (_, target) in zip(exemplar_guides, guides)]
         image, stats = synthesize(style, guides=pairs, style_weight=STYLE_WEIGHT, seed=SEED)
-        image = np.ascontiguousarray(image[m:image.shape[0] - m, m:image.shape[1] - m])
         tempera.write_image(str(out / "frames" / f"frame_{frame:04d}.png"), image)
         renders.append(linear_to_srgb(passes["Combined"][:, :, :3]))
         stylized.append(image)

@@ -80,7 +80,7 @@ class ReversedRetrieval {
   void assign(const Assignment& a) {
     nnf_.x[a.target] = a.source % sw_;
     nnf_.y[a.target] = a.source / sw_;
-    nnf_.dist[a.target] = a.dist;
+    nnf_.dist[a.target] = a.dist / border_scale(a.target % tw_, a.target / tw_);
     assigned_[a.target] = 1;
     candidate_[a.source] = kNone;
     candidate_dist_[a.source] = kInf;
@@ -90,6 +90,22 @@ class ReversedRetrieval {
   bool is_assigned(std::size_t target) const { return assigned_[target] != 0; }
 
  private:
+  // Target patches at the frame border are clipped, so their raw distances
+  // sum fewer pixels and would look like bargains to every source patch.
+  // Reversed retrieval compares distances across targets, so it scales them
+  // to a whole patch.
+  float border_scale(int qx, int qy) const {
+    const int r = space_.radius;
+    const int w = std::min(r, tw_ - 1 - qx) + std::min(r, qx) + 1;
+    const int h = std::min(r, th_ - 1 - qy) + std::min(r, qy) + 1;
+    return float((2 * r + 1) * (2 * r + 1)) / float(w * h);
+  }
+
+  float scaled_distance(int sx, int sy, int qx, int qy, float cutoff) const {
+    const float scale = border_scale(qx, qy);
+    return scale * patch_distance(space_, sx, sy, qx, qy, cutoff / scale);
+  }
+
   bool open_target(int qx, int qy, int segment) const {
     if (qx < 0 || qy < 0 || qx >= tw_ || qy >= th_) return false;
     const std::size_t q = std::size_t(qy) * tw_ + qx;
@@ -117,9 +133,10 @@ class ReversedRetrieval {
     for (const auto& list : unassigned_) {
       for (std::int32_t q : list) {
         const std::size_t p = std::size_t(nnf_.y[q]) * sw_ + nnf_.x[q];
-        if (eligible_[p] && nnf_.dist[q] < candidate_dist_[p]) {
+        const float d = nnf_.dist[q] * border_scale(q % tw_, q / tw_);
+        if (eligible_[p] && d < candidate_dist_[p]) {
           candidate_[p] = q;
-          candidate_dist_[p] = nnf_.dist[q];
+          candidate_dist_[p] = d;
         }
       }
     }
@@ -132,7 +149,7 @@ class ReversedRetrieval {
         Rng rng(params_.seed, mix64(stream_ * 7919 + round_index) ^ p);
         const std::int32_t q = list[rng.below(int(list.size()))];
         candidate_[p] = q;
-        candidate_dist_[p] = patch_distance(space_, sx, sy, q % tw_, q / tw_, kInf);
+        candidate_dist_[p] = scaled_distance(sx, sy, q % tw_, q / tw_, kInf);
         wide_search_[p] = 1;
       }
     });
@@ -153,7 +170,7 @@ class ReversedRetrieval {
     if (!open_target(qx, qy, segment)) return;
     const std::int32_t q = qy * tw_ + qx;
     if (q == best) return;
-    const float d = patch_distance(space_, sx, sy, qx, qy, best_dist);
+    const float d = scaled_distance(sx, sy, qx, qy, best_dist);
     if (d < best_dist) {
       best = q;
       best_dist = d;

@@ -315,3 +315,36 @@ TEST(PatchSpace, AxialRotationTakesTheSmallestAngle) {
   space.axial = false;
   EXPECT_NEAR(space.rotation(1, 1, 2, 2), -3 * kPi / 2, 1e-4);
 }
+
+// Clipped target patches at the frame border sum fewer pixels; reversed
+// retrieval must not mistake that for a good match and dump misfit exemplar
+// patches along the border. The misfit blocks here cost only about twice a
+// fitting patch, so a raw corner distance (9 of 25 pixels) would undercut a
+// fitting one.
+TEST(Synthesis, BudgetKeepsMisfitPatchesOffTheFrameBorder) {
+  const Image tex = noise_texture(64, 64, 3, 9);
+  Image style(64, 64, 3), src_guide(64, 64, 1), tgt_guide(80, 60, 1, 0.0f);
+  auto misfit = [](int x, int y) { return (x / 8 + y / 8) % 2 == 0 && x > 8 && x < 56 && y > 8 && y < 56; };
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      src_guide.at(x, y, 0) = misfit(x, y) ? 0.1f : 0.0f;
+      for (int c = 0; c < 3; ++c) style.at(x, y, c) = misfit(x, y) ? 0.5f : 0.4f + 0.6f * tex.at(x, y, c);
+    }
+  SynthesisInput in;
+  in.style = style.view();
+  in.guides.add("g", src_guide.view(), tgt_guide.view(), 1.0f);
+  // Misfits copied into the outer two-pixel ring of the frame.
+  auto ring_misfits = [&](PatchUsage usage) {
+    const SynthesisResult r = synthesize(in, fast_options(usage));
+    int n = 0;
+    for (int y = 0; y < 60; ++y)
+      for (int x = 0; x < 80; ++x) {
+        const std::size_t i = r.nnf.index(x, y);
+        const bool ring = x < 2 || y < 2 || x >= 78 || y >= 58;
+        n += ring && misfit(r.nnf.x[i], r.nnf.y[i]);
+      }
+    return n;
+  };
+  // Plain nearest neighbours set the bar: the error budget may not do worse there.
+  EXPECT_LE(ring_misfits(PatchUsage::Budget), ring_misfits(PatchUsage::None) + 2);
+}
