@@ -9,7 +9,7 @@
 
 namespace tempera {
 
-void SearchConstraints::finalize(int source_width) {
+void SearchConstraints::finalize() {
   int segments = 1;
   for (int s : source_segment) segments = std::max(segments, s + 1);
   for (int s : target_segment) segments = std::max(segments, s + 1);

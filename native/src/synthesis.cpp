@@ -281,7 +281,7 @@ void build_level(const Pyramids& p, int l, const SynthesisOptions& opt, Level& l
   if (!p.target_label.empty())
     for (float v : std::vector<float>(p.target_label[l].data(), p.target_label[l].data() + tw * th))
       cons.target_segment.push_back(std::int32_t(std::lround(v)));
-  cons.finalize(sw);
+  cons.finalize();
 }
 
 // Writes B' into the style slots of the target features.

@@ -138,3 +138,19 @@ def test_unknown_map_or_option_is_rejected():
         tempera.synthesize(noise(16, 16), [(g, g)], sharpness=3)
     with pytest.raises(ValueError, match="unknown synthesis option 'sharpness'"):
         tempera._native.synthesize(noise(16, 16), [("g", g, g, 1.0, None)], {"sharpness": 3}, {}, None, None)
+
+
+def test_occurrence_penalty_breaks_up_hotspots():
+    """Plain matching reuses a few exemplar patches many times on a flat guide;
+    the occurrence penalty (Kaspar et al. 2015) spreads the usage."""
+    yy, xx = np.mgrid[0:48, 0:48]
+    rng = np.random.default_rng(2)
+    style = (0.5 + 0.4 * np.sin(xx / 3.0)[..., None] + 0.05 * rng.random((48, 48, 3))).astype(np.float32)
+    flat_source, flat_target = np.zeros((48, 48), np.float32), np.zeros((64, 64), np.float32)
+
+    def max_uses(**kwargs):
+        _, stats = tempera.synthesize(style, [(flat_source, flat_target)], seed=3, **kwargs)
+        nnf = stats["nnf"]
+        return np.bincount((nnf[..., 1] * 48 + nnf[..., 0]).ravel()).max()
+
+    assert max_uses(usage="penalty", penalty_weight=0.5) < 0.5 * max_uses(usage="none")

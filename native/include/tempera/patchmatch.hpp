@@ -34,7 +34,7 @@ struct SearchConstraints {
   std::vector<std::vector<std::int32_t>> valid_by_segment;
 
   // Builds valid_by_segment; throws ValueError if a target segment has no source.
-  void finalize(int source_width);
+  void finalize();
   int segment_of_target(std::size_t i) const { return target_segment.empty() ? 0 : target_segment[i]; }
   int segment_of_source(std::size_t i) const { return source_segment.empty() ? 0 : source_segment[i]; }
   bool allowed(std::size_t source_index, int segment) const {
