@@ -77,6 +77,18 @@ def picture_grid(picture, width, height, supersample=1):
     return to_cells(xs), to_cells(ys)
 
 
+def place_picture(page, picture, image):
+    """Draws `image` ((h, w, 3), any size) into the rectangle `picture` of
+    `page` in place, bilinearly scaled; returns page. (The template's render,
+    or in tests and docs a stand-in for the artist's paint.)"""
+    x0, y0, x1, y1 = picture
+    height, width = image.shape[:2]
+    xs, ys = picture_grid(picture, x1 - x0, y1 - y0)  # one sample per page pixel
+    page[y0:y1, x0:x1] = sample_bilinear(image, (xs[..., 0] - x0) * width / (x1 - x0),
+                                         (ys[..., 0] - y0) * height / (y1 - y0))
+    return page
+
+
 def _layout(width, height, dpi):
     """(page size in mm, picture rectangle in px, mark centres in px, mark side in px)."""
     page_mm = (A4_MM[1], A4_MM[0]) if width >= height else A4_MM
@@ -131,12 +143,7 @@ def make_template(render, *, dpi=150.0, contrast=0.25):
     page_mm, (page_w, page_h), picture, marks, side = _layout(width, height, dpi)
 
     page = np.ones((page_h, page_w, 3))
-    x0, y0, x1, y1 = picture
-    xs, ys = picture_grid(picture, x1 - x0, y1 - y0)  # one sample per page pixel
-    # Page pixel centres -> render pixel coordinates, then the render faded towards white.
-    faded = 1.0 - contrast * (1.0 - np.clip(rgb, 0.0, 1.0))
-    page[y0:y1, x0:x1] = sample_bilinear(faded, (xs[..., 0] - x0) * width / (x1 - x0),
-                                         (ys[..., 0] - y0) * height / (y1 - y0))
+    place_picture(page, picture, 1.0 - contrast * (1.0 - np.clip(rgb, 0.0, 1.0)))  # faded towards white
     for i, centre in enumerate(marks):
         _draw_mark(page, centre, side, key=(i == 0))
     return Template(page.astype(np.float32), marks, picture, side, [width, height], float(dpi), page_mm)

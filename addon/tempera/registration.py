@@ -243,3 +243,19 @@ def register_painting(photo, kit, *, flatten=True):
         style = style / np.maximum(paper, 1e-3)
     return np.clip(style, 0.0, 1.0).astype(np.float32)
 
+
+
+def simulate_photo(page, page_to_photo, size, *, seed=0, noise=0.01, table=(0.25, 0.2, 0.15)):
+    """A synthetic photo of `page` ((H, W, 3) in [0, 1]) for tests and docs:
+    the page seen through the homography `page_to_photo` on a dark table, in
+    a (width, height) = `size` frame, under light falling off from 1.0 on the
+    left to 0.65 on the right with a warm cast, plus Gaussian noise."""
+    width, height = size
+    ys, xs = np.mgrid[:height, :width] + 0.5
+    p = apply_homography(np.linalg.inv(page_to_photo), np.stack([xs, ys], -1))
+    inside = (p[..., 0] >= 0) & (p[..., 0] < page.shape[1]) & (p[..., 1] >= 0) & (p[..., 1] < page.shape[0])
+    photo = np.where(inside[..., None], sample_bilinear(np.asarray(page, np.float64), p[..., 0], p[..., 1]), table)
+    light = 0.95 - 0.3 * xs / width + 0.05 * ys / height
+    photo = photo * light[..., None] * [1.0, 0.97, 0.9]
+    photo += np.random.default_rng(seed).normal(0.0, noise, photo.shape)
+    return np.clip(photo, 0.0, 1.0).astype(np.float32)

@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 
 import tempera
-from tempera.painting_template import make_template, sample_bilinear, write_kit_json, write_pdf
-from tempera.registration import apply_homography, estimate_homography, find_marks, label_components, register_painting
+from tempera.painting_template import make_template, place_picture, write_kit_json, write_pdf
+from tempera.registration import (apply_homography, estimate_homography, find_marks, label_components,
+                                  register_painting, simulate_photo)
 
 W, H = 64, 48  # guide resolution of the synthetic exemplar
 DPI = 60  # small pages keep the tests quick
@@ -34,24 +35,11 @@ def known_painting():
 
 def painted_page(template, painting):
     """The template with `painting` laid opaquely over its picture area."""
-    page = template.image.astype(np.float64).copy()
-    x0, y0, x1, y1 = template.picture
-    ys, xs = np.mgrid[y0:y1, x0:x1] + 0.5
-    page[y0:y1, x0:x1] = sample_bilinear(painting, (xs - x0) * W / (x1 - x0), (ys - y0) * H / (y1 - y0))
-    return page
+    return place_picture(template.image.astype(np.float64), template.picture, painting)
 
 
 def photograph(page, page_to_photo, size, rng, noise=0.01):
-    """A simulated photo (size = (width, height)): the page seen through the
-    homography on a dark table, under light falling off from left to right, noisy."""
-    width, height = size
-    ys, xs = np.mgrid[:height, :width] + 0.5
-    p = apply_homography(np.linalg.inv(page_to_photo), np.stack([xs, ys], -1))
-    inside = (p[..., 0] >= 0) & (p[..., 0] < page.shape[1]) & (p[..., 1] >= 0) & (p[..., 1] < page.shape[0])
-    photo = np.where(inside[..., None], sample_bilinear(page, p[..., 0], p[..., 1]), [0.25, 0.2, 0.15])
-    light = 0.95 - 0.3 * xs / width + 0.05 * ys / height  # uneven: 0.65 .. 1.0
-    photo = photo * light[..., None] * [1.0, 0.97, 0.9]  # and a warm cast
-    return np.clip(photo + rng.normal(0, noise, photo.shape), 0, 1).astype(np.float32)
+    return simulate_photo(page, page_to_photo, size, seed=int(rng.integers(1 << 30)), noise=noise)
 
 
 def homography_onto(page_shape, quad):
