@@ -48,8 +48,8 @@ def main():
     kit = read_kit_json(kit_dir / "kit.json")
     page = tempera.read_image(str(kit_dir / "template.png"))[:, :, :3].astype(np.float64)
     exr = kit_dir / kit["guides"]
-    painting = paint_hatching(read_pass(exr, "Combined", kit["view_layer"]), read_pass(exr, "DiffCol", kit["view_layer"]),
-                              seed=7)
+    painting = paint_hatching(read_pass(exr, "Combined", kit["view_layer"]),
+                              read_pass(exr, "DiffCol", kit["view_layer"]), seed=7)
     painted = place_picture(page.copy(), kit["picture"], painting)
 
     # Upside down, in perspective, on a 1600 x 1200 photo.

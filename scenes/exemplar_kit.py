@@ -124,7 +124,8 @@ def main():
     finally:
         if scripts_dir:
             shutil.rmtree(scripts_dir, ignore_errors=True)
-    print(f"exemplar kit '{args.variant}': {kit.parent}/ (guides.exr, render.png, template.png, template.pdf, kit.json)")
+    print(f"exemplar kit '{args.variant}': {kit.parent}/ "
+          "(guides.exr, render.png, template.png, template.pdf, kit.json)")
 
 
 if __name__ == "__main__":

@@ -56,7 +56,8 @@ def sample_bilinear(image, xs, ys):
     h, w = image.shape[:2]
     x = np.clip(np.asarray(xs, dtype=np.float64) - 0.5, 0.0, w - 1.0)
     y = np.clip(np.asarray(ys, dtype=np.float64) - 0.5, 0.0, h - 1.0)
-    x0, y0 = np.minimum(x.astype(np.int64), w - 2 if w > 1 else 0), np.minimum(y.astype(np.int64), h - 2 if h > 1 else 0)
+    # The upper-left neighbour of each sample, kept one pixel from the far edge (fx, fy then reach 1).
+    x0, y0 = np.minimum(x.astype(np.int64), max(w - 2, 0)), np.minimum(y.astype(np.int64), max(h - 2, 0))
     x1, y1 = np.minimum(x0 + 1, w - 1), np.minimum(y0 + 1, h - 1)
     fx, fy = (x - x0)[..., None], (y - y0)[..., None]
     top = image[y0, x0] * (1 - fx) + image[y0, x1] * fx

@@ -141,7 +141,7 @@ def find_marks(photo):
     small = gray[: h * f, : w * f].reshape(h, f, w, f).mean(axis=(1, 3))
     dark = small < 0.55 * _box_mean(small, max(7, min(h, w) // 16))
     labels = label_components(dark)
-    ids, first, areas = np.unique(labels[dark], return_index=True, return_counts=True)
+    areas = np.unique(labels[dark], return_counts=True)[1]  # per component, in label order
     min_area, max_area = 40, 0.02 * h * w
     candidates = []
     yy, xx = np.nonzero(dark)

@@ -211,5 +211,6 @@ def test_register_painting_command(template, tmp_path):
     result = subprocess.run([sys.executable, "-m", "tempera.register_painting", str(tmp_path / "blank.png"),
                              "--kit", str(kit), "--out", str(tmp_path / "x.png")], capture_output=True, text=True)
     assert result.returncode != 0 and "found 0 of 4 alignment marks" in result.stderr
-    result = subprocess.run(command[:-1] + [str(tmp_path), "--out", str(tmp_path / "x.png")], capture_output=True, text=True)
+    result = subprocess.run(command[:-1] + [str(tmp_path), "--out", str(tmp_path / "x.png")],
+                            capture_output=True, text=True)
     assert result.returncode != 0 and "kit.json" in result.stderr
