@@ -236,8 +236,12 @@ def register_painting(photo, kit, *, flatten=True):
                              np.linalg.norm(corners[3] - corners[0]) / height)
     s = int(np.clip(np.ceil(photo_px_per_pixel), 1, 8))
     xs, ys = picture_grid(kit["picture"], width, height, s)
-    pxy = apply_homography(to_photo, np.stack([xs, ys], -1))
-    style = sample_bilinear(photo, pxy[..., 0], pxy[..., 1]).mean(axis=2)
+    style = np.empty((height, width, 3))
+    band = max(1, 2 ** 20 // (width * s * s))  # rows at a time: bounded memory for large photos
+    for top in range(0, height, band):
+        rows = slice(top, top + band)
+        pxy = apply_homography(to_photo, np.stack([xs[rows], ys[rows]], -1))
+        style[rows] = sample_bilinear(photo, pxy[..., 0], pxy[..., 1]).mean(axis=2)
     if flatten:
         paper = _paper_lighting(photo, to_photo, kit)(xs.mean(axis=2), ys.mean(axis=2))
         style = style / np.maximum(paper, 1e-3)

@@ -214,3 +214,22 @@ def test_register_painting_command(template, tmp_path):
     result = subprocess.run(command[:-1] + [str(tmp_path), "--out", str(tmp_path / "x.png")],
                             capture_output=True, text=True)
     assert result.returncode != 0 and "kit.json" in result.stderr
+
+
+def test_dark_paint_and_a_look_alike_do_not_confuse_it(template):
+    """Dark strokes over the picture and, inside it, a doodle shaped like a
+    mark but smaller: the four real marks are still the ones found."""
+    page = painted_page(template, known_painting())
+    x0, y0, x1, y1 = template.picture
+    rng = np.random.default_rng(8)
+    for _ in range(60):  # short dark strokes
+        x, y = rng.integers(x0, x1 - 12), rng.integers(y0, y1 - 3)
+        page[y:y + 2, x:x + 12] = 0.05
+    s = int(template.mark_size * 0.6)
+    cx, cy = (x0 + x1) // 2, (y0 + y1) // 2
+    page[cy - s // 2:cy + s // 2, cx - s // 2:cx + s // 2] = 0.0
+    page[cy - 2:cy + 2, cx - 2:cx + 2] = 1.0
+    to_photo = homography_onto(page.shape, TURNED_90)
+    photo = photograph(page, to_photo, (860, 680), rng)
+    expected = apply_homography(to_photo, np.array(template.marks))
+    assert np.abs(find_marks(photo) - expected).max() < 1.5
