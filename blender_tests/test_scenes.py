@@ -87,3 +87,37 @@ def test_exemplar_renders_to_guides(exemplar_scene, tmp_path):
     assert guides["FULL"].mean() > 0.1 and guides["LDE"].max() > 0.3  # lit, not black
     # The sphere (red albedo) is in the middle of the frame.
     assert passes["DiffCol"][18, 24, 0] > 2 * passes["DiffCol"][18, 24, 1]
+
+
+def test_exemplar_variants():
+    scene = exemplar_kit.build_exemplar_scene("Test variant", variant="sphere_and_box")
+    try:
+        names = sorted(o.name.split(".")[0] for o in objects(scene, "MESH"))
+        assert names == ["Box", "Sphere", "Table"]
+        box = next(o for o in objects(scene, "MESH") if o.name.startswith("Box"))
+        assert box.location.z == pytest.approx(scene_kit.BOX_SIZE / 2)  # standing on the table
+    finally:
+        scene_kit.clear_scene(scene)
+        bpy.data.scenes.remove(scene)
+    with pytest.raises(ValueError, match="unknown exemplar variant 'nope'"):
+        exemplar_kit.build_exemplar_scene("Test variant", variant="nope")
+
+
+def test_exemplar_kit_outputs(tmp_path):
+    import json
+
+    import tempera
+
+    kit = exemplar_kit.make_kit(tmp_path / "kit", "sphere_and_box", (48, 36), samples=2, dpi=40)
+    folder = kit.parent
+    assert sorted(p.name for p in folder.iterdir()) == ["guides.exr", "kit.json", "render.png", "template.pdf",
+                                                       "template.png"]
+    info = json.loads(kit.read_text())
+    assert info["variant"] == "sphere_and_box" and info["resolution"] == [48, 36] and len(info["marks"]) == 4
+    assert tempera.image_info(str(folder / "guides.exr"))["width"] == 48
+    assert tempera.read_image(str(folder / "render.png")).shape[:2] == (36, 48)
+    page = tempera.read_image(str(folder / "template.png"))
+    assert page.shape[:2] == (round(210 * 40 / 25.4), round(297 * 40 / 25.4))  # A4 landscape at 40 dpi
+    x0, y0, x1, y1 = info["picture"]
+    assert 0 < x0 < x1 < page.shape[1] and 0 < y0 < y1 < page.shape[0]
+    assert (folder / "template.pdf").read_bytes().startswith(b"%PDF")

@@ -31,7 +31,6 @@ import sys
 import time
 from pathlib import Path
 
-import bmesh
 import bpy
 
 HERE = Path(__file__).resolve().parent
@@ -81,10 +80,7 @@ def build_scene(scene):
         for key in fcurve.keyframe_points:
             key.interpolation = "LINEAR"
 
-    box = scene_kit.mesh_object(
-        scene, "Box", lambda bm: bmesh.ops.create_cube(bm, size=0.5),
-        scene_kit.material("Box", (0.12, 0.28, 0.7), 0.45), (0.35, 0.55, 0.25))
-    box.rotation_euler = (0, 0, math.radians(30))
+    scene_kit.add_box(scene, (0.35, 0.55, scene_kit.BOX_SIZE / 2), math.radians(30))
 
     scene_kit.add_key_light(scene)
     scene_kit.add_camera(scene, location=(0.0, -3.3, 1.7), target=(0, 0.1, 0.2), lens=35)

@@ -17,6 +17,8 @@ from mathutils import Vector
 TABLE_COLOR, TABLE_ROUGHNESS = (0.62, 0.55, 0.45), 0.55
 SPHERE_COLOR, SPHERE_ROUGHNESS = (0.8, 0.12, 0.08), 0.25
 SPHERE_RADIUS = 0.3
+BOX_COLOR, BOX_ROUGHNESS = (0.12, 0.28, 0.7), 0.45
+BOX_SIZE = 0.5
 WORLD_COLOR = (0.05, 0.06, 0.08)
 # One area light, up and to the front left of the subject, aimed at it.
 KEY_LIGHT = {"location": (-1.6, -1.2, 2.4), "target": (0.0, 0.0, 0.0), "energy": 120.0, "size": 1.2}
@@ -86,6 +88,14 @@ def add_sphere(scene, location, radius=SPHERE_RADIUS, name="Sphere"):
         scene, name,
         lambda bm: bmesh.ops.create_uvsphere(bm, u_segments=48, v_segments=24, radius=radius),
         material(name, SPHERE_COLOR, SPHERE_ROUGHNESS), location, smooth=True)
+
+
+def add_box(scene, location, angle_z=0.0, size=BOX_SIZE, name="Box"):
+    """A cube of side `size` centred on `location`, turned by `angle_z` radians."""
+    box = mesh_object(scene, name, lambda bm: bmesh.ops.create_cube(bm, size=size),
+                      material(name, BOX_COLOR, BOX_ROUGHNESS), location)
+    box.rotation_euler = (0.0, 0.0, angle_z)
+    return box
 
 
 def add_key_light(scene, offset=(0.0, 0.0, 0.0)):
