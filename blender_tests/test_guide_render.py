@@ -1,6 +1,8 @@
 """tempera.blender.guide_render on a tiny animated scene rendered headless:
 a cube moving right with linear keyframes in front of a static backdrop."""
 import math
+import tempfile
+from pathlib import Path
 
 import bpy
 import numpy as np
@@ -11,7 +13,7 @@ from mathutils import Vector
 # 131 x 97 at 50 %: an odd effective width, 65 x 48 pixels.
 RESOLUTION, PERCENT, SIZE = (131, 97), 50, (65, 48)
 FRAMES = (2, 3, 4)  # keyframes at 1 and 5: linear motion on every rendered frame and its neighbours
-CUBE_START, CUBE_STEP = -1.0, 0.5  # x at frame 1, units per frame
+CUBE_START, CUBE_STEP = Vector((-1.0, 0.0, -0.4)), Vector((0.5, 0.0, 0.2))  # at frame 1; per frame (right and up)
 PARAMS = {"samples": 8, "ld12e_samples": 8}
 
 
@@ -40,13 +42,14 @@ def _build_scene():
     scene.collection.children.link(movers)
     backdrop = mesh("Backdrop", 1.0, (0, 3.0, 0), scene.collection)
     backdrop.scale = (30, 0.1, 30)
-    cube = mesh("MovingCube", 1.5, (CUBE_START, 0, 0), movers)
-    for frame, x in ((1, CUBE_START), (5, CUBE_START + 4 * CUBE_STEP)):
-        cube.location.x = x
-        cube.keyframe_insert("location", index=0, frame=frame)
-    for key in cube.animation_data.action.fcurves[0].keyframe_points:
-        key.interpolation = "LINEAR"
-    cube.location.x = CUBE_START  # where frame 1 has it
+    cube = mesh("MovingCube", 1.5, CUBE_START, movers)
+    for frame, location in ((1, CUBE_START), (5, CUBE_START + 4 * CUBE_STEP)):
+        cube.location = location
+        cube.keyframe_insert("location", frame=frame)
+    for fcurve in cube.animation_data.action.fcurves:
+        for key in fcurve.keyframe_points:
+            key.interpolation = "LINEAR"
+    cube.location = CUBE_START  # where frame 1 has it
 
     sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
     sun.data.energy = 3.0
@@ -112,9 +115,11 @@ def rendered(tmp_path_factory):
     bpy.ops.wm.save_as_mainfile(filepath=str(blend), copy=True)
     blend_bytes = blend.read_bytes()
     calls = []
+    temp_dirs = set(Path(tempfile.gettempdir()).glob("tempera-guides-*"))
     report = render_guides(scene, FRAMES, tmp / "cache", PARAMS, progress=lambda *a: calls.append(a))
     yield {"scene": scene, "before": before, "blend": blend, "blend_bytes": blend_bytes,
-           "cache": tmp / "cache", "window_scene": window_scene, "report": report, "progress": calls}
+           "cache": tmp / "cache", "window_scene": window_scene,
+           "temp_dirs_left": set(Path(tempfile.gettempdir()).glob("tempera-guides-*")) - temp_dirs, "report": report, "progress": calls}
     _remove_scene(scene)
 
 
@@ -124,10 +129,11 @@ def frame(rendered, f):
     return guide_cache.read_frame(rendered["cache"], f)
 
 
-def screen_position(scene, point, f):
-    """Pixel position (x right, y down, pixel centres at .5) of a world point at frame f."""
-    scene.frame_set(f)
-    ndc = world_to_camera_view(scene, scene.camera, Vector(point))
+def screen_position(scene, point):
+    """Pixel position (x right, y down, pixel centres at .5) of a world point."""
+    camera = scene.camera  # static: its matrix does not depend on the frame
+    assert (camera.matrix_world.translation - camera.location).length < 1e-6  # not a stale matrix
+    ndc = world_to_camera_view(scene, camera, Vector(point))
     return np.array([ndc.x * SIZE[0], (1 - ndc.y) * SIZE[1]])
 
 
@@ -137,6 +143,7 @@ def test_manifest_and_channels(rendered):
     report, cache = rendered["report"], rendered["cache"]
     assert report["rendered"] == list(FRAMES) and report["skipped"] == []
     assert rendered["progress"][-1][:2] == (len(FRAMES), len(FRAMES))
+    assert not rendered["temp_dirs_left"]
     manifest = guide_cache.read_manifest(cache)
     assert manifest["resolution"] == list(SIZE) and manifest["frame_range"] == [2, 4]
     assert manifest["camera"] == "GuideCamera" and manifest["params"]["samples"] == 8
@@ -161,13 +168,12 @@ def test_every_channel_is_finite_and_full_size(rendered):
 def test_velocity_matches_the_analytic_screen_motion(rendered):
     scene = rendered["scene"]
     guides = frame(rendered, 3)
-    front = (CUBE_START + 2 * CUBE_STEP, -0.75, 0.0)  # centre of the cube's front face at frame 3
-    p2, p3, p4 = (screen_position(scene, (front[0] + d * CUBE_STEP, *front[1:]), f)
-                  for d, f in ((-1, 2), (0, 3), (1, 4)))
+    front = CUBE_START + 2 * CUBE_STEP + Vector((0, -0.75, 0))  # centre of the cube's front face at frame 3
+    p2, p3, p4 = (screen_position(scene, front + d * CUBE_STEP) for d in (-1, 0, 1))
     x, y = np.floor(p3).astype(int)
     window = np.s_[y - 1:y + 2, x - 1:x + 2]
     assert guides["mask.OB_MovingCube"][window].min() == 1
-    assert abs(p4 - p3)[0] > 3  # it does move
+    assert (p4 - p3)[0] > 3 and (p4 - p3)[1] < -1  # it does move, right and up the image
     for measured in guides["velocity_forward"][window].reshape(-1, 2):
         np.testing.assert_allclose(measured, p4 - p3, atol=0.5)
     for measured in guides["velocity_backward"][window].reshape(-1, 2):
@@ -254,3 +260,58 @@ def test_motion_blur_is_refused_with_a_clear_message(rendered, tmp_path):
     finally:
         scene.render.use_motion_blur = False
     assert not (tmp_path / "cache").exists()
+
+
+def test_no_camera_is_refused(rendered, tmp_path):
+    from tempera.blender.guide_render import GuideRenderError, render_guides
+
+    scene = rendered["scene"]
+    camera, scene.camera = scene.camera, None
+    try:
+        with pytest.raises(GuideRenderError, match="no active camera"):
+            render_guides(scene, FRAMES, tmp_path / "cache", PARAMS)
+    finally:
+        scene.camera = camera
+
+
+def test_settings_come_back_when_rendering_fails(rendered, tmp_path):
+    """An error (here: a progress callback cancelling after the first frame's
+    renders) leaves the scene, the window and the temporary folder as they were."""
+    from tempera.blender.guide_render import render_guides
+
+    scene = rendered["scene"]
+    scene.frame_set(1)
+    before = scene_dump(scene)
+    temp_dirs = set(Path(tempfile.gettempdir()).glob("tempera-guides-*"))
+
+    class Cancel(Exception):
+        pass
+
+    def cancel(done, total, message):
+        if done == 1:
+            raise Cancel()
+
+    with pytest.raises(Cancel):
+        render_guides(scene, (2, 3), tmp_path / "cache", {"samples": 2, "ld12e_samples": 2}, progress=cancel)
+    after = scene_dump(scene)
+    assert [k for k in before if before[k] != after.get(k)] == []
+    assert bpy.context.window.scene.name == rendered["window_scene"]
+    assert set(Path(tempfile.gettempdir()).glob("tempera-guides-*")) == temp_dirs
+    assert not list((tmp_path / "cache").glob("*.exr"))  # frames are written after all renders
+
+
+def test_workbench_scene_gets_cycles_guides_and_keeps_its_engine(rendered, tmp_path):
+    from tempera import guide_cache
+    from tempera.blender.guide_render import render_guides
+
+    scene = rendered["scene"]
+    scene.render.engine = "BLENDER_WORKBENCH"
+    try:
+        render_guides(scene, (3,), tmp_path / "cache", {"samples": 2, "ld12e_samples": 2, "masks": "none"})
+        assert scene.render.engine == "BLENDER_WORKBENCH"
+    finally:
+        scene.render.engine = "BLENDER_EEVEE"
+    guides = guide_cache.read_frame(tmp_path / "cache", 3)
+    assert guides["FULL"].max() > 0.1 and guides["LDDE"].max() > 0  # Cycles light paths
+    assert not [g for g in guides if g.startswith("mask.")]
+    assert guides["occlusion_backward"].min() == 0  # neighbours from motion-only renders

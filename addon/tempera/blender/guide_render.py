@@ -312,11 +312,26 @@ def render_guides(scene, frames, out_dir, params=None, progress=None):
         keys = {f: guide_cache.frame_key(params, scene_fingerprint(scene, f)) for f in frames}
         todo = [f for f in frames if not guide_cache.is_frame_current(out_dir, manifest, f, keys[f])]
         report["skipped"] = [f for f in frames if f not in todo]
+        if _forget_stale_frames(scene, manifest, out_dir, params) and not todo:
+            guide_cache.write_manifest(out_dir, manifest)
         if todo:
             with tempfile.TemporaryDirectory(prefix="tempera-guides-") as tmp:
                 _render_frames(scene, todo, keys, manifest, out_dir, Path(tmp), params, progress)
         report["rendered"] = todo
     return report
+
+
+def _forget_stale_frames(scene, manifest, out_dir, params):
+    """Drops the manifest entries of frames rendered from an older state of the
+    scene (the manifest lists only current frames). True if any was dropped."""
+    entries = manifest.get("frames", {})
+    stale = [f for f in entries if not guide_cache.is_frame_current(
+        out_dir, manifest, int(f), guide_cache.frame_key(params, scene_fingerprint(scene, int(f))))]
+    for f in stale:
+        del entries[f]
+    if stale and entries:
+        manifest["frame_range"] = [min(map(int, entries)), max(map(int, entries))]
+    return bool(stale)
 
 
 def _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress):
