@@ -315,3 +315,19 @@ def test_workbench_scene_gets_cycles_guides_and_keeps_its_engine(rendered, tmp_p
     assert guides["FULL"].max() > 0.1 and guides["LDDE"].max() > 0  # Cycles light paths
     assert not [g for g in guides if g.startswith("mask.")]
     assert guides["occlusion_backward"].min() == 0  # neighbours from motion-only renders
+
+
+def test_frame_key_follows_the_scene(rendered):
+    from tempera.blender.guide_render import scene_fingerprint
+
+    scene = rendered["scene"]
+    first = scene_fingerprint(scene, 3)
+    assert scene_fingerprint(scene, 3) == first and scene_fingerprint(scene, 4) != first
+    camera, backdrop = scene.camera.data, scene.objects["Backdrop"]
+    camera.lens += 10
+    assert scene_fingerprint(scene, 3) != first
+    camera.lens -= 10
+    backdrop.location.y += 1
+    assert scene_fingerprint(scene, 3) != first
+    backdrop.location.y -= 1
+    assert scene_fingerprint(scene, 3) == first

@@ -195,13 +195,14 @@ def assign_pass_indices(scene, mode):
 
 def scene_fingerprint(scene, frame):
     """What the guides of `frame` depend on besides the parameters: the saved
-    file (path, modification time), camera, resolution, bounces, and every
-    object with its transform or, if animated, its keyframes.
+    file (path, modification time), camera and lens, resolution, bounces,
+    film, and every object with its transform or, if animated, its
+    keyframes, mesh size, modifiers and materials.
 
     Taken from the original data, not evaluated at `frame`: evaluated
     transforms of a scene are not reliable outside the active depsgraph (seen
     stale after a render on Blender 3.4). Drivers, constraints and unsaved
-    edits of materials or meshes are not seen: save the file to have them
+    edits inside materials, node trees or meshes are not seen: save the file to have them
     picked up (its modification time is part of the fingerprint)."""
     render = scene.render
     source = None
@@ -214,6 +215,8 @@ def scene_fingerprint(scene, frame):
         "bounces": [scene.cycles.max_bounces, scene.cycles.diffuse_bounces, scene.cycles.glossy_bounces,
                     scene.cycles.transmission_bounces],
         "pixel_aspect": [render.pixel_aspect_x, render.pixel_aspect_y],
+        "film": [scene.cycles.film_exposure, scene.cycles.pixel_filter_type, scene.cycles.filter_width],
+        "camera_data": _camera_fingerprint(scene.camera.data),
         "objects": [_object_fingerprint(o) for o in sorted(scene.objects, key=lambda o: o.name)],
     }
 
@@ -228,14 +231,22 @@ def _animation(id_block):
             for fc in anim.action.fcurves]
 
 
+def _camera_fingerprint(camera):
+    return [camera.type, camera.lens, camera.ortho_scale, camera.sensor_fit, camera.sensor_width,
+            camera.sensor_height, camera.shift_x, camera.shift_y, camera.clip_start, camera.clip_end]
+
+
 def _object_fingerprint(obj):
     animation = _animation(obj)
     transform = None
     if animation is None:  # animated values depend on the frame last evaluated, the keyframes do not
         transform = [list(obj.location), list(obj.rotation_euler), list(obj.rotation_quaternion),
                      obj.rotation_mode, list(obj.scale)]
+    mesh = [len(obj.data.vertices), len(obj.data.polygons)] if obj.type == "MESH" else None
+    modifiers = [[m.name, m.type, m.show_render] for m in obj.modifiers]
     return [obj.name, obj.type, obj.data.name if obj.data else None, obj.hide_render,
-            obj.parent.name if obj.parent else None, transform, animation, _animation(obj.data)]
+            obj.parent.name if obj.parent else None, transform, animation, _animation(obj.data), mesh,
+            modifiers, [slot.material.name if slot.material else None for slot in obj.material_slots]]
 
 
 def effective_resolution(scene):
