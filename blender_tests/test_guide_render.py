@@ -119,7 +119,8 @@ def rendered(tmp_path_factory):
     report = render_guides(scene, FRAMES, tmp / "cache", PARAMS, progress=lambda *a: calls.append(a))
     yield {"scene": scene, "before": before, "blend": blend, "blend_bytes": blend_bytes,
            "cache": tmp / "cache", "window_scene": window_scene,
-           "temp_dirs_left": set(Path(tempfile.gettempdir()).glob("tempera-guides-*")) - temp_dirs, "report": report, "progress": calls}
+           "temp_dirs_left": set(Path(tempfile.gettempdir()).glob("tempera-guides-*")) - temp_dirs,
+           "report": report, "progress": calls}
     _remove_scene(scene)
 
 

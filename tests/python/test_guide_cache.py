@@ -112,3 +112,12 @@ def test_manifest_is_plain_json(tmp_path):
     guide_cache.write_manifest(tmp_path, {"params": guide_cache.DEFAULT_PARAMS, "frames": {}})
     data = json.loads((tmp_path / "manifest.json").read_text())
     assert data["params"]["occlusion_epsilon"] == 2.0
+
+
+def test_conversions_reject_wrong_shapes():
+    with pytest.raises(ValueError, match=r"Vector pass must be \(H, W, 4\)"):
+        guide_cache.velocities_from_vector_pass(np.zeros((4, 4, 2)))
+    with pytest.raises(ValueError, match="differ in size"):
+        guide_cache.line_guide(np.ones((4, 4)), np.zeros((4, 5, 3)))
+    with pytest.raises(ValueError, match="kind must be"):
+        guide_cache.mask_guide("XX", "a")

@@ -91,7 +91,8 @@ def shown_in_window(scene):
     """Makes `scene` the window's scene while rendering. Cycles computes the
     previous-frame half of the Vector pass (XY) only for the scene the window
     shows; for any other scene it is left all zeros (seen on Blender 3.4)."""
-    window = bpy.context.window
+    windows = bpy.context.window_manager.windows
+    window = bpy.context.window or (windows[0] if len(windows) else None)  # e.g. called from a timer
     if window is None or window.scene == scene:
         yield
         return
