@@ -1,0 +1,436 @@
+"""Rendering a scene's guides with Cycles into the guide cache (tempera.guide_cache).
+
+    render_guides(scene, frames, out_dir, params=None, progress=None)
+
+Per frame: one main render with the light-path, motion, depth, normal and
+object-index passes, and a second render with one diffuse and no glossy or
+transmission bounce for LD{1,2}E. The derived guides (velocities, occlusion,
+structure tensor, lines, masks) are computed with numpy and tempera.guides.
+
+Every setting changed for this (render, Cycles, passes, view layers, frame,
+objects' pass index) is put back exactly afterwards by GuideRenderSettings:
+the user's file is never left changed.
+"""
+import os
+import tempfile
+from contextlib import contextmanager
+from pathlib import Path
+
+import bpy
+import numpy as np
+
+from .. import guide_cache, guides, read_image
+from ..stylit_guides import tonemap
+
+
+class GuideRenderError(RuntimeError):
+    """A scene that cannot be rendered into guides; the message says what to change."""
+
+
+# Settings changed while rendering guides, restored in this order afterwards
+# (file_format before color_depth: the depths on offer depend on the format).
+RENDER_SETTINGS = ("engine", "film_transparent", "filepath", "use_file_extension", "use_compositing",
+                   "use_sequencer", "use_border")
+IMAGE_SETTINGS = ("file_format", "color_depth", "exr_codec", "color_mode", "use_preview")
+CYCLES_SETTINGS = ("device", "samples", "use_adaptive_sampling", "use_denoising", "sample_clamp_direct",
+                   "sample_clamp_indirect", "seed", "use_animated_seed", "max_bounces", "diffuse_bounces",
+                   "glossy_bounces", "transmission_bounces", "volume_bounces", "transparent_max_bounces",
+                   "caustics_reflective", "caustics_refractive")
+VIEW_LAYER_SETTINGS = ("use", "samples", "use_pass_combined", "use_pass_z", "use_pass_normal", "use_pass_vector",
+                       "use_pass_object_index", "use_pass_diffuse_direct", "use_pass_diffuse_indirect",
+                       "use_pass_diffuse_color", "use_pass_glossy_direct", "use_pass_glossy_color")
+
+# Passes of each render (Blender's EXR pass names and their components).
+MAIN_PASSES = {"Combined": "RGBA", "DiffDir": "RGB", "DiffInd": "RGB", "DiffCol": "RGB", "GlossDir": "RGB",
+               "GlossCol": "RGB", "Vector": "XYZW", "Depth": "Z", "Normal": "XYZ", "IndexOB": "X"}
+LD12E_PASSES = {"Combined": "RGBA", "DiffDir": "RGB", "DiffInd": "RGB", "DiffCol": "RGB"}
+MOTION_PASSES = {"Combined": "RGBA", "Vector": "XYZW"}
+PASS_PROPERTIES = {"Combined": "use_pass_combined", "DiffDir": "use_pass_diffuse_direct",
+                   "DiffInd": "use_pass_diffuse_indirect", "DiffCol": "use_pass_diffuse_color",
+                   "GlossDir": "use_pass_glossy_direct", "GlossCol": "use_pass_glossy_color",
+                   "Vector": "use_pass_vector", "Depth": "use_pass_z", "Normal": "use_pass_normal",
+                   "IndexOB": "use_pass_object_index"}
+RENDERABLE_TYPES = {"MESH", "CURVE", "SURFACE", "META", "FONT", "CURVES", "POINTCLOUD", "VOLUME"}
+
+
+# --------------------------------------------------------------------------- settings
+
+def _snapshot(struct, names):
+    return [(name, getattr(struct, name)) for name in names if hasattr(struct, name)]
+
+
+def _restore(struct, values):
+    for name, value in values:
+        if getattr(struct, name) != value:
+            setattr(struct, name, value)
+
+
+@contextmanager
+def guide_render_settings(scene):
+    """Snapshots every setting render_guides touches and restores it on exit,
+    whatever happens inside (errors, cancelling)."""
+    render = scene.render
+    saved = [
+        (render, _snapshot(render, RENDER_SETTINGS)),
+        (render.image_settings, _snapshot(render.image_settings, IMAGE_SETTINGS)),
+        (scene.cycles, _snapshot(scene.cycles, CYCLES_SETTINGS)),
+        *((layer, _snapshot(layer, VIEW_LAYER_SETTINGS)) for layer in scene.view_layers),
+        *((obj, _snapshot(obj, ("pass_index",))) for obj in scene.objects),
+    ]
+    frame, subframe = scene.frame_current, scene.frame_subframe
+    try:
+        yield
+    finally:
+        for struct, values in saved:
+            _restore(struct, values)
+        scene.frame_set(frame, subframe=subframe)
+
+
+@contextmanager
+def shown_in_window(scene):
+    """Makes `scene` the window's scene while rendering. Cycles computes the
+    previous-frame half of the Vector pass (XY) only for the scene the window
+    shows; for any other scene it is left all zeros (seen on Blender 3.4)."""
+    windows = bpy.context.window_manager.windows
+    window = bpy.context.window or (windows[0] if len(windows) else None)  # e.g. called from a timer
+    if window is None or window.scene == scene:
+        yield
+        return
+    saved_scene, saved_layer = window.scene, window.view_layer
+    window.scene = scene
+    try:
+        yield
+    finally:
+        window.scene = saved_scene
+        if window.view_layer != saved_layer:
+            window.view_layer = saved_layer
+
+
+def guide_view_layer(scene):
+    """The view layer guides come from: the first one that renders."""
+    for layer in scene.view_layers:
+        if layer.use:
+            return layer
+    raise GuideRenderError(f"Scene '{scene.name}' has no view layer enabled for rendering.")
+
+
+def check_scene(scene):
+    """Raises GuideRenderError if guides cannot be rendered from `scene`."""
+    if scene.render.use_motion_blur:
+        # With motion blur Cycles leaves the Vector pass all zeros, so there
+        # would be no motion guides; refuse instead of writing wrong ones.
+        raise GuideRenderError(
+            f"Motion blur is on in scene '{scene.name}': Blender then renders no motion vectors, which the "
+            "guides need. Turn off Render Properties > Motion Blur and render the guides again.")
+    if scene.camera is None:
+        raise GuideRenderError(f"Scene '{scene.name}' has no active camera to render the guides from.")
+    guide_view_layer(scene)
+
+
+def _configure(scene, layer, samples, passes, seed):
+    """Cycles settings that keep passes usable as guides: no denoising (it
+    smears passes differently), no clamping (it biases indirect light), a fixed
+    seed, output as a 32-bit multilayer EXR with exactly `passes`."""
+    render, cycles = scene.render, scene.cycles
+    render.engine = "CYCLES"
+    render.film_transparent = True  # alpha guide; the background is then 0 in the light paths
+    render.use_file_extension = False
+    render.use_compositing = False  # the EXR holds the render passes, not a composite
+    render.use_sequencer = False
+    render.use_border = False  # guides cover the whole frame
+    settings = render.image_settings
+    settings.file_format = "OPEN_EXR_MULTILAYER"
+    settings.color_depth = "32"
+    settings.exr_codec = "ZIP"
+    cycles.device = "CPU"
+    cycles.samples = samples
+    cycles.use_adaptive_sampling = False
+    cycles.use_denoising = False
+    cycles.sample_clamp_direct = 0.0
+    cycles.sample_clamp_indirect = 0.0
+    cycles.seed = seed
+    cycles.use_animated_seed = False
+    cycles.caustics_reflective = False  # L.*DDE without caustic paths (the issue's definition)
+    cycles.caustics_refractive = False
+    for other in scene.view_layers:
+        other.use = other == layer
+    layer.samples = 0  # no per-layer override of the samples
+    for name, prop in PASS_PROPERTIES.items():
+        setattr(layer, prop, name in passes)
+
+
+def _render(scene, path, frame):
+    scene.frame_set(frame)
+    scene.render.filepath = str(path)
+    bpy.ops.render.render(write_still=True, scene=scene.name)
+    if not Path(path).is_file():
+        raise RuntimeError(f"Blender did not write {path}")
+    return path
+
+
+def _read_passes(path, layer_name, passes):
+    return {name: read_image(str(path), [f"{layer_name}.{name}.{c}" for c in comps])
+            for name, comps in passes.items()}
+
+
+# --------------------------------------------------------------------------- scene description
+
+def assign_pass_indices(scene, mode):
+    """Gives every renderable object a pass index 1..N (restored afterwards by
+    guide_render_settings) and returns {mask guide: (kind, name, [indices])}."""
+    objects = sorted((o for o in scene.objects if o.type in RENDERABLE_TYPES), key=lambda o: o.name)
+    index = {}
+    for i, obj in enumerate(objects, start=1):
+        obj.pass_index = i
+        index[obj.name] = i
+    masks = {}
+    if mode in ("objects", "objects+collections"):
+        for obj in objects:
+            masks[guide_cache.mask_guide("OB", obj.name)] = ("object", obj.name, [index[obj.name]])
+    if mode in ("collections", "objects+collections"):
+        for coll in scene.collection.children_recursive:
+            members = sorted(index[o.name] for o in coll.all_objects if o.name in index)
+            masks[guide_cache.mask_guide("CO", coll.name)] = ("collection", coll.name, members)
+    return masks
+
+
+def scene_fingerprint(scene, frame):
+    """What the guides of `frame` depend on besides the parameters: the saved
+    file (path, modification time), camera and lens, resolution, bounces,
+    film, and every object with its transform or, if animated, its
+    keyframes, mesh size, modifiers and materials.
+
+    Taken from the original data, not evaluated at `frame`: evaluated
+    transforms of a scene are not reliable outside the active depsgraph (seen
+    stale after a render on Blender 3.4). Drivers, constraints and unsaved
+    edits inside materials, node trees or meshes are not seen: save the file to have them
+    picked up (its modification time is part of the fingerprint)."""
+    render = scene.render
+    source = None
+    if bpy.data.filepath and os.path.isfile(bpy.data.filepath):
+        source = [bpy.data.filepath, os.stat(bpy.data.filepath).st_mtime_ns]
+    return {
+        "blender": bpy.app.version_string, "source": source, "scene": scene.name, "frame": frame,
+        "camera": scene.camera.name, "resolution": effective_resolution(scene),
+        "view_layer": guide_view_layer(scene).name, "world": scene.world.name if scene.world else None,
+        "bounces": [scene.cycles.max_bounces, scene.cycles.diffuse_bounces, scene.cycles.glossy_bounces,
+                    scene.cycles.transmission_bounces],
+        "pixel_aspect": [render.pixel_aspect_x, render.pixel_aspect_y],
+        "film": [scene.cycles.film_exposure, scene.cycles.pixel_filter_type, scene.cycles.filter_width],
+        "camera_data": _camera_fingerprint(scene.camera.data),
+        "objects": [_object_fingerprint(o) for o in sorted(scene.objects, key=lambda o: o.name)],
+    }
+
+
+def _animation(id_block):
+    """Keyframes of an ID's action as a list (None if it is not animated)."""
+    anim = getattr(id_block, "animation_data", None)
+    if anim is None or anim.action is None:
+        return None
+    return [[fc.data_path, fc.array_index, fc.extrapolation,
+             [[*k.co, *k.handle_left, *k.handle_right, k.interpolation] for k in fc.keyframe_points]]
+            for fc in anim.action.fcurves]
+
+
+def _camera_fingerprint(camera):
+    return [camera.type, camera.lens, camera.ortho_scale, camera.sensor_fit, camera.sensor_width,
+            camera.sensor_height, camera.shift_x, camera.shift_y, camera.clip_start, camera.clip_end]
+
+
+def _object_fingerprint(obj):
+    animation = _animation(obj)
+    transform = None
+    if animation is None:  # animated values depend on the frame last evaluated, the keyframes do not
+        transform = [list(obj.location), list(obj.rotation_euler), list(obj.rotation_quaternion),
+                     obj.rotation_mode, list(obj.scale)]
+    mesh = [len(obj.data.vertices), len(obj.data.polygons)] if obj.type == "MESH" else None
+    modifiers = [[m.name, m.type, m.show_render] for m in obj.modifiers]
+    return [obj.name, obj.type, obj.data.name if obj.data else None, obj.hide_render,
+            obj.parent.name if obj.parent else None, transform, animation, _animation(obj.data), mesh,
+            modifiers, [slot.material.name if slot.material else None for slot in obj.material_slots]]
+
+
+def effective_resolution(scene):
+    """(width, height) Blender renders: resolution times its percentage."""
+    r = scene.render
+    return [int(r.resolution_x * r.resolution_percentage / 100), int(r.resolution_y * r.resolution_percentage / 100)]
+
+
+# --------------------------------------------------------------------------- guides of one frame
+
+def light_path_guides(main, ld12e):
+    """Linear radiance guides from the passes of the two renders."""
+    rgb = {name: a[:, :, :3] for name, a in main.items()}
+    return {
+        "FULL": rgb["Combined"],
+        "LDE": rgb["DiffDir"] * rgb["DiffCol"],
+        "LSE": rgb["GlossDir"] * rgb["GlossCol"],
+        "LDDE": rgb["DiffInd"] * rgb["DiffCol"],
+        "LD12E": (ld12e["DiffDir"] + ld12e["DiffInd"]) * ld12e["DiffCol"],
+    }
+
+
+def frame_guides(main, ld12e, v_plus_prev, v_minus_next, masks, params):
+    """Every guide of one frame, as written to the cache."""
+    backward, forward = guide_cache.velocities_from_vector_pass(main["Vector"])
+    eps = params["occlusion_epsilon"]
+    lines = guide_cache.line_guide(main["Depth"], main["Normal"], params["line_depth_threshold"],
+                                   params["line_normal_angle"])
+    out = light_path_guides(main, ld12e)
+    out.update({
+        "velocity_forward": forward,
+        "velocity_backward": backward,
+        "occlusion_backward": guides.occlusion_backward(backward, v_plus_prev, eps),
+        "occlusion_forward": guides.occlusion_forward(forward, v_minus_next, eps),
+        # Of the tone-mapped render, as seen, so that dark areas have structure too.
+        "tensor": np.asarray(guides.structure_tensor(tonemap(out["FULL"]), params["tensor_sigma"])),
+        "alpha": main["Combined"][:, :, 3],
+        "depth": main["Depth"],
+        "normal": main["Normal"],
+        "lines": lines,
+        "line_distance": guides.line_distance(lines, params["line_d_max"]),
+    })
+    index = np.rint(main["IndexOB"][:, :, 0])
+    for guide, (_kind, _name, indices) in masks.items():
+        out[guide] = np.isin(index, indices).astype(np.float32)
+    return out
+
+
+# --------------------------------------------------------------------------- the whole run
+
+def render_guides(scene, frames, out_dir, params=None, progress=None):
+    """Renders the guides of `frames` of `scene` into the cache folder `out_dir`.
+
+    Frames whose cache is current (same parameters, same scene at that frame)
+    are skipped. `params` overrides tempera.guide_cache.DEFAULT_PARAMS.
+    `progress(done, total, message)` is called as frames complete.
+    Returns {"rendered": [frames], "skipped": [frames], "manifest": path}.
+    Raises GuideRenderError with an explanation if the scene cannot be used.
+    """
+    unknown = set(params or {}) - set(guide_cache.DEFAULT_PARAMS)
+    if unknown:
+        raise ValueError(f"unknown guide parameters {sorted(unknown)}; known: {sorted(guide_cache.DEFAULT_PARAMS)}")
+    params = {**guide_cache.DEFAULT_PARAMS, **(params or {})}
+    check_scene(scene)
+    frames = sorted({int(f) for f in frames})
+    if not frames:
+        raise ValueError("render_guides: no frames to render")
+    out_dir = Path(out_dir)
+    manifest = guide_cache.read_manifest(out_dir) or {}
+    if manifest.get("params") != params:
+        manifest = {}  # other parameters: no cached frame can be current
+    report = {"rendered": [], "skipped": [], "manifest": out_dir / guide_cache.MANIFEST_NAME}
+    with shown_in_window(scene), guide_render_settings(scene):
+        keys = {f: guide_cache.frame_key(params, scene_fingerprint(scene, f)) for f in frames}
+        todo = [f for f in frames if not guide_cache.is_frame_current(out_dir, manifest, f, keys[f])]
+        report["skipped"] = [f for f in frames if f not in todo]
+        if _forget_stale_frames(scene, manifest, out_dir, params) and not todo:
+            guide_cache.write_manifest(out_dir, manifest)
+        if todo:
+            with tempfile.TemporaryDirectory(prefix="tempera-guides-") as tmp:
+                _render_frames(scene, todo, keys, manifest, out_dir, Path(tmp), params, progress)
+        report["rendered"] = todo
+    return report
+
+
+def _forget_stale_frames(scene, manifest, out_dir, params):
+    """Drops the manifest entries of frames rendered from an older state of the
+    scene (the manifest lists only current frames). True if any was dropped."""
+    entries = manifest.get("frames", {})
+    stale = [f for f in entries if not guide_cache.is_frame_current(
+        out_dir, manifest, int(f), guide_cache.frame_key(params, scene_fingerprint(scene, int(f))))]
+    for f in stale:
+        del entries[f]
+    if stale and entries:
+        manifest["frame_range"] = [min(map(int, entries)), max(map(int, entries))]
+    return bool(stale)
+
+
+def _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress):
+    layer = guide_view_layer(scene)
+    masks = assign_pass_indices(scene, params["masks"])
+    total = len(todo)
+
+    def step(done, message):
+        if progress:
+            progress(done, total, message)
+
+    # 1. The renders of every frame to do, kept in `tmp` until all are done:
+    #    occlusion needs the velocities of the neighbouring frames.
+    renders = {}
+    for i, frame in enumerate(todo):
+        step(i, f"rendering frame {frame}")
+        _configure(scene, layer, params["samples"], MAIN_PASSES, params["seed"])
+        main = _render(scene, tmp / f"main_{frame}.exr", frame)
+        _configure(scene, layer, params["ld12e_samples"], LD12E_PASSES, params["seed"])
+        with _ld12e_bounces(scene):
+            ld12e = _render(scene, tmp / f"ld12e_{frame}.exr", frame)
+        renders[frame] = (main, ld12e)
+
+    def vector_pass(frame):
+        """Vector pass of a neighbouring frame: rendered now, in the cache, or
+        from a quick motion-only render (one sample: only its velocities are used)."""
+        if frame in renders:
+            return _read_passes(renders[frame][0], layer.name, {"Vector": "XYZW"})["Vector"]
+        if guide_cache.is_frame_current(out_dir, manifest, frame, keys.get(frame)):
+            cached = guide_cache.read_frame(out_dir, frame, ["velocity_backward", "velocity_forward"])
+            back, fwd = cached["velocity_backward"], cached["velocity_forward"]
+            return np.dstack([-back[:, :, 0], back[:, :, 1], -fwd[:, :, 0], fwd[:, :, 1]])  # inverse conversion
+        _configure(scene, layer, 1, MOTION_PASSES, params["seed"])
+        path = _render(scene, tmp / f"motion_{frame}.exr", frame)
+        return _read_passes(path, layer.name, MOTION_PASSES)["Vector"]
+
+    # 2. Derived guides, one cache EXR per frame, manifest after each.
+    frame_entries = manifest.get("frames", {})
+    for i, frame in enumerate(todo):
+        main = _read_passes(renders[frame][0], layer.name, MAIN_PASSES)
+        ld12e = _read_passes(renders[frame][1], layer.name, LD12E_PASSES)
+        _, v_plus_prev = guide_cache.velocities_from_vector_pass(vector_pass(frame - 1))
+        v_minus_next, _ = guide_cache.velocities_from_vector_pass(vector_pass(frame + 1))
+        frame_data = frame_guides(main, ld12e, v_plus_prev, v_minus_next, masks, params)
+        path = guide_cache.write_frame(out_dir, frame, frame_data)
+        frame_entries[str(frame)] = {"key": keys[frame], "file": path.name}
+        height, width = main["Combined"].shape[:2]
+        manifest = _manifest(scene, layer, params, frame_entries, list(frame_data), masks, (width, height))
+        guide_cache.write_manifest(out_dir, manifest)
+        step(i + 1, f"guides of frame {frame} written")
+
+
+@contextmanager
+def _ld12e_bounces(scene):
+    """Bounce limits that leave only light paths L D E and L D D E: one
+    diffuse bounce, no glossy or transmission; the user's limits come back
+    for the next main render."""
+    cycles = scene.cycles
+    saved = _snapshot(cycles, ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces",
+                               "volume_bounces"))
+    cycles.diffuse_bounces = 1
+    cycles.glossy_bounces = 0
+    cycles.transmission_bounces = 0
+    cycles.volume_bounces = 0
+    cycles.max_bounces = max(cycles.max_bounces, 1)
+    try:
+        yield
+    finally:
+        _restore(cycles, saved)
+
+
+def _manifest(scene, layer, params, frames, guide_names, masks, size):
+    render = scene.render
+    numbers = sorted(int(f) for f in frames)
+    return {
+        "scene": scene.name,
+        "camera": scene.camera.name,
+        "view_layer": layer.name,
+        "resolution": list(size),
+        "resolution_setting": [render.resolution_x, render.resolution_y, render.resolution_percentage],
+        "frame_range": [numbers[0], numbers[-1]],
+        "frames": frames,
+        "guides": guide_names,
+        "masks": {g: {"kind": kind, "name": name} for g, (kind, name, _) in masks.items()},
+        "blender_version": bpy.app.version_string,
+        "source_file": bpy.data.filepath or None,
+        "params": params,
+        "conventions": {"rows": "top-down", "x": "right", "y": "down", "velocity_unit": "pixels",
+                        "light_paths": "linear radiance, background 0 (transparent film)"},
+    }

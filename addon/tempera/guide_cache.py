@@ -1,0 +1,220 @@
+"""The guide cache: one multilayer EXR per frame plus a JSON manifest, with no bpy.
+
+Layout of a cache folder (documented in docs/guide_cache.md):
+
+    <cache>/manifest.json        what was rendered, how, and a key per frame
+    <cache>/frame_0001.exr       every guide of frame 1, one EXR channel per component
+    ...
+
+Channel names are "<guide>.<component>" (GUIDES below); masks are
+"mask.<OB_|CO_><name>.V". All values are float32 and linear (light-path
+guides are radiance, not tone-mapped: apply tempera.stylit_guides.tonemap).
+Images are rows top-down; x runs right and y down, velocities are in pixels
+with the conventions of tempera.guides.
+
+Also here, because they need only numpy: converting Blender's Vector pass to
+the two velocity fields, and the line guide from depth and normal
+discontinuities. The Blender side is tempera.blender.guide_render.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+MANIFEST_NAME = "manifest.json"
+FORMAT_VERSION = 1
+
+# guide name -> channel components, in the order they are written.
+GUIDES = {
+    "FULL": "RGB",  # Combined: full global illumination
+    "LDE": "RGB",  # DiffDir * DiffCol: direct diffuse
+    "LSE": "RGB",  # GlossDir * GlossCol: direct specular
+    "LDDE": "RGB",  # DiffInd * DiffCol, caustics off: L.*DDE, diffuse interreflection
+    "LD12E": "RGB",  # (DiffDir + DiffInd) * DiffCol of a render with 1 diffuse, 0 glossy bounces
+    "velocity_forward": "XY",  # V+: pixel p moves to p + V+ in the next frame
+    "velocity_backward": "XY",  # V-: pixel p came from p - V- in the previous frame
+    "occlusion_backward": "V",  # chi-: 1 visible in the previous frame, 0 disoccluded
+    "occlusion_forward": "V",  # chi+: 1 still visible in the next frame, 0 about to be occluded
+    "tensor": ("XX", "XY", "YY"),  # structure tensor of the grayscale render (interpolates)
+    "alpha": "A",  # coverage (film transparent)
+    "depth": "Z",  # Cycles Depth pass (distance to the camera; huge on the background)
+    "normal": "XYZ",  # world-space shading normal
+    "lines": "V",  # 1 on depth / normal discontinuities
+    "line_distance": "V",  # min(distance to lines, d_max) / d_max
+}
+
+# Defaults of the parameters that change the guides; they are part of each frame's key.
+DEFAULT_PARAMS = {
+    "samples": 16,  # Cycles samples of the main render
+    "ld12e_samples": 16,  # Cycles samples of the second (LD{1,2}E) render
+    "seed": 0,
+    "occlusion_epsilon": 2.0,  # squared pixels, Bénard 2013 §3.1
+    "tensor_sigma": 2.0,  # Gaussian of the structure tensor, pixels
+    "line_depth_threshold": 0.05,  # relative depth jump that makes a line
+    "line_normal_angle": 40.0,  # degrees between neighbouring normals that makes a line
+    "line_d_max": 10.0,  # bound of the line distance, pixels (Bénard 2013 §3.2)
+    "masks": "objects+collections",  # or "objects", "collections", "none"
+}
+
+
+def channel_names(guide):
+    """EXR channel names of one guide, e.g. ['velocity_forward.X', 'velocity_forward.Y']."""
+    if guide.startswith("mask."):
+        return [f"{guide}.V"]
+    try:
+        return [f"{guide}.{c}" for c in GUIDES[guide]]
+    except KeyError:
+        raise ValueError(f"unknown guide {guide!r}; known guides: {', '.join(GUIDES)} and mask.<name>") from None
+
+
+def mask_guide(kind, name):
+    """Guide name of an object ('OB') or collection ('CO') mask. Dots would
+    split the EXR layer name, so they become '_' (the manifest keeps the real name)."""
+    if kind not in ("OB", "CO"):
+        raise ValueError(f"mask kind must be 'OB' or 'CO', got {kind!r}")
+    return f"mask.{kind}_{name.replace('.', '_')}"
+
+
+def frame_path(cache_dir, frame):
+    return Path(cache_dir) / f"frame_{frame:04d}.exr"
+
+
+# --------------------------------------------------------------------------- manifest
+
+def frame_key(params, fingerprint):
+    """A hash of everything a frame's guides depend on: the parameters and a
+    description of the scene at that frame (any JSON-able value)."""
+    text = json.dumps({"format": FORMAT_VERSION, "params": params, "scene": fingerprint},
+                      sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def read_manifest(cache_dir):
+    """The manifest dict, or None if the folder has none (or an unreadable one,
+    which a rerun then overwrites)."""
+    try:
+        with open(Path(cache_dir) / MANIFEST_NAME, encoding="utf-8") as f:
+            manifest = json.load(f)
+    except (FileNotFoundError, json.JSONDecodeError):
+        return None
+    return manifest if manifest.get("format") == FORMAT_VERSION else None
+
+
+def write_manifest(cache_dir, manifest):
+    """Writes manifest.json atomically (temporary file, then rename)."""
+    cache_dir = Path(cache_dir)
+    cache_dir.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=".manifest.", suffix=".partial", dir=cache_dir)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            json.dump(dict(manifest, format=FORMAT_VERSION), f, indent=2, sort_keys=True)
+        os.replace(tmp, cache_dir / MANIFEST_NAME)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def is_frame_current(cache_dir, manifest, frame, key):
+    """True if the cache holds frame `frame` rendered with this key."""
+    if not manifest:
+        return False
+    entry = manifest.get("frames", {}).get(str(frame))
+    return bool(entry) and entry.get("key") == key and frame_path(cache_dir, frame).is_file()
+
+
+def read_frame(cache_dir, frame, guides=None):
+    """Guides of one cached frame as {name: float32 (H, W, C) array} (C = 1
+    for single-channel guides, which come back as (H, W)). `guides` defaults
+    to every guide listed in the manifest."""
+    from . import read_image
+
+    if guides is None:
+        manifest = read_manifest(cache_dir)
+        if manifest is None:
+            raise FileNotFoundError(f"no guide cache manifest in {cache_dir}")
+        guides = manifest["guides"]
+    path = str(frame_path(cache_dir, frame))
+    out = {}
+    for guide in guides:
+        array = read_image(path, channel_names(guide))
+        out[guide] = array[:, :, 0] if array.shape[2] == 1 else array
+    return out
+
+
+def write_frame(cache_dir, frame, guides):
+    """Writes {guide name: (H, W) or (H, W, C) array} as frame `frame`'s EXR,
+    atomically (tempera.write_image). Returns the path."""
+    from . import write_image
+
+    arrays, names = [], []
+    for guide, array in guides.items():
+        a = np.asarray(array, np.float32)
+        a = a[:, :, None] if a.ndim == 2 else a
+        expected = channel_names(guide)
+        if a.shape[2] != len(expected):
+            raise ValueError(f"guide {guide!r} has {a.shape[2]} channels, its layout has {len(expected)}")
+        arrays.append(a)
+        names += expected
+    path = frame_path(cache_dir, frame)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_image(str(path), np.ascontiguousarray(np.concatenate(arrays, axis=2)), names)
+    return path
+
+
+# --------------------------------------------------------------------------- conversions
+
+def velocities_from_vector_pass(vector):
+    """Blender's Vector pass (H, W, 4), rows top-down -> (velocity_backward,
+    velocity_forward), each (H, W, 2) in pixels, x right, y down.
+
+    Blender stores, with y up and p(f) the pixel position of the surface point
+    in frame f: XY = p(f-1) - p(f) and ZW = p(f) - p(f+1).
+    tempera.guides wants V-_t = p(t) - p(t-1) (the point came from p - V-) and
+    V+_t = p(t+1) - p(t) (it goes to p + V+), i.e. V- = -XY and V+ = -ZW with
+    y up. Turning y down negates the y components: V- = (-X, +Y), V+ = (-Z, +W).
+    """
+    v = np.asarray(vector, np.float32)
+    if v.ndim != 3 or v.shape[2] != 4:
+        raise ValueError(f"Vector pass must be (H, W, 4), got shape {v.shape}")
+    backward = np.stack([-v[:, :, 0], v[:, :, 1]], axis=2)
+    forward = np.stack([-v[:, :, 2], v[:, :, 3]], axis=2)
+    return backward, forward
+
+
+def line_guide(depth, normal, depth_threshold=0.05, normal_angle=40.0):
+    """1 on pixels at a depth or normal discontinuity, else 0 ((H, W) float32).
+
+    Between each pixel and its right and lower neighbour: a depth jump larger
+    than `depth_threshold` times the nearer depth (a silhouette or an
+    occluding contour; the background's huge depth counts as far away) marks
+    the nearer pixel, so lines lie on the occluding object; normals more than
+    `normal_angle` degrees apart (a crease) mark the upper / left pixel.
+    """
+    z = np.asarray(depth, np.float64)
+    z = z[:, :, 0] if z.ndim == 3 else z
+    n = np.asarray(normal, np.float64)[:, :, :3]
+    if z.shape != n.shape[:2]:
+        raise ValueError(f"depth {z.shape} and normal {n.shape[:2]} differ in size")
+    z = np.where(np.isfinite(z), z, 1e10)
+    norm = np.linalg.norm(n, axis=2, keepdims=True)
+    unit = np.divide(n, norm, out=np.zeros_like(n), where=norm > 1e-6)
+    has_normal = norm[:, :, 0] > 1e-6
+    cos_max = np.cos(np.radians(normal_angle))
+    lines = np.zeros(z.shape, bool)
+    for axis in (0, 1):  # neighbour below, neighbour to the right
+        a = [slice(None)] * 2
+        b = [slice(None)] * 2
+        a[axis], b[axis] = slice(None, -1), slice(1, None)
+        a, b = tuple(a), tuple(b)
+        za, zb = z[a], z[b]
+        jump = np.abs(za - zb) > depth_threshold * np.minimum(za, zb)
+        lines[a] |= jump & (za <= zb)
+        lines[b] |= jump & (zb < za)
+        crease = (np.sum(unit[a] * unit[b], axis=2) < cos_max) & has_normal[a] & has_normal[b] & ~jump
+        lines[a] |= crease
+    return lines.astype(np.float32)
