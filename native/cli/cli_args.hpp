@@ -45,5 +45,6 @@ class ArgReader {
 };
 
 int run_synth(const Args& args);
+int run_render_guides(const Args& args);
 
 }  // namespace tempera::cli

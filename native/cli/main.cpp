@@ -22,6 +22,8 @@ struct Command {
 const std::map<std::string, Command>& commands() {
   static const std::map<std::string, Command> table = {
       {"synth", {"guided patch synthesis of one image (StyLit / image analogies)", tempera::cli::run_synth}},
+      {"render-guides",
+       {"render a .blend scene's guide cache with background Blender", tempera::cli::run_render_guides}},
   };
   return table;
 }

@@ -1,0 +1,65 @@
+"""Inside background Blender for `tempera render-guides SCENE.blend ...`: renders
+the guide cache of the opened file's scene and exits non-zero with a clear
+message on any problem. The .blend on disk is never written.
+
+    blender -b --factory-startup SCENE.blend --python-exit-code 1 \\
+        --python-expr "...; from tempera.blender.render_guides_main import main; main()" \\
+        -- --frames 1-24 --out DIR [--scene NAME] [--samples N] ...
+"""
+import argparse
+import sys
+import time
+
+import bpy
+
+from .. import guide_cache
+from ..frames import parse_frames
+from .guide_render import GuideRenderError, render_guides
+
+# Command-line flags for the guide parameters (see guide_cache.DEFAULT_PARAMS).
+PARAM_FLAGS = {
+    "samples": ("--samples", int),
+    "ld12e_samples": ("--ld12e-samples", int),
+    "seed": ("--seed", int),
+    "occlusion_epsilon": ("--epsilon", float),
+    "tensor_sigma": ("--tensor-sigma", float),
+    "line_depth_threshold": ("--line-depth-threshold", float),
+    "line_normal_angle": ("--line-normal-angle", float),
+    "line_d_max": ("--d-max", float),
+    "masks": ("--masks", str),
+}
+
+
+def parse_args(argv):
+    parser = argparse.ArgumentParser(prog="tempera render-guides", description="Render a scene's guide cache.")
+    parser.add_argument("--frames", required=True, help="e.g. 1-24 or 1-10,15")
+    parser.add_argument("--out", required=True, help="guide cache folder")
+    parser.add_argument("--scene", help="scene name (default: the file's active scene)")
+    for key, (flag, kind) in PARAM_FLAGS.items():
+        parser.add_argument(flag, dest=key, type=kind, help=f"default {guide_cache.DEFAULT_PARAMS[key]}")
+    return parser.parse_args(argv)
+
+
+def main():
+    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    args = parse_args(argv)
+    try:
+        frames = parse_frames(args.frames)
+        scene = bpy.data.scenes.get(args.scene) if args.scene else bpy.context.scene
+        if scene is None:
+            names = ", ".join(s.name for s in bpy.data.scenes)
+            raise ValueError(f"no scene named {args.scene!r} in {bpy.data.filepath} (it has: {names})")
+        params = {key: getattr(args, key) for key in PARAM_FLAGS if getattr(args, key) is not None}
+        started = time.monotonic()
+
+        def progress(done, total, message):
+            elapsed = time.monotonic() - started
+            eta = elapsed / done * (total - done) if done else 0.0
+            print(f"tempera render-guides: {done}/{total} {message} (ETA {eta:.0f} s)", flush=True)
+
+        report = render_guides(scene, frames, args.out, params, progress)
+    except (GuideRenderError, ValueError, OSError) as exc:
+        print(f"tempera render-guides: error: {exc}", file=sys.stderr, flush=True)
+        sys.exit(1)
+    print(f"tempera render-guides: rendered {len(report['rendered'])} frame(s), "
+          f"{len(report['skipped'])} already current; manifest {report['manifest']}", flush=True)

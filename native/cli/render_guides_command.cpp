@@ -1,0 +1,109 @@
+// `tempera render-guides SCENE.blend --frames A-B --out DIR [...]`: renders a
+// scene's guide cache by running Blender in the background on the file (which
+// is opened, never written) with the add-on's guide renderer.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+
+#include "cli_args.hpp"
+#include "tempera/error.hpp"
+
+namespace fs = std::filesystem;
+
+namespace tempera::cli {
+namespace {
+
+const char* kRenderGuidesHelp =
+    "usage: tempera render-guides SCENE.blend --frames A-B --out DIR [options]\n"
+    "\n"
+    "Renders the guides of SCENE (light paths, velocities, occlusion, orientation, masks,\n"
+    "lines) with Cycles in background Blender into the guide cache DIR: one multilayer EXR\n"
+    "per frame plus manifest.json (docs/guide_cache.md). Frames already current are skipped.\n"
+    "The .blend file is only read; its own engine, resolution and settings are respected\n"
+    "(guides are rendered at the scene's effective resolution).\n"
+    "\n"
+    "options:\n"
+    "  --frames RANGE          frames to render, e.g. 1-24 or 1-10,15\n"
+    "  --out DIR               guide cache folder\n"
+    "  --scene NAME            scene in the file (default: its active scene)\n"
+    "  --samples N             Cycles samples of the main render (default 16)\n"
+    "  --ld12e-samples N       samples of the LD{1,2}E render (default 16)\n"
+    "  --seed N                Cycles seed (default 0)\n"
+    "  --epsilon E             occlusion tolerance, squared pixels (default 2)\n"
+    "  --tensor-sigma S        structure tensor smoothing, pixels (default 2)\n"
+    "  --line-depth-threshold T, --line-normal-angle DEG, --d-max D   line guide\n"
+    "  --masks MODE            objects+collections | objects | collections | none\n"
+    "  --blender PATH          Blender to run (default: $TEMPERA_BLENDER or 'blender')\n"
+    "  --addon-path DIR        folder holding the tempera package\n"
+    "                          (default: $TEMPERA_ADDON_PATH or this build's addon folder)\n";
+
+std::string env_or(const char* name, const std::string& fallback) {
+  const char* value = std::getenv(name);
+  return value && *value ? value : fallback;
+}
+
+// Runs argv, waits, and returns its exit status (128 + signal if killed).
+int run_process(const std::vector<std::string>& argv) {
+  std::vector<char*> raw;
+  for (const auto& a : argv) raw.push_back(const_cast<char*>(a.c_str()));
+  raw.push_back(nullptr);
+  const pid_t pid = fork();
+  if (pid < 0) throw IoError("cannot start Blender: fork failed");
+  if (pid == 0) {
+    execvp(raw[0], raw.data());
+    std::cerr << "tempera render-guides: error: cannot run '" << argv[0]
+              << "' (install Blender or pass --blender PATH)\n";
+    _exit(127);
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0) {
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+}  // namespace
+
+int run_render_guides(const Args& args) {
+  ArgReader in(args, "render-guides");
+  if (in.wants_help() || args.empty()) {
+    std::cout << kRenderGuidesHelp;
+    return args.empty() ? 2 : 0;
+  }
+  const std::string scene = args[0];
+  if (scene.rfind("--", 0) == 0) throw ValueError("the first argument must be the .blend file");
+  std::error_code ec;
+  if (!fs::is_regular_file(scene, ec)) throw FileNotFoundError(concat("scene file not found: '", scene, "'"));
+  std::string blender = env_or("TEMPERA_BLENDER", "blender");
+  std::string addon = env_or("TEMPERA_ADDON_PATH", fs::path(TEMPERA_PYTHON_PACKAGE_DIR).parent_path().string());
+  std::vector<std::string> forwarded;
+  bool has_frames = false, has_out = false;
+  for (std::size_t i = 1; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if ((a == "--blender" || a == "--addon-path") && i + 1 < args.size()) {
+      (a == "--blender" ? blender : addon) = args[++i];
+      continue;
+    }
+    has_frames |= a == "--frames";
+    has_out |= a == "--out";
+    forwarded.push_back(a);
+  }
+  if (!has_frames) throw ValueError("--frames is required (e.g. --frames 1-24)");
+  if (!has_out) throw ValueError("--out is required (the guide cache folder)");
+  if (!fs::is_directory(fs::path(addon) / "tempera", ec))
+    throw FileNotFoundError(concat("no tempera package in '", addon, "' (pass --addon-path)"));
+  // The package path travels as an argument, not inside the Python code, so
+  // no quoting of paths is ever needed.
+  const std::string bootstrap =
+      "import sys; sys.path.insert(0, sys.argv[sys.argv.index('--') + 1]); "
+      "del sys.argv[sys.argv.index('--') + 1]; "
+      "from tempera.blender.render_guides_main import main; main()";
+  std::vector<std::string> argv = {blender, "-b", "--factory-startup", scene, "--python-exit-code", "1",
+                                   "--python-expr", bootstrap, "--", addon};
+  argv.insert(argv.end(), forwarded.begin(), forwarded.end());
+  return run_process(argv);
+}
+
+}  // namespace tempera::cli

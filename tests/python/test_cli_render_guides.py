@@ -1,0 +1,80 @@
+"""`tempera render-guides`: the guide cache of a .blend made by somebody else,
+rendered by the CLI through background Blender, without touching the file."""
+import hashlib
+import os
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from tempera import guide_cache
+
+ROOT = Path(__file__).resolve().parents[2]
+BLENDER = os.environ.get("TEMPERA_BLENDER", "blender")
+
+# Builds the demo's animated scene, then makes it awkward the way users' files
+# are: saved with EEVEE as the engine, an odd resolution at 50 %, motion blur off.
+MAKE_BLEND = """
+import sys, bpy
+sys.path.insert(0, {scenes!r})
+import demo_scene
+scene = bpy.context.scene
+demo_scene.build_scene(scene)
+scene.render.engine = "BLENDER_EEVEE"
+scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = 97, 73, 50
+scene.frame_start, scene.frame_end = 1, 8
+bpy.ops.wm.save_as_mainfile(filepath={path!r})
+"""
+
+
+@pytest.fixture(scope="module")
+def user_blend(tmp_path_factory):
+    path = tmp_path_factory.mktemp("blend") / "someone_elses.blend"
+    code = MAKE_BLEND.format(scenes=str(ROOT / "scenes"), path=str(path))
+    result = subprocess.run([BLENDER, "-b", "--factory-startup", "--python-exit-code", "1", "--python-expr", code],
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0 and path.is_file(), result.stdout[-2000:] + result.stderr[-2000:]
+    return path
+
+
+def render_guides(cli_path, *args):
+    return subprocess.run([str(cli_path), "render-guides", *map(str, args)], capture_output=True, text=True,
+                          timeout=300, env=dict(os.environ, TEMPERA_BLENDER=BLENDER))
+
+
+def digest(path):
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def test_renders_the_cache_at_the_effective_resolution_and_leaves_the_file_alone(cli_path, user_blend, tmp_path):
+    before = digest(user_blend)
+    out = tmp_path / "cache"
+    result = render_guides(cli_path, user_blend, "--frames", "2-3", "--out", out, "--samples", "4",
+                           "--ld12e-samples", "4")
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    assert "rendered 2 frame(s)" in result.stdout
+    assert digest(user_blend) == before, "the .blend on disk was modified"
+    manifest = guide_cache.read_manifest(out)
+    assert manifest["resolution"] == [48, 36]  # 97x73 at 50 %
+    guides = guide_cache.read_frame(out, 2)
+    assert guides["FULL"].shape[:2] == (36, 48)
+    assert "velocity_forward" in guides and "occlusion_backward" in guides and "LD12E" in guides
+
+    again = render_guides(cli_path, user_blend, "--frames", "2-3", "--out", out, "--samples", "4",
+                          "--ld12e-samples", "4")
+    assert again.returncode == 0, again.stderr[-2000:]
+    assert "rendered 0 frame(s), 2 already current" in again.stdout
+
+
+def test_clear_errors(cli_path, user_blend, tmp_path):
+    cases = [
+        ((user_blend, "--out", tmp_path), "--frames is required"),
+        ((user_blend, "--frames", "1-2"), "--out is required"),
+        ((tmp_path / "missing.blend", "--frames", "1", "--out", tmp_path), "scene file not found"),
+        ((user_blend, "--frames", "3-1", "--out", tmp_path), "ends before it starts"),
+        ((user_blend, "--frames", "1", "--out", tmp_path, "--scene", "Nope"), "no scene named 'Nope'"),
+    ]
+    for args, message in cases:
+        result = render_guides(cli_path, *args)
+        assert result.returncode != 0, args
+        assert message in result.stderr, (args, result.stderr[-1500:])
