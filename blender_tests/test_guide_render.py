@@ -332,3 +332,29 @@ def test_frame_key_follows_the_scene(rendered):
     assert scene_fingerprint(scene, 3) != first
     backdrop.location.y -= 1
     assert scene_fingerprint(scene, 3) == first
+
+
+def test_freestyle_lines_join_the_line_guide(rendered, tmp_path):
+    """With Freestyle on, the artist's lines are part of the line guide. The
+    depth and normal thresholds are set out of reach so only Freestyle draws."""
+    from tempera import guide_cache
+    from tempera.blender.guide_render import render_guides
+
+    scene = rendered["scene"]
+    no_breaks = {"samples": 2, "ld12e_samples": 2, "masks": "none", "line_depth_threshold": 1e9,
+                 "line_normal_angle": 180.0}
+    render_guides(scene, (3,), tmp_path / "plain", no_breaks)
+    settings = scene.view_layers[0].freestyle_settings
+    lineset = settings.linesets.new("Outline")  # silhouettes, borders and creases by default
+    scene.render.use_freestyle = True
+    try:
+        render_guides(scene, (3,), tmp_path / "freestyle", no_breaks)
+        assert not settings.as_render_pass  # restored
+    finally:
+        scene.render.use_freestyle = False
+        settings.linesets.remove(lineset)
+    plain = guide_cache.read_frame(tmp_path / "plain", 3, ["lines", "FULL"])
+    drawn = guide_cache.read_frame(tmp_path / "freestyle", 3, ["lines", "FULL"])
+    assert plain["lines"].sum() == 0
+    assert drawn["lines"].sum() >= 20  # the cube's outline
+    assert np.allclose(plain["FULL"], drawn["FULL"], atol=1e-4)  # lines kept out of the light paths

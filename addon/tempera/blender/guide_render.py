@@ -75,6 +75,8 @@ def guide_render_settings(scene):
         (render.image_settings, _snapshot(render.image_settings, IMAGE_SETTINGS)),
         (scene.cycles, _snapshot(scene.cycles, CYCLES_SETTINGS)),
         *((layer, _snapshot(layer, VIEW_LAYER_SETTINGS)) for layer in scene.view_layers),
+        *((layer.freestyle_settings, _snapshot(layer.freestyle_settings, ("as_render_pass",)))
+          for layer in scene.view_layers),
         *((obj, _snapshot(obj, ("pass_index",))) for obj in scene.objects),
     ]
     frame, subframe = scene.frame_current, scene.frame_subframe
@@ -157,6 +159,9 @@ def _configure(scene, layer, samples, passes, seed):
     layer.samples = 0  # no per-layer override of the samples
     for name, prop in PASS_PROPERTIES.items():
         setattr(layer, prop, name in passes)
+    # The user's Freestyle lines (if they draw any) go to their own pass, so
+    # the light-path guides stay line-free and the lines join the line guide.
+    layer.freestyle_settings.as_render_pass = "Freestyle" in passes
 
 
 def _render(scene, path, frame):
@@ -276,6 +281,8 @@ def frame_guides(main, ld12e, v_plus_prev, v_minus_next, masks, params):
     eps = params["occlusion_epsilon"]
     lines = guide_cache.line_guide(main["Depth"], main["Normal"], params["line_depth_threshold"],
                                    params["line_normal_angle"])
+    if "Freestyle" in main:  # the artist's own Freestyle lines count too
+        lines = np.maximum(lines, (main["Freestyle"][:, :, 3] > 0.5).astype(np.float32))
     out = light_path_guides(main, ld12e)
     out.update({
         "velocity_forward": forward,
@@ -346,9 +353,18 @@ def _forget_stale_frames(scene, manifest, out_dir, params):
     return bool(stale)
 
 
+def uses_freestyle(scene, layer):
+    """Whether the user draws Freestyle lines on this layer (Blender writes no
+    Freestyle pass when no line set renders)."""
+    settings = layer.freestyle_settings
+    drawing = settings.mode != "EDITOR" or any(lineset.show_render for lineset in settings.linesets)
+    return scene.render.use_freestyle and layer.use_freestyle and drawing
+
+
 def _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress):
     layer = guide_view_layer(scene)
     masks = assign_pass_indices(scene, params["masks"])
+    main_passes = {**MAIN_PASSES, "Freestyle": "RGBA"} if uses_freestyle(scene, layer) else MAIN_PASSES
     total = len(todo)
 
     def step(done, message):
@@ -360,7 +376,7 @@ def _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress):
     renders = {}
     for i, frame in enumerate(todo):
         step(i, f"rendering frame {frame}")
-        _configure(scene, layer, params["samples"], MAIN_PASSES, params["seed"])
+        _configure(scene, layer, params["samples"], main_passes, params["seed"])
         main = _render(scene, tmp / f"main_{frame}.exr", frame)
         _configure(scene, layer, params["ld12e_samples"], LD12E_PASSES, params["seed"])
         with _ld12e_bounces(scene):
@@ -383,7 +399,7 @@ def _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress):
     # 2. Derived guides, one cache EXR per frame, manifest after each.
     frame_entries = manifest.get("frames", {})
     for i, frame in enumerate(todo):
-        main = _read_passes(renders[frame][0], layer.name, MAIN_PASSES)
+        main = _read_passes(renders[frame][0], layer.name, main_passes)
         ld12e = _read_passes(renders[frame][1], layer.name, LD12E_PASSES)
         _, v_plus_prev = guide_cache.velocities_from_vector_pass(vector_pass(frame - 1))
         v_minus_next, _ = guide_cache.velocities_from_vector_pass(vector_pass(frame + 1))
