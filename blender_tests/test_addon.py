@@ -9,7 +9,7 @@ import pytest
 import tempera
 from conftest import ADDON, disable, enable, is_enabled, registered_tempera_classes
 
-EXPECTED_CLASSES = ["TEMPERA_PT_output", "TemperaPreferences", "TemperaSettings"]
+EXPECTED_CLASSES = ["TEMPERA_OT_render_guides", "TEMPERA_PT_output", "TemperaPreferences", "TemperaSettings"]
 
 
 def test_addon_is_enabled_from_the_installed_zip():
@@ -135,6 +135,11 @@ class _Recorder:
     def label(self, text="", **kwargs):
         self.calls.append(("label", text))
 
+    def operator(self, idname, **kwargs):
+        category, _, name = idname.partition(".")
+        getattr(getattr(bpy.ops, category), name).get_rna_type()  # KeyError if not registered
+        self.calls.append(("operator", idname))
+
     def _sub(self, *args, **kwargs):
         return _Recorder(self.calls)
 
@@ -147,8 +152,11 @@ def test_output_panel_draws_version_and_settings():
     bpy.types.TEMPERA_PT_output.draw(fake, bpy.context)
     props = [name for kind, name in calls if kind == "prop"]
     labels = [text for kind, text in calls if kind == "label"]
-    assert props == ["output_dir", "patch_size", "seed"]
+    assert props == ["output_dir", "patch_size", "seed", "guide_dir", "guide_frame_range", "guide_samples",
+                     "guide_occlusion_epsilon", "guide_line_d_max", "guide_masks"]
     assert f"Version {tempera.__version__}" in labels
+    assert "Guides" in labels
+    assert ("operator", "tempera.render_guides") in calls
 
 
 def test_preferences_draw_reports_the_cli(tmp_path):

@@ -7,6 +7,7 @@ and come back when the add-on is enabled again).
 """
 import bpy
 
+from .guide_operator import TEMPERA_OT_render_guides
 from .panels import TEMPERA_PT_output
 from .preferences import TemperaPreferences
 from .properties import TemperaSettings
@@ -15,11 +16,13 @@ from .properties import TemperaSettings
 CLASSES = (
     TemperaPreferences,
     TemperaSettings,
+    TEMPERA_OT_render_guides,
     TEMPERA_PT_output,
 )
 
 
 def register():
+    TEMPERA_OT_render_guides._running = False  # a run cut short by disabling the add-on is over
     registered = []
     try:
         for cls in CLASSES:

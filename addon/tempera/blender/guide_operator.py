@@ -1,0 +1,339 @@
+"""Render Guides: the operator behind the Guides box of the Output panel.
+
+    bpy.ops.tempera.render_guides()
+
+renders the guide cache (tempera.guide_cache) of the scene's frames as set in
+Scene.tempera (folder, frame range, parameters). In the UI it is modal: a
+window-manager timer renders one frame per step, with a progress cursor and
+"Tempera: guides frame i/N, ETA ..." in the status bar; Esc stops after the
+frame being rendered (finished frames stay in the cache). In background mode
+(blender -b), where timers do not run, execute() renders every frame in one
+go. Both go through GuideJob.step(), which renders one frame with
+render_guide_frame(); frames already current in the cache are skipped by
+render_guides itself.
+"""
+import functools
+import json
+import os
+import time
+import traceback
+
+import bpy
+from bpy.types import Operator
+
+from .. import guide_cache
+from .guide_render import GuideRenderError, check_scene, render_guides, scene_fingerprint
+from .properties import GUIDE_MASK_MODES
+
+TIMER_STEP = 0.1  # seconds between the end of a frame and the start of the next (redraws, Esc)
+
+
+# --------------------------------------------------------------------------- settings -> job
+
+def guide_params(settings):
+    """The render_guides parameters of Scene.tempera: DEFAULT_PARAMS with the
+    settings the panel shows (one Samples for both renders)."""
+    return {
+        **guide_cache.DEFAULT_PARAMS,
+        "samples": settings.guide_samples,
+        "ld12e_samples": settings.guide_samples,
+        "occlusion_epsilon": float(settings.guide_occlusion_epsilon),
+        "line_d_max": float(settings.guide_line_d_max),
+        "masks": GUIDE_MASK_MODES[settings.guide_masks],
+    }
+
+
+def guide_frames(scene, settings):
+    """The frames to render, in order, for the Frames setting."""
+    mode = settings.guide_frame_range
+    if mode == "CURRENT":
+        return [scene.frame_current]
+    if mode == "SCENE":
+        first, last = scene.frame_start, scene.frame_end
+    else:
+        first, last = settings.guide_frame_start, settings.guide_frame_end
+    if last < first:
+        raise ValueError(f"The guide frame range {first}-{last} is empty: End is before Start.")
+    return list(range(first, last + 1))
+
+
+def resolve_guide_dir(path_setting, blend_filepath=None):
+    """Absolute guide folder of the Guide Folder setting. '//' is relative to
+    the .blend file; an unsaved file has none, so that is refused."""
+    blend_filepath = bpy.data.filepath if blend_filepath is None else blend_filepath
+    path = path_setting.strip()
+    if not path:
+        raise ValueError("Set a Guide Folder in Output Properties > Tempera > Guides.")
+    if path.startswith("//"):
+        if not blend_filepath:
+            raise ValueError(f"Save the .blend file first: the Guide Folder '{path_setting}' is relative to it "
+                             "('//'). Or choose an absolute folder.")
+        path = bpy.path.abspath(path, start=os.path.dirname(blend_filepath))
+    return os.path.normpath(path)
+
+
+def render_guide_frame(scene, frame, folder, params, progress=None):
+    """Renders (or skips, if current) the guides of one frame: the single
+    step of both the modal and the background run."""
+    return render_guides(scene, [frame], folder, params, progress)
+
+
+def format_duration(seconds):
+    seconds = int(round(seconds))
+    hours, rest = divmod(seconds, 3600)
+    minutes, secs = divmod(rest, 60)
+    return f"{hours}:{minutes:02d}:{secs:02d}" if hours else f"{minutes}:{secs:02d}"
+
+
+class GuideJob:
+    """The frames of one Render Guides run, rendered one step at a time."""
+
+    def __init__(self, scene, frames, folder, params):
+        self.scene_name = scene.name
+        self.frames = list(frames)
+        self.folder = folder
+        self.params = params
+        self.index = 0  # frames done (rendered or skipped)
+        self.rendered, self.skipped = [], []
+        self.render_seconds = 0.0  # time spent on rendered frames (skipped ones take none)
+
+    @classmethod
+    def from_settings(cls, scene):
+        """The job Scene.tempera describes. Raises ValueError or
+        GuideRenderError (with what to change) before anything is rendered."""
+        settings = scene.tempera
+        folder = resolve_guide_dir(settings.guide_dir)
+        frames = guide_frames(scene, settings)
+        check_scene(scene)
+        return cls(scene, frames, folder, guide_params(settings))
+
+    @property
+    def total(self):
+        return len(self.frames)
+
+    @property
+    def finished(self):
+        return self.index >= self.total
+
+    def scene(self):
+        scene = bpy.data.scenes.get(self.scene_name)
+        if scene is None:
+            raise GuideRenderError(f"Scene '{self.scene_name}' no longer exists.")
+        return scene
+
+    def step(self, progress=None):
+        """Renders the next frame; `progress(fraction)` follows it within the frame."""
+        frame = self.frames[self.index]
+
+        def frame_progress(done, total, _message):
+            if progress:
+                progress(done / max(total, 1))
+
+        start = time.monotonic()
+        report = render_guide_frame(self.scene(), frame, self.folder, self.params, frame_progress)
+        if report["rendered"]:
+            self.rendered.append(frame)
+            self.render_seconds += time.monotonic() - start
+        else:
+            self.skipped.append(frame)
+        self.index += 1
+        return report
+
+    def eta_seconds(self):
+        """Time left if the remaining frames take as long as the rendered ones (None: no estimate yet)."""
+        if not self.rendered:
+            return None
+        return self.render_seconds / len(self.rendered) * (self.total - self.index)
+
+    def status_text(self):
+        eta = self.eta_seconds()
+        eta_text = "…" if eta is None else format_duration(eta)
+        current = min(self.index + 1, self.total)
+        return f"Tempera: guides frame {current}/{self.total}, ETA {eta_text} (Esc to stop)"
+
+    def summary(self):
+        parts = [f"{len(self.rendered)} rendered"]
+        if self.skipped:
+            parts.append(f"{len(self.skipped)} already current")
+        left = self.total - self.index
+        if left:
+            parts.append(f"{left} not done")
+        return f"Tempera guides: {', '.join(parts)} in {self.folder}"
+
+
+# --------------------------------------------------------------------------- panel status
+
+@functools.lru_cache(maxsize=16)
+def _current_frames(folder, manifest_mtime_ns, params_json, fingerprint_json, frames):
+    manifest = guide_cache.read_manifest(folder)
+    if not manifest:
+        return 0
+    params = json.loads(params_json)
+    fingerprint = json.loads(fingerprint_json)
+    current = 0
+    for frame in frames:
+        fingerprint["frame"] = frame
+        if guide_cache.is_frame_current(folder, manifest, frame, guide_cache.frame_key(params, fingerprint)):
+            current += 1
+    return current
+
+
+def cache_status(scene):
+    """(text, icon) for the panel: how many frames of the range are in the
+    cache and current. Reads the manifest only (cached per manifest version
+    and scene state); never renders."""
+    settings = scene.tempera
+    try:
+        folder = resolve_guide_dir(settings.guide_dir)
+        frames = guide_frames(scene, settings)
+        check_scene(scene)
+    except (ValueError, GuideRenderError) as exc:
+        return str(exc), "ERROR"
+    try:
+        mtime = os.stat(os.path.join(folder, guide_cache.MANIFEST_NAME)).st_mtime_ns
+    except OSError:
+        return f"No guides cached yet ({len(frames)} frames to render)", "INFO"
+    # A frame's fingerprint differs from the first one's only by its number
+    # (checked by blender_tests/test_operator.py), so it is taken once.
+    fingerprint = json.dumps(scene_fingerprint(scene, frames[0]), sort_keys=True, default=str)
+    params = json.dumps(guide_params(settings), sort_keys=True)
+    current = _current_frames(folder, mtime, params, fingerprint, tuple(frames))
+    icon = "CHECKMARK" if current == len(frames) else "INFO"
+    return f"{current}/{len(frames)} frames cached and current", icon
+
+
+# --------------------------------------------------------------------------- operator
+
+class TEMPERA_OT_render_guides(Operator):
+    """Render the guide passes of the frames set in the Guides box into the guide cache
+    (frames already cached and current are skipped; Esc stops after the current frame)"""
+
+    bl_idname = "tempera.render_guides"
+    bl_label = "Render Guides"
+    bl_options = {"REGISTER"}
+
+    _running = False  # one run at a time: the button is greyed out meanwhile
+
+    @classmethod
+    def poll(cls, context):
+        if cls._running:
+            cls.poll_message_set("Tempera is already rendering guides")
+            return False
+        return context.scene is not None and hasattr(context.scene, "tempera")
+
+    # -- shared
+
+    def _job(self, context):
+        try:
+            return GuideJob.from_settings(context.scene)
+        except (ValueError, GuideRenderError) as exc:
+            self.report({"ERROR"}, str(exc))
+            return None
+
+    def _step(self, job, progress=None):
+        """One frame; True if it went well, else the error is reported."""
+        try:
+            job.step(progress)
+            return True
+        except (ValueError, GuideRenderError) as exc:
+            message = str(exc)
+        except Exception as exc:  # e.g. disk full: a message for the artist, the details on the console
+            traceback.print_exc()
+            message = f"{type(exc).__name__}: {exc}"
+        frame = job.frames[job.index]
+        self.report({"ERROR"}, f"Guides of frame {frame} failed: {message}")
+        return False
+
+    # -- background / scripts: every frame now
+
+    def execute(self, context):
+        job = self._job(context)
+        if job is None:
+            return {"CANCELLED"}
+        wm = context.window_manager
+        type(self)._running = True
+        wm.progress_begin(0, job.total)
+        try:
+            while not job.finished:
+                if bpy.app.background:
+                    print(job.status_text().replace(" (Esc to stop)", ""), flush=True)
+                done = job.index
+                if not self._step(job, lambda f: wm.progress_update(done + f)):
+                    return {"CANCELLED"}
+                wm.progress_update(job.index)
+        finally:
+            wm.progress_end()
+            type(self)._running = False
+        self.report({"INFO"}, job.summary())
+        return {"FINISHED"}
+
+    # -- UI: one frame per timer step
+
+    def invoke(self, context, event):
+        if bpy.app.background or context.window is None:
+            return self.execute(context)
+        self._guide_job = job = self._job(context)
+        if job is None:
+            return {"CANCELLED"}
+        wm = context.window_manager
+        type(self)._running = True
+        self._timer = wm.event_timer_add(TIMER_STEP, window=context.window)
+        wm.modal_handler_add(self)
+        wm.progress_begin(0, job.total)
+        self._show(context, job)
+        return {"RUNNING_MODAL"}
+
+    def modal(self, context, event):
+        job = self._guide_job
+        if event.type == "ESC" and event.value == "PRESS":
+            self._finish(context)
+            self.report({"WARNING"}, f"Stopped. {job.summary()}")
+            return {"CANCELLED"}
+        if event.type != "TIMER":
+            return {"PASS_THROUGH"}
+        wm = context.window_manager
+        # A fresh timer after each (long) frame: the window redraws and Esc is
+        # seen before the next frame starts.
+        wm.event_timer_remove(self._timer)
+        self._timer = None
+        done = job.index
+        ok = self._step(job, lambda f: wm.progress_update(done + f))
+        if not ok:
+            self._finish(context)
+            return {"CANCELLED"}
+        if job.finished:
+            self._finish(context)
+            self.report({"INFO"}, job.summary())
+            return {"FINISHED"}
+        wm.progress_update(job.index)
+        self._show(context, job)
+        self._timer = wm.event_timer_add(TIMER_STEP, window=context.window)
+        return {"PASS_THROUGH"}
+
+    def cancel(self, context):
+        """Blender ends the operator (a file is loaded, the window closes)."""
+        self._finish(context)
+
+    def _show(self, context, job):
+        if context.workspace is not None:
+            context.workspace.status_text_set(job.status_text())
+        _redraw_properties(context)
+
+    def _finish(self, context):
+        wm = context.window_manager
+        if getattr(self, "_timer", None) is not None:
+            wm.event_timer_remove(self._timer)
+            self._timer = None
+        wm.progress_end()
+        if context.workspace is not None:
+            context.workspace.status_text_set(None)
+        _redraw_properties(context)
+        type(self)._running = False
+
+
+def _redraw_properties(context):
+    """The panel's cache line follows the frames as they are written."""
+    screen = context.screen
+    for area in screen.areas if screen else ():
+        if area.type == "PROPERTIES":
+            area.tag_redraw()
