@@ -274,6 +274,19 @@ def test_frame_key_follows_the_scene(rendered):
     assert scene_fingerprint(scene, 3) != first
     backdrop.location.y -= 1
     assert scene_fingerprint(scene, 3) == first
+    # Shading and lighting edits count; saving the file does not.
+    material = backdrop.material_slots[0].material
+    material.use_nodes = True
+    with_nodes = scene_fingerprint(scene, 3)
+    material.node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = (0.1, 0.9, 0.1, 1)
+    assert scene_fingerprint(scene, 3) != with_nodes
+    material.use_nodes = False
+    assert scene_fingerprint(scene, 3) == first
+    sun = scene.objects["Sun"].data
+    sun.energy *= 2
+    assert scene_fingerprint(scene, 3) != first
+    sun.energy /= 2
+    assert scene_fingerprint(scene, 3) == first
 
 
 def test_freestyle_lines_join_the_line_guide(rendered, tmp_path):

@@ -11,7 +11,6 @@ Every setting changed for this (render, Cycles, passes, view layers, frame,
 objects' pass index) is put back exactly afterwards by GuideRenderSettings:
 the user's file is never left changed.
 """
-import os
 import tempfile
 from contextlib import contextmanager
 from pathlib import Path
@@ -200,24 +199,22 @@ def assign_pass_indices(scene, mode):
 
 
 def scene_fingerprint(scene, frame):
-    """What the guides of `frame` depend on besides the parameters: the saved
-    file (path, modification time), camera and lens, resolution, bounces,
-    film, and every object with its transform or, if animated, its
-    keyframes, mesh size, modifiers and materials.
+    """What the guides of `frame` depend on besides the parameters: camera and
+    lens, resolution, bounces, film, the world, and every object with its
+    transform or, if animated, its keyframes, mesh size, modifiers, materials
+    (their node values and links) and light settings.
 
     Taken from the original data, not evaluated at `frame`: evaluated
     transforms of a scene are not reliable outside the active depsgraph (seen
-    stale after a render on Blender 3.4). Drivers, constraints and unsaved
-    edits inside materials, node trees or meshes are not seen: save the file to have them
-    picked up (its modification time is part of the fingerprint)."""
+    stale after a render on Blender 3.4). The file itself is not part of it,
+    so saving, or copying the .blend to a render farm, keeps the cache current.
+    Not seen: drivers, constraints, and mesh edits that keep the vertex and
+    face counts (delete the cache folder to re-render after those)."""
     render = scene.render
-    source = None
-    if bpy.data.filepath and os.path.isfile(bpy.data.filepath):
-        source = [bpy.data.filepath, os.stat(bpy.data.filepath).st_mtime_ns]
     return {
-        "blender": bpy.app.version_string, "source": source, "scene": scene.name, "frame": frame,
+        "blender": bpy.app.version_string, "scene": scene.name, "frame": frame,
         "camera": scene.camera.name, "resolution": effective_resolution(scene),
-        "view_layer": guide_view_layer(scene).name, "world": scene.world.name if scene.world else None,
+        "view_layer": guide_view_layer(scene).name, "world": _world_fingerprint(scene.world),
         "bounces": [scene.cycles.max_bounces, scene.cycles.diffuse_bounces, scene.cycles.glossy_bounces,
                     scene.cycles.transmission_bounces],
         "pixel_aspect": [render.pixel_aspect_x, render.pixel_aspect_y],
@@ -225,6 +222,49 @@ def scene_fingerprint(scene, frame):
         "camera_data": _camera_fingerprint(scene.camera.data),
         "objects": [_object_fingerprint(o) for o in sorted(scene.objects, key=lambda o: o.name)],
     }
+
+
+def _socket_value(socket):
+    """An unlinked input's value in JSON terms (numbers, lists, names)."""
+    value = getattr(socket, "default_value", None)
+    if value is None or isinstance(value, (bool, int, float, str)):
+        return value
+    if hasattr(value, "name"):  # an ID such as an object or image
+        return value.name
+    try:
+        return [float(v) for v in value]
+    except (TypeError, ValueError):
+        return str(value)
+
+
+def _node_tree_fingerprint(tree):
+    if tree is None:
+        return None
+    nodes = [[n.name, n.bl_idname, n.mute, getattr(getattr(n, "image", None), "name", None),
+              [[i.identifier, _socket_value(i)] for i in n.inputs if not i.is_linked]]
+             for n in sorted(tree.nodes, key=lambda n: n.name)]
+    links = sorted([l.from_node.name, l.from_socket.identifier, l.to_node.name, l.to_socket.identifier]
+                   for l in tree.links)
+    return [nodes, links]
+
+
+def _material_fingerprint(material):
+    if material is None:
+        return None
+    shading = _node_tree_fingerprint(material.node_tree) if material.use_nodes else list(material.diffuse_color)
+    return [material.name, shading]
+
+
+def _world_fingerprint(world):
+    if world is None:
+        return None
+    return [world.name, _node_tree_fingerprint(world.node_tree) if world.use_nodes else list(world.color)]
+
+
+def _light_fingerprint(light):
+    return [light.type, light.energy, list(light.color), light.shadow_soft_size, getattr(light, "size", None),
+            getattr(light, "size_y", None), getattr(light, "spot_size", None), getattr(light, "angle", None),
+            _node_tree_fingerprint(light.node_tree) if light.use_nodes else None]
 
 
 def _animation(id_block):
@@ -250,9 +290,10 @@ def _object_fingerprint(obj):
                      obj.rotation_mode, list(obj.scale)]
     mesh = [len(obj.data.vertices), len(obj.data.polygons)] if obj.type == "MESH" else None
     modifiers = [[m.name, m.type, m.show_render] for m in obj.modifiers]
+    light = _light_fingerprint(obj.data) if obj.type == "LIGHT" else None
     return [obj.name, obj.type, obj.data.name if obj.data else None, obj.hide_render,
             obj.parent.name if obj.parent else None, transform, animation, _animation(obj.data), mesh,
-            modifiers, [slot.material.name if slot.material else None for slot in obj.material_slots]]
+            modifiers, [_material_fingerprint(slot.material) for slot in obj.material_slots], light]
 
 
 def effective_resolution(scene):
