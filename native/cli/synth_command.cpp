@@ -1,5 +1,6 @@
 // `tempera synth`: guided synthesis on image files, with options that people
 // who know ebsynth recognise.
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <optional>
@@ -20,7 +21,9 @@ const char* kSynthHelp =
     "\n"
     "options:\n"
     "  --style FILE            exemplar (A')\n"
-    "  --guide SRC TGT         a guide pair: SRC has the size of the style, TGT of the output\n"
+    "  --guide SRC TGT         a guide pair: SRC has the size of the style, TGT of the output;\n"
+    "                          FILE:LAYER takes one layer of a multilayer EXR, e.g. a guide cache\n"
+    "                          frame: --guide ex/frame_0001.exr:LDE shot/frame_0012.exr:LDE\n"
     "  --weight W              weight of the preceding guide pair\n"
     "  --output FILE           result (B'); PNG/JPEG are clamped to [0,1], EXR/TIFF keep float\n"
     "  --usage MODE            none | penalty | uniform | budget (default budget)\n"
@@ -43,8 +46,18 @@ struct GuideFiles {
   float weight = 1.0f;
 };
 
+// "FILE" or "FILE:LAYER": a layer of a multilayer EXR, e.g. a guide of a
+// guide cache frame ("frame_0001.exr:FULL"). A path that exists as written
+// is always taken whole.
+Image read_input(const std::string& spec) {
+  const std::size_t colon = spec.rfind(':');
+  std::error_code ec;
+  if (colon == std::string::npos || std::filesystem::exists(spec, ec)) return read_image(spec);
+  return read_image_layer(spec.substr(0, colon), spec.substr(colon + 1));
+}
+
 // First channel of a mask file.
-Image read_mask(const std::string& path) { return extract_channels(read_image(path).view(), 0, 1); }
+Image read_mask(const std::string& path) { return extract_channels(read_input(path).view(), 0, 1); }
 
 void write_stats(const std::string& path, const SynthesisResult& r, const SynthesisOptions& opt) {
   std::ofstream out(path + ".tmp");
@@ -109,11 +122,11 @@ int run_synth(const Args& args) {
   if (output_path.empty()) throw ValueError("--output is required");
   if (guides.empty()) throw ValueError("at least one --guide SRC TGT pair is required");
 
-  const Image style = read_image(style_path);
+  const Image style = read_input(style_path);
   std::vector<Image> sources, targets;
   for (const auto& g : guides) {
-    sources.push_back(read_image(g.source));
-    targets.push_back(read_image(g.target));
+    sources.push_back(read_input(g.source));
+    targets.push_back(read_input(g.target));
   }
   SynthesisInput input;
   input.style = style.view();

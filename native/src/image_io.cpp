@@ -113,6 +113,23 @@ Image read_image(const std::string& path, const std::vector<std::string>& channe
   return out;
 }
 
+Image read_image_layer(const std::string& path, const std::string& layer) {
+  const ImageFileInfo info = inspect_image(path);
+  std::vector<std::string> selected;
+  std::vector<std::string> layers;
+  for (const auto& name : info.channel_names) {
+    if (name == layer || name.rfind(layer + ".", 0) == 0) selected.push_back(name);
+    const std::string prefix = name.substr(0, name.rfind('.'));
+    if (std::find(layers.begin(), layers.end(), prefix) == layers.end()) layers.push_back(prefix);
+  }
+  if (selected.empty()) {
+    std::string known;
+    for (const auto& l : layers) known += (known.empty() ? "" : ", ") + l;
+    throw ValueError(concat("image '", path, "' has no layer '", layer, "' (it has: ", known, ")"));
+  }
+  return read_image(path, selected);
+}
+
 void write_image(const std::string& path, const ImageView& image,
                  const std::vector<std::string>& channel_names) {
   require_nonempty(image, concat("image to write to '", path, "'"));

@@ -97,3 +97,18 @@ TEST(ImageIo, WriteLeavesNoTemporaryFiles) {
 TEST(ImageIo, UnknownExtensionIsIoError) {
   EXPECT_THROW(write_image((scratch_dir() / "x.notaformat").string(), gradient(2, 2, 1).view()), IoError);
 }
+
+TEST(ImageIo, ReadsOneLayerOfAMultilayerFile) {
+  const fs::path path = scratch_dir() / "layers.exr";
+  write_image(path.string(), gradient(5, 4, 4).view(), {"FULL.R", "FULL.G", "FULL.B", "lines.V"});
+  const Image full = read_image_layer(path.string(), "FULL");
+  EXPECT_EQ(full.channels(), 3);
+  const Image lines = read_image_layer(path.string(), "lines");
+  EXPECT_EQ(lines.channels(), 1);
+  try {
+    read_image_layer(path.string(), "LDE");
+    FAIL();
+  } catch (const ValueError& e) {
+    EXPECT_NE(std::string(e.what()).find("it has: FULL, lines"), std::string::npos) << e.what();
+  }
+}

@@ -77,3 +77,20 @@ def test_synth_help(cli_path):
     for flag in ("--style", "--guide", "--weight", "--usage", "--patch-size", "--levels", "--em-iters",
                  "--pm-iters", "--seed", "--threads", "--output", "--stats"):
         assert flag in result.stdout
+
+
+def test_synth_reads_layers_of_multilayer_guide_files(cli_path, tmp_path):
+    """Guides straight from guide-cache style EXRs: FILE:LAYER picks one layer."""
+    p = write_inputs(tmp_path)
+    source = tempera.read_image(str(p["src"]))
+    frame = tmp_path / "frame_0001.exr"
+    tempera.write_image(str(frame), np.dstack([source, source[..., :1] * 0]),
+                        ["FULL.R", "FULL.G", "FULL.B", "lines.V"])
+    out = tmp_path / "o.png"
+    result = run(cli_path, "--style", p["style"], "--guide", f"{frame}:FULL", f"{frame}:FULL", "--weight", 4,
+                 "--usage", "none", "--output", out, "--quiet")
+    assert result.returncode == 0, result.stderr
+    style = tempera.read_image(str(p["style"]))
+    assert np.abs(tempera.read_image(str(out)) - style)[6:-6, 6:-6].mean() < 2e-3
+    bad = run(cli_path, "--style", p["style"], "--guide", f"{frame}:LDE", f"{frame}:FULL", "--output", out)
+    assert bad.returncode != 0 and "has no layer 'LDE' (it has: FULL, lines)" in bad.stderr

@@ -22,6 +22,12 @@ ImageFileInfo inspect_image(const std::string& path);
 // ValueError naming the file and the missing channel on failure).
 Image read_image(const std::string& path, const std::vector<std::string>& channels = {});
 
+// The channels of one layer of `path`: the channel named `layer` itself, or
+// every channel named "<layer>.<component>" in file order (e.g. "FULL" gives
+// FULL.R, FULL.G, FULL.B of a guide cache frame). ValueError lists the layers
+// the file has when there is no such layer.
+Image read_image_layer(const std::string& path, const std::string& layer);
+
 // Writes atomically: a temporary file in the same folder, then a rename, so a
 // crash or cancel never leaves a half-written `path`. 8-bit formats (PNG, JPEG)
 // get values clamped to [0, 1]; EXR and TIFF keep float.
