@@ -153,7 +153,8 @@ def test_output_panel_draws_version_and_settings():
     props = [name for kind, name in calls if kind == "prop"]
     labels = [text for kind, text in calls if kind == "label"]
     assert props == ["output_dir", "patch_size", "seed", "guide_dir", "guide_frame_range", "guide_samples",
-                     "guide_occlusion_epsilon", "guide_line_d_max", "guide_masks"]
+                     "guide_occlusion_epsilon", "guide_line_d_max", "guide_masks",
+                     "guide_orientation_aov"]
     assert f"Version {tempera.__version__}" in labels
     assert "Guides" in labels
     assert ("operator", "tempera.render_guides") in calls

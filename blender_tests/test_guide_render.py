@@ -313,3 +313,33 @@ def test_freestyle_lines_join_the_line_guide(rendered, tmp_path):
     assert plain["lines"].sum() == 0
     assert drawn["lines"].sum() >= 20  # the cube's outline
     assert np.allclose(plain["FULL"], drawn["FULL"], atol=1e-4)  # lines kept out of the light paths
+
+
+def test_orientation_from_the_artists_aov(rendered, tmp_path):
+    """Strokes along x written to a Color AOV on the cube become the cube's
+    orientation; pixels without the AOV keep the computed one."""
+    from tempera import guide_cache, guides
+    from tempera.blender.guide_render import GuideRenderError, render_guides
+
+    scene = rendered["scene"]
+    params = {"samples": 2, "ld12e_samples": 2, "masks": "objects", "orientation_aov": "stroke_dir"}
+    with pytest.raises(GuideRenderError, match="Shader AOV 'stroke_dir' is not declared"):
+        render_guides(scene, (3,), tmp_path / "missing", params)
+    aov = scene.view_layers[0].aovs.add()
+    aov.name, aov.type = "stroke_dir", "COLOR"
+    material = scene.objects["MovingCube"].material_slots[0].material
+    material.use_nodes = True
+    node = material.node_tree.nodes.new("ShaderNodeOutputAOV")
+    node.name = "stroke_dir"  # the AOV it writes
+    node.inputs["Color"].default_value = (1.0, 0.0, 0.0, 1.0)  # along x
+    try:
+        render_guides(scene, (3,), tmp_path / "aov", params)
+    finally:
+        material.node_tree.nodes.remove(node)
+        material.use_nodes = False
+    frame = guide_cache.read_frame(tmp_path / "aov", 3, ["tensor", "mask.OB_MovingCube"])
+    angle, coherence = guides.orientation(frame["tensor"], tensor=True)
+    cube = frame["mask.OB_MovingCube"] > 0.5
+    along_x = np.minimum(angle, np.pi - angle)[cube]
+    assert cube.sum() > 50 and np.percentile(along_x, 90) < 0.05
+    assert np.all(coherence[cube] > 0.99)

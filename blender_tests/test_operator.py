@@ -63,7 +63,9 @@ def test_settings_map_to_params_and_frames(scene):
         settings.guide_occlusion_epsilon = 3.5
         settings.guide_line_d_max = 6
         settings.guide_masks = "COLLECTIONS"
+        settings.guide_orientation_aov = " stroke_dir "
         params = guide_params(settings)
+        assert params["orientation_aov"] == "stroke_dir"
         assert (params["samples"], params["ld12e_samples"]) == (7, 7)
         assert (params["occlusion_epsilon"], params["line_d_max"], params["masks"]) == (3.5, 6.0, "collections")
         scene.frame_set(4)

@@ -59,6 +59,10 @@ DEFAULT_PARAMS = {
     "line_normal_angle": 40.0,  # degrees between neighbouring normals that makes a line
     "line_d_max": 10.0,  # bound of the line distance, pixels (Bénard 2013 §3.2)
     "masks": "objects+collections",  # or "objects", "collections", "none"
+    # A Color shader AOV of the view layer in which the artist's materials
+    # write the stroke direction in screen space (R = x right, G = y up);
+    # "" computes the orientation from the render instead.
+    "orientation_aov": "",
 }
 
 

@@ -36,6 +36,7 @@ const char* kRenderGuidesHelp =
     "  --tensor-sigma S        structure tensor smoothing, pixels (default 2)\n"
     "  --line-depth-threshold T, --line-normal-angle DEG, --d-max D   line guide\n"
     "  --masks MODE            objects+collections | objects | collections | none\n"
+    "  --orientation-aov NAME  Color shader AOV holding the artist's stroke directions\n"
     "  --blender PATH          Blender to run (default: $TEMPERA_BLENDER or 'blender')\n"
     "  --addon-path DIR        folder holding the tempera package\n"
     "                          (default: $TEMPERA_ADDON_PATH or this build's addon folder)\n";

@@ -40,6 +40,7 @@ def guide_params(settings):
         "occlusion_epsilon": float(settings.guide_occlusion_epsilon),
         "line_d_max": float(settings.guide_line_d_max),
         "masks": GUIDE_MASK_MODES[settings.guide_masks],
+        "orientation_aov": settings.guide_orientation_aov.strip(),
     }
 
 

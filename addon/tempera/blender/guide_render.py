@@ -128,6 +128,29 @@ def check_scene(scene):
     guide_view_layer(scene)
 
 
+def check_orientation_aov(scene, layer, name):
+    """The artist's direction AOV must be a Color AOV declared on the layer
+    (Tempera reads it; it does not add AOVs to the user's file)."""
+    aov = next((a for a in layer.aovs if a.name == name), None)
+    if aov is None or aov.type != "COLOR":
+        raise GuideRenderError(
+            f"Shader AOV '{name}' is not declared as a Color AOV on view layer '{layer.name}' of scene "
+            f"'{scene.name}': add it in View Layer Properties > Shader AOV (type Color) and write the stroke "
+            "direction to it with an AOV Output node in the materials.")
+
+
+def aov_tensor(direction, computed):
+    """Structure tensor of the artist's stroke directions (screen space, y up):
+    the tensor of the gradient across the strokes, the form the computed
+    orientation has, so both read back the same way. Pixels where no
+    direction was written keep the computed tensor."""
+    dx, dy = direction[:, :, 0], -direction[:, :, 1]  # to row-down image coordinates
+    nx, ny = -dy, dx  # across the stroke
+    tensor = np.dstack([nx * nx, nx * ny, ny * ny]).astype(np.float32)
+    written = (dx * dx + dy * dy) > 1e-6
+    return np.where(written[:, :, None], tensor, computed)
+
+
 def _configure(scene, layer, samples, passes, seed):
     """Cycles settings that keep passes usable as guides: no denoising (it
     smears passes differently), no clamping (it biases indirect light), a fixed
@@ -338,6 +361,8 @@ def frame_guides(main, ld12e, v_plus_prev, v_minus_next, masks, params):
         "lines": lines,
         "line_distance": guides.line_distance(lines, params["line_d_max"]),
     })
+    if params["orientation_aov"]:
+        out["tensor"] = aov_tensor(main[params["orientation_aov"]], out["tensor"])
     index = np.rint(main["IndexOB"][:, :, 0])
     for guide, (_kind, _name, indices) in masks.items():
         out[guide] = np.isin(index, indices).astype(np.float32)
@@ -405,7 +430,10 @@ def uses_freestyle(scene, layer):
 def _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress):
     layer = guide_view_layer(scene)
     masks = assign_pass_indices(scene, params["masks"])
-    main_passes = {**MAIN_PASSES, "Freestyle": "RGBA"} if uses_freestyle(scene, layer) else MAIN_PASSES
+    main_passes = {**MAIN_PASSES, "Freestyle": "RGBA"} if uses_freestyle(scene, layer) else dict(MAIN_PASSES)
+    if params["orientation_aov"]:
+        check_orientation_aov(scene, layer, params["orientation_aov"])
+        main_passes[params["orientation_aov"]] = "RGB"  # declared AOVs are written with every render
     total = len(todo)
 
     def step(done, message):

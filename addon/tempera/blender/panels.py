@@ -43,6 +43,7 @@ def draw_guides(box, scene, settings):
     col.prop(settings, "guide_occlusion_epsilon")
     col.prop(settings, "guide_line_d_max")
     col.prop(settings, "guide_masks")
+    col.prop(settings, "guide_orientation_aov")
     try:
         text, icon = cache_status(scene)
     except Exception as exc:  # a status line must never break the panel

@@ -133,3 +133,9 @@ class TemperaSettings(PropertyGroup):
         items=_MASK_ITEMS,
         default=_DEFAULT_MASK_MODE,
     )
+    guide_orientation_aov: StringProperty(
+        name="Orientation AOV",
+        description=("Color shader AOV of the view layer in which your materials write the stroke direction "
+                     "(R = screen x, G = screen y); empty: orientation computed from the render"),
+        default=guide_cache.DEFAULT_PARAMS["orientation_aov"],
+    )

@@ -27,6 +27,7 @@ PARAM_FLAGS = {
     "line_normal_angle": ("--line-normal-angle", float),
     "line_d_max": ("--d-max", float),
     "masks": ("--masks", str),
+    "orientation_aov": ("--orientation-aov", str),
 }
 
 
