@@ -139,25 +139,38 @@ def render_frames(out):
 
 
 def stylize_frames(out, scene, exrs, style, exemplar_guides):
-    """tempera.synthesize per frame; returns (renders sRGB, stylized frames)."""
+    """tempera.synthesize per frame, each on its own (no temporal guide yet);
+    returns (renders sRGB, stylized frames, flicker per frame: the mean colour
+    change along the rendered motion, see tempera.temporal.flicker)."""
     import tempera
+    from tempera import temporal
     from tempera.color import linear_to_srgb
+    from tempera.passes import read_pass
     from tempera.synthesis import synthesize
 
-    renders, stylized = [], []
+    view_layer = scene_kit.view_layer_name(scene)
+    renders, stylized, flickers = [], [], []
+    previous = None  # (stylized frame, Vector pass) of the frame before
     for i, (frame, exr) in enumerate(zip(FRAMES, exrs), 1):
         started = time.monotonic()
         passes, guides = read_guides(exr, scene, f"frame {frame}")
+        vector = read_pass(exr, "Vector", view_layer)
         pairs = [(source, target, GUIDE_WEIGHTS[name])
                  for (name, source), (_, target) in zip(exemplar_guides, guides)]
         image, stats = synthesize(style, guides=pairs, style_weight=STYLE_WEIGHT, seed=SEED)
         tempera.write_image(str(out / "frames" / f"frame_{frame:04d}.png"), image)
+        note = ""
+        if previous is not None:
+            backward, visible = temporal.motion(vector, previous[1])
+            flickers.append(temporal.flicker(previous[0], image, backward, visible))
+            note = f", flicker {flickers[-1]:.3f}"
         renders.append(linear_to_srgb(passes["Combined"][:, :, :3]))
         stylized.append(image)
+        previous = (image, vector)
         print(f"stylize frame {i}/{len(FRAMES)}: {time.monotonic() - started:.1f} s "
-              f"(synthesis {stats.get('seconds', 0):.1f} s, source coverage {stats.get('source_coverage', 0):.0%})",
-              flush=True)
-    return renders, stylized
+              f"(synthesis {stats.get('seconds', 0):.1f} s, source coverage {stats.get('source_coverage', 0):.0%}"
+              f"{note})", flush=True)
+    return renders, stylized, flickers
 
 
 def contact_sheets(out, exemplar_render, style, exemplar_guides, renders, stylized):
@@ -216,7 +229,7 @@ def run(out, started):
     exemplar_done = time.monotonic()
     scene, exrs = render_frames(out)
     rendered = time.monotonic()
-    renders, stylized = stylize_frames(out, scene, exrs, style, exemplar_guides)
+    renders, stylized, flickers = stylize_frames(out, scene, exrs, style, exemplar_guides)
     stylized_done = time.monotonic()
     sheet, exemplar_sheet = contact_sheets(out, exemplar_render, style, exemplar_guides, renders, stylized)
 
@@ -226,6 +239,7 @@ def run(out, started):
     print(f"frames:         {out / 'frames'}/frame_####.png (stylized)")
     print(f"contact sheet:  {sheet}")
     print(f"exemplar sheet: {exemplar_sheet}")
+    print(f"flicker:        {sum(flickers) / max(1, len(flickers)):.3f} mean colour change along valid motion")
     print(f"exemplar {exemplar_done - started:.1f} s, render {rendered - exemplar_done:.1f} s, "
           f"stylize {stylized_done - rendered:.1f} s, total {time.monotonic() - started:.1f} s")
 
