@@ -1,7 +1,7 @@
 # Tempera: one entry point for humans and CI.
 #   make demo    install deps, build, stylize the bundled demo scene in background Blender
 #   make test    install deps, build, run C++, Python and in-Blender tests
-# Other targets: deps, build, addon-zip, wheel, bench, sanitize, clean.
+# Other targets: deps, build, kit, addon-zip, wheel, bench, sanitize, clean.
 
 PYTHON   := /usr/bin/python3
 BLENDER  ?= blender
@@ -9,9 +9,13 @@ BUILD    ?= build
 JOBS     ?= $(shell nproc)
 VERSION  := $(shell sed -n 's/^project.tempera VERSION \([0-9.]*\).*/\1/p' CMakeLists.txt)
 ADDON_ZIP := dist/tempera-addon-$(VERSION).zip
+# The exemplar kit bundled in the add-on zip (scenes/exemplar_kit.py renders and paints it).
+KIT      := $(BUILD)/kit/sphere_on_table
+KIT_SOURCES := scenes/exemplar_kit.py scenes/scene_kit.py addon/tempera/exemplar_paint.py \
+               addon/tempera/blender/guide_render.py addon/tempera/guide_cache.py
 DEMO_OUT ?= out/demo
 
-.PHONY: all deps build addon-zip wheel test demo bench sanitize clean
+.PHONY: all deps build kit addon-zip wheel test demo bench sanitize clean
 
 all: build
 
@@ -24,8 +28,14 @@ $(BUILD)/CMakeCache.txt:
 build: deps $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS)
 
-addon-zip: build
-	$(PYTHON) tools/make_addon_zip.py --out $(ADDON_ZIP)
+$(KIT)/kit.json: $(KIT_SOURCES) | build
+	$(BLENDER) -b --factory-startup --python-exit-code 1 --python scenes/exemplar_kit.py -- \
+	    --variant sphere_on_table --out $(KIT)
+
+kit: build $(KIT)/kit.json
+
+addon-zip: build $(KIT)/kit.json
+	$(PYTHON) tools/make_addon_zip.py --out $(ADDON_ZIP) --kit $(KIT)
 
 wheel: deps
 	$(PYTHON) -m pip wheel --no-build-isolation --no-deps -w dist .

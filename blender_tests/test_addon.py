@@ -1,5 +1,6 @@
 """The Tempera add-on inside Blender, installed from the add-on zip."""
 import os
+from types import SimpleNamespace
 from pathlib import Path
 
 import bpy
@@ -9,7 +10,8 @@ import pytest
 import tempera
 from conftest import ADDON, disable, enable, is_enabled, registered_tempera_classes
 
-EXPECTED_CLASSES = ["TEMPERA_OT_render_guides", "TEMPERA_PT_output", "TemperaPreferences", "TemperaSettings"]
+EXPECTED_CLASSES = ["TEMPERA_OT_render_guides", "TEMPERA_OT_stylize", "TEMPERA_PT_output", "TemperaPreferences",
+                    "TemperaSettings"]
 
 
 def test_addon_is_enabled_from_the_installed_zip():
@@ -139,6 +141,7 @@ class _Recorder:
         category, _, name = idname.partition(".")
         getattr(getattr(bpy.ops, category), name).get_rna_type()  # KeyError if not registered
         self.calls.append(("operator", idname))
+        return SimpleNamespace()  # the operator's properties, set by the panel
 
     def _sub(self, *args, **kwargs):
         return _Recorder(self.calls)
@@ -152,12 +155,16 @@ def test_output_panel_draws_version_and_settings():
     bpy.types.TEMPERA_PT_output.draw(fake, bpy.context)
     props = [name for kind, name in calls if kind == "prop"]
     labels = [text for kind, text in calls if kind == "label"]
-    assert props == ["output_dir", "patch_size", "seed", "guide_dir", "guide_frame_range", "guide_samples",
+    assert props == ["exemplar_source", "weight_full", "weight_lde", "weight_lse", "weight_ldde", "weight_ld12e",
+                     "quality", "usage", "temporal_weight", "patch_size", "seed",
+                     "output_dir", "output_format", "make_video", "load_result",
+                     "guide_dir", "guide_frame_range", "guide_samples",
                      "guide_occlusion_epsilon", "guide_line_d_max", "guide_masks",
                      "guide_orientation_aov"]
     assert f"Version {tempera.__version__}" in labels
-    assert "Guides" in labels
-    assert ("operator", "tempera.render_guides") in calls
+    assert {"Exemplar", "Light Path Guides", "Synthesis", "Output", "Guides"} <= set(labels)
+    assert [name for kind, name in calls if kind == "operator"] == [
+        "tempera.render_guides", "tempera.stylize", "tempera.stylize"]
 
 
 def test_preferences_draw_reports_the_cli(tmp_path):

@@ -6,6 +6,7 @@ import time
 
 import bpy
 import pytest
+from fake_ui import modal_run
 from guide_scene import build_scene, remove_scene
 
 GUIDE_SETTINGS = {"guide_frame_range": "CUSTOM", "guide_frame_start": 2, "guide_frame_end": 3,
@@ -175,68 +176,10 @@ def test_job_steps_one_frame_at_a_time(scene, tmp_path):
         settings.guide_dir = saved
 
 
-class _FakeWindowManager:
-    def __init__(self, log):
-        self.log, self.timers = log, set()
-
-    def event_timer_add(self, step, window=None):
-        timer = object()
-        self.timers.add(timer)
-        return timer
-
-    def event_timer_remove(self, timer):
-        self.timers.remove(timer)  # KeyError if removed twice or unknown
-
-    def modal_handler_add(self, op):
-        self.log.append(("modal_handler_add",))
-
-    def progress_begin(self, lo, hi):
-        self.log.append(("progress_begin", lo, hi))
-
-    def progress_update(self, value):
-        self.log.append(("progress_update", value))
-
-    def progress_end(self):
-        self.log.append(("progress_end",))
-
-
 def _modal_run(scene, events, after_start=None):
-    """Drives the operator's invoke() and modal() with stand-ins for the
-    window manager, workspace and events (modal timers do not run in
-    background mode). Returns (results, log, reports, timers left)."""
-    from types import SimpleNamespace
+    from tempera.blender.guide_operator import TEMPERA_OT_render_guides, GuideJob
 
-    from tempera.blender.guide_operator import TEMPERA_OT_render_guides as Op
-    from tempera.blender.guide_operator import GuideJob
-
-    log, reports = [], []
-    wm = _FakeWindowManager(log)
-    workspace = SimpleNamespace(status_text_set=lambda text: log.append(("status", text)))
-    context = SimpleNamespace(scene=scene, window=object(), window_manager=wm, workspace=workspace,
-                              screen=SimpleNamespace(areas=[]))
-
-    class FakeOperator:  # the operator's own methods on a plain object
-        invoke, modal, cancel, execute = Op.invoke, Op.modal, Op.cancel, Op.execute
-        _job, _step, _show, _finish = Op._job, Op._step, Op._show, Op._finish
-        _running = False
-
-        def report(self, kind, message):
-            reports.append((set(kind), message))
-
-    op = FakeOperator()
-    # invoke() runs execute() in background mode; this is what it does in the UI.
-    op._guide_job = GuideJob.from_settings(scene)
-    op._timer = wm.event_timer_add(0.1)
-    wm.progress_begin(0, op._guide_job.total)
-    if after_start:
-        after_start()
-    results = []
-    for kind, value in events:
-        result = op.modal(context, SimpleNamespace(type=kind, value=value))
-        results.append(result)
-        if result != {"PASS_THROUGH"}:
-            break
-    return results, log, reports, wm.timers, op
+    return modal_run(TEMPERA_OT_render_guides, scene, GuideJob.from_settings(scene), events, after_start)
 
 
 def test_modal_steps_show_progress_and_finish(scene, tmp_path):
@@ -250,7 +193,8 @@ def test_modal_steps_show_progress_and_finish(scene, tmp_path):
         settings.guide_dir = saved
     assert results == [{"PASS_THROUGH"}, {"PASS_THROUGH"}, {"FINISHED"}]
     statuses = [entry[1] for entry in log if entry[0] == "status"]
-    assert statuses[0].startswith("Tempera: guides frame 2/2, ETA 0:0") and statuses[-1] is None
+    assert statuses[0].startswith("Tempera: guides frame 1/2, ETA …")
+    assert statuses[1].startswith("Tempera: guides frame 2/2, ETA 0:0") and statuses[-1] is None
     assert ("progress_update", 1) in log and log[-2:] == [("progress_end",), ("status", None)]
     assert not timers and type(op)._running is False
     assert reports == [({"INFO"}, f"Tempera guides: 2 rendered in {tmp_path / 'guides'}")]

@@ -19,8 +19,9 @@ artist paints from:
     blender -b --factory-startup --python scenes/exemplar_kit.py -- \
         --variant sphere_on_table --out kit/ [--resolution 320 240] [--samples 64] [--dpi 150]
 
-which writes into kit/: guides.exr (the exemplar's guide passes),
-render.png, template.png and template.pdf (the printable painting template
+which writes into kit/: guides.exr (the exemplar's render passes), guides/
+(its guide cache, what the synthesis matches), style.png (the project's own
+coloured-pencil painting of it), render.png, template.png and template.pdf (the printable painting template
 of tempera.painting_template) and kit.json (variant, resolution and the
 template's mark and picture geometry, read by `python -m
 tempera.register_painting`). See docs/exemplar_kit.md.
@@ -77,10 +78,30 @@ def render_exemplar(scene, path, resolution, samples):
     return scene_kit.render_exr(scene, path, frame=1)
 
 
-def make_kit(out, variant=DEFAULT_VARIANT, resolution=(320, 240), samples=64, dpi=150.0):
-    """Renders `variant` and writes the kit into the folder `out`; returns the kit.json path."""
+def render_exemplar_guides(scene, folder, resolution, samples):
+    """The exemplar's guide cache (tempera.guide_cache, frame 1) in `folder`:
+    the guides the synthesis matches, rendered exactly as a target scene's."""
+    from tempera import guide_cache
+    from tempera.blender.guide_render import render_guides
+
+    scene.render.resolution_x, scene.render.resolution_y = resolution
+    scene.render.resolution_percentage = 100
+    scene.frame_start = scene.frame_end = 1
+    params = dict(guide_cache.DEFAULT_PARAMS, samples=samples, ld12e_samples=samples)
+    render_guides(scene, [1], folder, params)
+    return Path(folder)
+
+
+def make_kit(out, variant=DEFAULT_VARIANT, resolution=(320, 240), samples=64, dpi=150.0, seed=7):
+    """Renders `variant` and writes the kit into the folder `out`; returns the kit.json path.
+
+    Besides what an artist paints from (render, template), the kit holds the
+    exemplar's guide cache (guides/) and the project's own painting of it
+    (style.png: coloured-pencil hatching whose density and colours follow the
+    exemplar's shading, tempera.exemplar_paint), ready to stylize with."""
     import tempera
     from tempera.color import linear_to_srgb
+    from tempera.exemplar_paint import paint_hatching
     from tempera.painting_template import make_template, write_kit_json, write_pdf
     from tempera.passes import read_pass
 
@@ -88,8 +109,12 @@ def make_kit(out, variant=DEFAULT_VARIANT, resolution=(320, 240), samples=64, dp
     scene = build_exemplar_scene(variant=variant)
     exr = render_exemplar(scene, out / "guides.exr", tuple(resolution), samples)
     view_layer = scene_kit.view_layer_name(scene)
-    render = linear_to_srgb(read_pass(exr, "Combined", view_layer)[:, :, :3])
+    combined = read_pass(exr, "Combined", view_layer)
+    render = linear_to_srgb(combined[:, :, :3])
     tempera.write_image(str(out / "render.png"), render)
+    style = paint_hatching(combined, read_pass(exr, "DiffCol", view_layer), seed=seed)
+    tempera.write_image(str(out / "style.png"), style)
+    render_exemplar_guides(scene, out / "guides", tuple(resolution), samples)
     template = make_template(render, dpi=dpi)
     tempera.write_image(str(out / "template.png"), template.image)
     width, height = resolution
@@ -125,7 +150,7 @@ def main():
         if scripts_dir:
             shutil.rmtree(scripts_dir, ignore_errors=True)
     print(f"exemplar kit '{args.variant}': {kit.parent}/ "
-          "(guides.exr, render.png, template.png, template.pdf, kit.json)")
+          "(guides.exr, guides/, render.png, style.png, template.png, template.pdf, kit.json)")
 
 
 if __name__ == "__main__":

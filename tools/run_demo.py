@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 """Runs Tempera's demo job: scenes/demo_scene.py in background Blender, with
 the add-on installed from its zip (see tools/blender_env.py), then checks
-that the expected images exist and prints where they are. The job renders
-StyLit's "sphere on a table" exemplar, paints a hatched drawing of it,
-renders the animated scene and stylizes every frame after the drawing.
+that the expected files exist and prints where they are. The job builds an
+animated scene and runs the add-on's Stylize Animation with the bundled
+exemplar kit (StyLit's "sphere on a table" and a coloured-pencil painting).
 
     /usr/bin/python3 tools/run_demo.py --addon-zip dist/tempera-addon-X.Y.Z.zip \
         --blender blender --out out/demo
@@ -17,7 +17,7 @@ from pathlib import Path
 import blender_env
 
 SCENE = blender_env.ROOT / "scenes" / "demo_scene.py"
-FRAMES = 8  # scenes/demo_scene.py renders and stylizes frames 1-8 (its FRAMES)
+FRAMES = 12  # scenes/demo_scene.py renders and stylizes frames 1-12 (its FRAMES)
 
 
 def main():
@@ -38,20 +38,20 @@ def main():
         print(f"demo: Blender failed (exit code {rc}) after {elapsed:.1f} s", file=sys.stderr)
         return 1
 
-    expected = [out / "exemplar" / name for name in ("guides.exr", "render.png", "style.png")]
-    expected += [out / "guides" / f"frame_{f:04d}.exr" for f in range(1, FRAMES + 1)]
+    expected = [out / "guides" / f"frame_{f:04d}.exr" for f in range(1, FRAMES + 1)]
     expected += [out / "frames" / f"frame_{f:04d}.png" for f in range(1, FRAMES + 1)]
-    expected += [out / "contact_sheet.png", out / "exemplar_sheet.png"]
+    expected += [out / name for name in ("contact_sheet.png", "comparison_sheet.png", "demo.blend")]
     missing = [str(p) for p in expected if not p.is_file()]
     if missing:
         print(f"demo: missing outputs: {', '.join(missing)}", file=sys.stderr)
         return 1
     print(f"\ndemo finished in {elapsed:.1f} s")
-    print(f"  exemplar       {out / 'exemplar'}  (guides.exr, render.png, style.png: the hatched drawing)")
-    print(f"  guide passes   {out / 'guides'}  ({FRAMES} multilayer EXR)")
-    print(f"  frames         {out / 'frames'}  ({FRAMES} stylized PNG)")
-    print(f"  contact sheet  {out / 'contact_sheet.png'}  (renders above stylized frames)")
-    print(f"  exemplar sheet {out / 'exemplar_sheet.png'}  (render, FULL, LDE, LSE, L.*DDE, drawing)")
+    print(f"  frames           {out / 'frames'}  ({FRAMES} stylized PNG)")
+    print(f"  contact sheet    {out / 'contact_sheet.png'}  (the painting, then every frame)")
+    print(f"  comparison sheet {out / 'comparison_sheet.png'}  (renders above stylized frames)")
+    video = out / "stylized.mp4"
+    print(f"  video            {video if video.is_file() else '(none: ffmpeg not found)'}")
+    print(f"  blend file       {out / 'demo.blend'}  (open it: scene 'Demo Tempera' plays the result)")
     return 0
 
 

@@ -16,7 +16,6 @@ bl_info = {
     "blender": (3, 4, 0),
     "location": "Properties > Output > Tempera",
     "description": "Stylize 3D animations by example",
-    "warning": "Early development: the Blender UI does not stylize yet (use tempera.synthesize / tempera synth)",
     "category": "Render",
 }
 

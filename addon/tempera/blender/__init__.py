@@ -11,18 +11,21 @@ from .guide_operator import TEMPERA_OT_render_guides
 from .panels import TEMPERA_PT_output
 from .preferences import TemperaPreferences
 from .properties import TemperaSettings
+from .stylize_operator import TEMPERA_OT_stylize
 
 # Registration order: property groups before the pointers and panels using them.
 CLASSES = (
     TemperaPreferences,
     TemperaSettings,
     TEMPERA_OT_render_guides,
+    TEMPERA_OT_stylize,
     TEMPERA_PT_output,
 )
 
 
 def register():
-    TEMPERA_OT_render_guides._running = False  # a run cut short by disabling the add-on is over
+    for operator in (TEMPERA_OT_render_guides, TEMPERA_OT_stylize):
+        operator._running = False  # a run cut short by disabling the add-on is over
     registered = []
     try:
         for cls in CLASSES:

@@ -16,16 +16,14 @@ import functools
 import json
 import os
 import time
-import traceback
 
 import bpy
 from bpy.types import Operator
 
 from .. import guide_cache
 from .guide_render import GuideRenderError, check_scene, render_guides, scene_fingerprint
+from .job_operator import JobOperator
 from .properties import GUIDE_MASK_MODES
-
-TIMER_STEP = 0.1  # seconds between the end of a frame and the start of the next (redraws, Esc)
 
 
 # --------------------------------------------------------------------------- settings -> job
@@ -99,12 +97,13 @@ class GuideJob:
         self.render_seconds = 0.0  # time spent on rendered frames (skipped ones take none)
 
     @classmethod
-    def from_settings(cls, scene):
-        """The job Scene.tempera describes. Raises ValueError or
-        GuideRenderError (with what to change) before anything is rendered."""
+    def from_settings(cls, scene, frames=None):
+        """The job Scene.tempera describes (for `frames`, default its Frames
+        setting). Raises ValueError or GuideRenderError (with what to
+        change) before anything is rendered."""
         settings = scene.tempera
         folder = resolve_guide_dir(settings.guide_dir)
-        frames = guide_frames(scene, settings)
+        frames = guide_frames(scene, settings) if frames is None else list(frames)
         check_scene(scene)
         return cls(scene, frames, folder, guide_params(settings))
 
@@ -115,6 +114,12 @@ class GuideJob:
     @property
     def finished(self):
         return self.index >= self.total
+
+    def threaded(self):
+        return False  # rendering needs bpy: the main thread
+
+    def failure(self, exc):
+        return f"Guides of frame {self.frames[self.index]} failed: {exc}"
 
     def scene(self):
         scene = bpy.data.scenes.get(self.scene_name)
@@ -205,7 +210,7 @@ def cache_status(scene):
 
 # --------------------------------------------------------------------------- operator
 
-class TEMPERA_OT_render_guides(Operator):
+class TEMPERA_OT_render_guides(JobOperator, Operator):
     """Render the guide passes of the frames set in the Guides box into the guide cache
     (frames already cached and current are skipped; Esc stops after the current frame)"""
 
@@ -213,7 +218,7 @@ class TEMPERA_OT_render_guides(Operator):
     bl_label = "Render Guides"
     bl_options = {"REGISTER"}
 
-    _running = False  # one run at a time: the button is greyed out meanwhile
+    job_errors = (ValueError, GuideRenderError)
 
     @classmethod
     def poll(cls, context):
@@ -222,119 +227,5 @@ class TEMPERA_OT_render_guides(Operator):
             return False
         return context.scene is not None and hasattr(context.scene, "tempera")
 
-    # -- shared
-
-    def _job(self, context):
-        try:
-            return GuideJob.from_settings(context.scene)
-        except (ValueError, GuideRenderError) as exc:
-            self.report({"ERROR"}, str(exc))
-            return None
-
-    def _step(self, job, progress=None):
-        """One frame; True if it went well, else the error is reported."""
-        try:
-            job.step(progress)
-            return True
-        except (ValueError, GuideRenderError) as exc:
-            message = str(exc)
-        except Exception as exc:  # e.g. disk full: a message for the artist, the details on the console
-            traceback.print_exc()
-            message = f"{type(exc).__name__}: {exc}"
-        frame = job.frames[job.index]
-        self.report({"ERROR"}, f"Guides of frame {frame} failed: {message}")
-        return False
-
-    # -- background / scripts: every frame now
-
-    def execute(self, context):
-        job = self._job(context)
-        if job is None:
-            return {"CANCELLED"}
-        wm = context.window_manager
-        type(self)._running = True
-        wm.progress_begin(0, job.total)
-        try:
-            while not job.finished:
-                if bpy.app.background:
-                    print(job.status_text().replace(" (Esc to stop)", ""), flush=True)
-                done = job.index
-                if not self._step(job, lambda f: wm.progress_update(done + f)):
-                    return {"CANCELLED"}
-                wm.progress_update(job.index)
-        finally:
-            wm.progress_end()
-            type(self)._running = False
-        self.report({"INFO"}, job.summary())
-        return {"FINISHED"}
-
-    # -- UI: one frame per timer step
-
-    def invoke(self, context, event):
-        if bpy.app.background or context.window is None:
-            return self.execute(context)
-        self._guide_job = job = self._job(context)
-        if job is None:
-            return {"CANCELLED"}
-        wm = context.window_manager
-        type(self)._running = True
-        self._timer = wm.event_timer_add(TIMER_STEP, window=context.window)
-        wm.modal_handler_add(self)
-        wm.progress_begin(0, job.total)
-        self._show(context, job)
-        return {"RUNNING_MODAL"}
-
-    def modal(self, context, event):
-        job = self._guide_job
-        if event.type == "ESC" and event.value == "PRESS":
-            self._finish(context)
-            self.report({"WARNING"}, f"Stopped. {job.summary()}")
-            return {"CANCELLED"}
-        if event.type != "TIMER":
-            return {"PASS_THROUGH"}
-        wm = context.window_manager
-        # A fresh timer after each (long) frame: the window redraws and Esc is
-        # seen before the next frame starts.
-        wm.event_timer_remove(self._timer)
-        self._timer = None
-        done = job.index
-        ok = self._step(job, lambda f: wm.progress_update(done + f))
-        if not ok:
-            self._finish(context)
-            return {"CANCELLED"}
-        if job.finished:
-            self._finish(context)
-            self.report({"INFO"}, job.summary())
-            return {"FINISHED"}
-        wm.progress_update(job.index)
-        self._show(context, job)
-        self._timer = wm.event_timer_add(TIMER_STEP, window=context.window)
-        return {"PASS_THROUGH"}
-
-    def cancel(self, context):
-        """Blender ends the operator (a file is loaded, the window closes)."""
-        self._finish(context)
-
-    def _show(self, context, job):
-        if context.workspace is not None:
-            context.workspace.status_text_set(job.status_text())
-        _redraw_properties(context)
-
-    def _finish(self, context):
-        wm = context.window_manager
-        if getattr(self, "_timer", None) is not None:
-            wm.event_timer_remove(self._timer)
-            self._timer = None
-        wm.progress_end()
-        if context.workspace is not None:
-            context.workspace.status_text_set(None)
-        _redraw_properties(context)
-        type(self)._running = False
-
-
-def _redraw_properties(context):
-    """The panel's cache line follows the frames as they are written."""
-    screen = context.screen
-    for area in screen.areas if screen else ():
-        if area.type == "PROPERTIES":
-            area.tag_redraw()
+    def make_job(self, context):
+        return GuideJob.from_settings(context.scene)

@@ -1,6 +1,6 @@
 """Per-scene Tempera settings, stored in the .blend file as Scene.tempera."""
 import bpy
-from bpy.props import EnumProperty, FloatProperty, IntProperty, StringProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 from bpy.types import PropertyGroup
 
 from .. import guide_cache
@@ -28,6 +28,41 @@ _MASK_ITEMS = (
     ("NONE", "None", "No mask guides"),
 )
 _DEFAULT_MASK_MODE = next(k for k, v in GUIDE_MASK_MODES.items() if v == guide_cache.DEFAULT_PARAMS["masks"])
+
+
+EXEMPLAR_SOURCES = (
+    ("KIT", "Bundled Kit", "The sphere-on-a-table exemplar shipped with the add-on, painted in coloured pencil"),
+    ("CUSTOM", "Custom", "Your painting and the guide cache of the exemplar scene it was painted over"),
+)
+USAGE_ITEMS = (
+    ("budget", "Error Budget", "StyLit: every exemplar patch is used about equally, except those that fit "
+     "nowhere (no wash-out, no forced misfits). The default"),
+    ("uniform", "Uniform", "Every exemplar patch used equally often (LazyFluids); may force misfits"),
+    ("penalty", "Occurrence Penalty", "Overused patches cost more (Kaspar et al.); a softer uniformity"),
+    ("none", "None", "Plain nearest neighbours: fastest, may wash out into few favourite patches"),
+)
+QUALITY_ITEMS = (
+    ("preview", "Preview", "Fewer solver iterations: quick look at a frame"),
+    ("final", "Final", "Full solver iterations"),
+)
+FORMAT_ITEMS = (
+    ("png", "PNG", "8-bit sRGB PNG frames"),
+    ("exr", "OpenEXR", "32-bit float EXR frames (the painting's values, unclamped)"),
+)
+RESULT_ITEMS = (
+    ("SEQUENCER", "Sequencer Scene", "A scene '<scene> Tempera' whose sequencer plays the stylized frames "
+     "(your scene is left untouched)"),
+    ("IMAGE", "Image", "An image sequence data-block, for the Image Editor or the compositor's Image node"),
+    ("NONE", "Nothing", "Only write the files"),
+)
+# Guide-cache guide name -> the Scene.tempera property holding its weight.
+WEIGHT_PROPERTIES = {"FULL": "weight_full", "LDE": "weight_lde", "LSE": "weight_lse",
+                     "LDDE": "weight_ldde", "LD12E": "weight_ld12e"}
+
+
+def _weight(guide, label, description):
+    return FloatProperty(name=label, description=description, min=0.0, soft_max=4.0,
+                         default=limits.DEFAULT_GUIDE_WEIGHTS[guide])
 
 
 def _keep_patch_size_odd(self, _context):
@@ -85,7 +120,7 @@ class TemperaSettings(PropertyGroup):
     )
     guide_frame_range: EnumProperty(
         name="Frames",
-        description="Which frames Render Guides renders (frames already in the cache and current are skipped)",
+        description="Frames of Render Guides and Stylize Animation (frames already done and current are skipped)",
         items=GUIDE_FRAME_RANGES,
         default="SCENE",
     )
@@ -139,3 +174,51 @@ class TemperaSettings(PropertyGroup):
                      "(R = screen x, G = screen y); empty: orientation computed from the render"),
         default=guide_cache.DEFAULT_PARAMS["orientation_aov"],
     )
+
+    # Exemplar and stylization (Stylize operator, tempera.blender.stylize_operator).
+    exemplar_source: EnumProperty(name="Exemplar", items=EXEMPLAR_SOURCES, default="KIT",
+                                  description="Where the style comes from")
+    exemplar_style: StringProperty(
+        name="Painting",
+        description="Your painted exemplar (PNG, JPEG, TIFF or EXR), painted over the exemplar scene's render; "
+        "'//' is relative to the .blend file",
+        subtype="FILE_PATH",
+        default="",
+    )
+    exemplar_guide_dir: StringProperty(
+        name="Exemplar Guides",
+        description="Guide cache of the exemplar scene (Render Guides on that scene, or `tempera render-guides`)",
+        subtype="DIR_PATH",
+        default="",
+    )
+    exemplar_frame: IntProperty(
+        name="Exemplar Frame",
+        description="Frame of the exemplar guide cache the painting matches; 0: the cache's only frame",
+        default=0,
+        min=0,
+    )
+    weight_full: _weight("FULL", "Full GI", "Weight of the whole render (all light paths, L.*E)")
+    weight_lde: _weight("LDE", "Direct Diffuse", "Weight of direct diffuse light (LDE): shading and shadows")
+    weight_lse: _weight("LSE", "Direct Specular", "Weight of direct specular light (LSE): highlights")
+    weight_ldde: _weight("LDDE", "Diffuse Interreflection",
+                         "Weight of diffuse interreflections (L.*DDE): colour bleeding, soft fill")
+    weight_ld12e: _weight("LD12E", "First Two Diffuse Bounces",
+                          "Weight of the first two diffuse bounces (LD{1,2}E)")
+    usage: EnumProperty(name="Patch Usage", items=USAGE_ITEMS, default="budget",
+                        description="How evenly the exemplar's patches are used")
+    quality: EnumProperty(name="Quality", items=QUALITY_ITEMS, default="final",
+                          description="Solver effort per frame")
+    temporal_weight: FloatProperty(
+        name="Temporal Coherence",
+        description="Pull of the previous stylized frame, moved along the rendered motion: higher values "
+        "flicker less but let the paint stick and smear; 0 stylizes each frame on its own",
+        default=limits.DEFAULT_TEMPORAL_WEIGHT,
+        min=0.0,
+        soft_max=2.0,
+    )
+    output_format: EnumProperty(name="Format", items=FORMAT_ITEMS, default="png",
+                                description="File format of the stylized frames")
+    make_video: BoolProperty(name="Video (mp4)", default=True,
+                             description="Also encode the stylized animation as an mp4 (needs ffmpeg)")
+    load_result: EnumProperty(name="Load Result", items=RESULT_ITEMS, default="SEQUENCER",
+                              description="What to load into Blender after Stylize Animation")

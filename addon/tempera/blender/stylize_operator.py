@@ -1,0 +1,244 @@
+"""Stylize Frame / Stylize Animation: StyLit over the scene's frames.
+
+    bpy.ops.tempera.stylize(mode="ANIMATION")   # or mode="FRAME": the current frame
+
+One run has two phases, each a step per frame (tempera.blender.job_operator
+runs them: modal with progress and Esc in the UI, all at once in background):
+
+1. guides: the scene's guide cache is brought up to date (frames already
+   current are skipped, see guide_operator.GuideJob);
+2. stylize: tempera.stylize.StylizeJob, the native sequence driver, stylizes
+   one frame per step in a worker thread (the solver releases the GIL), with
+   the previous stylized frame as temporal guide. Frames already stylized
+   with the same settings are skipped, so a rerun resumes where a stopped
+   run ended; every file is written atomically.
+
+After the last frame of an animation: a contact sheet, an mp4 (when ffmpeg
+is present) and the result loaded back into Blender (Load Result).
+"""
+import os
+import time
+
+import bpy
+from bpy.types import Operator
+from bpy.props import EnumProperty
+
+from .. import kit, settings as limits
+from .guide_operator import GuideJob, format_duration, guide_frames, resolve_guide_dir
+from .guide_render import GuideRenderError
+from .job_operator import JobOperator
+from .properties import WEIGHT_PROPERTIES
+from . import results
+
+FRAMES_DIR = "frames"
+CONTACT_SHEET = "contact_sheet.png"
+VIDEO = "stylized.mp4"
+
+
+# --------------------------------------------------------------------------- settings -> job
+
+def resolve_path(setting, what, blend_filepath=None):
+    """Absolute path of a path setting ('//' relative to the .blend file)."""
+    path = setting.strip()
+    if not path:
+        raise ValueError(f"Set the {what} in Output Properties > Tempera.")
+    if path.startswith("//"):
+        blend_filepath = bpy.data.filepath if blend_filepath is None else blend_filepath
+        if not blend_filepath:
+            raise ValueError(f"Save the .blend file first: the {what} '{setting}' is relative to it ('//'). "
+                             "Or choose an absolute path.")
+        path = bpy.path.abspath(path, start=os.path.dirname(blend_filepath))
+    return os.path.normpath(path)
+
+
+def exemplar_paths(settings):
+    """(painting, exemplar guide cache, exemplar frame or None) of the Exemplar setting."""
+    if settings.exemplar_source == "KIT":
+        style, guides = kit.kit_exemplar()
+        return str(style), str(guides), None
+    style = resolve_path(settings.exemplar_style, "exemplar Painting")
+    guides = resolve_path(settings.exemplar_guide_dir, "Exemplar Guides folder")
+    if not os.path.isfile(style):
+        raise FileNotFoundError(f"The exemplar painting '{style}' does not exist.")
+    if not os.path.isdir(guides):
+        raise FileNotFoundError(f"The exemplar guide folder '{guides}' does not exist "
+                                "(render the exemplar scene's guides first).")
+    return style, guides, settings.exemplar_frame or None
+
+
+def stylize_options(settings):
+    """The StylizeJob options of Scene.tempera (everything but paths and frames)."""
+    return {
+        "weights": {guide: float(getattr(settings, prop)) for guide, prop in WEIGHT_PROPERTIES.items()},
+        "temporal_weight": float(settings.temporal_weight),
+        "quality": settings.quality,
+        "usage": settings.usage,
+        "patch_size": limits.odd_patch_size(settings.patch_size),
+        "seed": int(settings.seed),
+        "format": settings.output_format,
+    }
+
+
+def output_dir(settings):
+    return resolve_path(settings.output_dir, "Output Folder")
+
+
+class StylizeRun:
+    """The steps of one Stylize run: guides of every frame, then StyLit per frame."""
+
+    def __init__(self, scene, frames, mode="ANIMATION"):
+        settings = scene.tempera
+        self.mode = mode
+        self.frames = list(frames)
+        self.out = output_dir(settings)
+        style, exemplar_guides, exemplar_frame = exemplar_paths(settings)
+        self.guides = GuideJob.from_settings(scene, self.frames)
+        self.config = dict(stylize_options(settings), style=style, exemplar_guides=exemplar_guides,
+                           guides=self.guides.folder, frames=self.frames,
+                           out=os.path.join(self.out, FRAMES_DIR))
+        if exemplar_frame is not None:
+            self.config["exemplar_frame"] = exemplar_frame
+        self.job = None  # the native StylizeJob, made once the guides exist
+        self.index = 0
+        self.results = []
+        self.stylize_seconds = 0.0
+        self.warnings = []
+
+    @classmethod
+    def from_settings(cls, scene, mode="ANIMATION"):
+        frames = [scene.frame_current] if mode == "FRAME" else guide_frames(scene, scene.tempera)
+        return cls(scene, frames, mode)
+
+    @property
+    def total(self):
+        return 2 * len(self.frames)
+
+    @property
+    def finished(self):
+        return self.index >= self.total
+
+    @property
+    def in_guide_phase(self):
+        return self.index < len(self.frames)
+
+    def threaded(self):
+        return not self.in_guide_phase  # the solver needs no bpy
+
+    def step(self, progress=None):
+        if self.in_guide_phase:
+            self.guides.step(progress)
+        else:
+            self._stylize(progress)
+        self.index += 1
+
+    def _stylize(self, progress):
+        from ..stylize import StylizeJob
+
+        if self.job is None:
+            self.job = StylizeJob(**self.config)
+            self.warnings = list(self.job.warnings)
+            for warning in self.warnings:
+                print(f"Tempera: {warning}", flush=True)
+        started = time.monotonic()
+        result = self.job.run_frame(self.index - len(self.frames), progress)
+        seconds = time.monotonic() - started
+        if result["status"] == "stylized":
+            self.stylize_seconds += seconds
+        self.results.append(result)
+        if bpy.app.background:  # the console is the only progress display
+            flicker = result.get("flicker")
+            note = f", flicker {flicker:.3f}" if flicker is not None and flicker == flicker else ""
+            print(f"Tempera: frame {result['frame']} {result['status']} in {seconds:.1f} s{note}", flush=True)
+
+    def current_frame(self):
+        frames = self.frames
+        return frames[min(self.index, self.total - 1) % len(frames)]
+
+    def failure(self, exc):
+        what = "Guides" if self.in_guide_phase else "Stylizing"
+        return f"{what} of frame {self.current_frame()} failed: {exc}"
+
+    def eta_seconds(self):
+        stylized = [r for r in self.results if r["status"] == "stylized"]
+        if not stylized:
+            return None
+        return self.stylize_seconds / len(stylized) * (len(self.frames) - len(self.results))
+
+    def status_text(self):
+        if self.in_guide_phase:
+            return self.guides.status_text()
+        eta = self.eta_seconds()
+        current = min(len(self.results) + 1, len(self.frames))
+        return (f"Tempera: stylizing frame {current}/{len(self.frames)}, "
+                f"ETA {'…' if eta is None else format_duration(eta)} (Esc to stop)")
+
+    def mean_flicker(self):
+        values = [r["flicker"] for r in self.results if r.get("flicker") is not None and r["flicker"] == r["flicker"]]
+        return sum(values) / len(values) if values else None
+
+    def summary(self):
+        done = [r for r in self.results if r["status"] == "stylized"]
+        parts = [f"{len(done)} stylized"]
+        skipped = len(self.results) - len(done)
+        if skipped:
+            parts.append(f"{skipped} already done")
+        left = len(self.frames) - len(self.results)
+        if left:
+            parts.append(f"{left} not done")
+        flicker = self.mean_flicker()
+        tail = f", flicker {flicker:.3f}" if flicker is not None else ""
+        return f"Tempera: {', '.join(parts)} in {self.config['out']}{tail}"
+
+
+# --------------------------------------------------------------------------- operator
+
+class TEMPERA_OT_stylize(JobOperator, Operator):
+    """Stylize the scene with the exemplar: renders missing guides, then paints every frame
+    (frames already done with the same settings are skipped; Esc stops)"""
+
+    bl_idname = "tempera.stylize"
+    bl_label = "Stylize"
+    bl_options = {"REGISTER"}
+
+    mode: EnumProperty(
+        name="Frames",
+        items=(("FRAME", "Current Frame", "Stylize the current frame"),
+               ("ANIMATION", "Animation", "Stylize the frame range of the Frames setting")),
+        default="ANIMATION",
+    )
+
+    job_errors = (ValueError, OSError, GuideRenderError)
+
+    @classmethod
+    def description(cls, _context, properties):
+        if properties.mode == "FRAME":
+            return "Stylize the current frame with the exemplar (renders its guides first if needed)"
+        return ("Stylize the frame range with the exemplar: renders missing guides, then paints every frame "
+                "(frames already done with the same settings are skipped; Esc stops)")
+
+    @classmethod
+    def poll(cls, context):
+        if cls._running:
+            cls.poll_message_set("Tempera is already stylizing")
+            return False
+        return context.scene is not None and hasattr(context.scene, "tempera")
+
+    def make_job(self, context):
+        return StylizeRun.from_settings(context.scene, self.mode)
+
+    def job_finished(self, context, job):
+        settings = context.scene.tempera
+        frames_dir = job.config["out"]
+        paths = [r["path"] for r in job.results]
+        if job.mode == "ANIMATION":
+            sheet = os.path.join(job.out, CONTACT_SHEET)
+            job.job.write_contact_sheet(sheet)
+            if settings.make_video:
+                from ..stylize import encode_video
+
+                fps = context.scene.render.fps / context.scene.render.fps_base
+                if not encode_video(job.job, os.path.join(job.out, VIDEO), fps):
+                    self.report({"WARNING"}, "ffmpeg not found: no mp4 written (the frames are there)")
+        results.load(context.scene, paths, job.frames, settings.load_result if job.mode == "ANIMATION" else "IMAGE")
+        for warning in job.warnings:
+            self.report({"WARNING"}, warning)
