@@ -9,7 +9,7 @@ proper temporal method.)
 """
 import numpy as np
 
-from . import guides
+from . import _native, guides
 from .guide_cache import velocities_from_vector_pass
 
 
@@ -24,8 +24,10 @@ def motion(vector_pass, previous_vector_pass, epsilon=2.0):
 def flicker(previous_stylized, stylized, velocity_backward, visible):
     """Mean absolute colour change along valid motion between two stylized
     frames (0 = the paint moves perfectly with the surface)."""
-    advected = guides.warp_backward(previous_stylized, velocity_backward)
-    mask = np.asarray(visible, bool)
-    if not mask.any():
-        return 0.0
-    return float(np.abs(np.asarray(stylized) - advected)[mask].mean())
+    def image(a):
+        a = np.ascontiguousarray(a, dtype=np.float32)
+        return a[:, :, None] if a.ndim == 2 else a
+
+    visible = np.asarray(visible)
+    return _native.flicker(image(previous_stylized), image(stylized), image(velocity_backward),
+                           image((visible != 0).astype(np.float32)))
