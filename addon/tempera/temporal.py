@@ -2,10 +2,9 @@
 Blender: per-frame motion and visibility (Bénard et al. 2013's χ−) from
 Blender's Vector passes, and the flicker figure of two stylized frames.
 
-(A temporal guide built from the previous stylized frame advected along the
-motion was tried in the demo: at weights 0.3-1 it cut the flicker from 0.031
-to 0.012-0.006 but washed the paint out over the frames, so it waits for a
-proper temporal method.)
+The temporal guide itself (the previous stylized frame advected along the
+motion, weighted by χ−) is part of StyLit per frame: tempera.stylize
+(native/src/stylit.cpp); flicker() here is the same native figure.
 """
 import numpy as np
 
