@@ -54,7 +54,7 @@ const char* kStylizeHelp =
     "                          guides not listed keep their default, 0 leaves a guide out\n"
     "  --temporal W            weight of the temporal guide: the previous stylized frame\n"
     "                          advected along the motion (default 0 = frames independent)\n"
-    "  --quality Q             final (default) | preview (about 4x faster, for trying settings)\n"
+    "  --quality Q             final (default) | preview (about 5x faster, for trying settings)\n"
     "  --usage MODE            none | penalty | uniform | budget (default budget)\n"
     "  --patch-size N          odd patch width (default 5)\n"
     "  --seed N                random seed (default 1)\n"

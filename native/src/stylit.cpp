@@ -120,7 +120,7 @@ std::vector<std::pair<std::string, float>> active_guides(const StylitOptions& op
 SynthesisOptions engine_options(const StylitOptions& options) {
   SynthesisOptions opt = options.synthesis;
   if (options.quality == Quality::Preview) {
-    // Measured at 320x240 (docs/engine.md): about 4x faster than final; the
+    // Measured at 320x240 (docs/engine.md): about 5x faster than final; the
     // coarse levels settle with few iterations and the finest level gets the
     // error-budget rounds that matter most for the look.
     opt.em_iterations = 2;

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -48,7 +49,7 @@ std::string file_stamp(const std::string& path) {
   std::error_code ec;
   const auto size = fs::file_size(path, ec);
   const auto mtime = fs::last_write_time(path, ec).time_since_epoch().count();
-  return concat(path, "|", size, "|", mtime);
+  return concat(size, "|", mtime);
 }
 
 void require_file(const std::string& path, const std::string& what) {
@@ -68,7 +69,7 @@ std::vector<int> cached_frames(const std::string& folder) {
     const std::string name = entry.path().filename().string();
     if (name.size() <= 10 || name.rfind("frame_", 0) != 0 || entry.path().extension() != ".exr") continue;
     const std::string digits = name.substr(6, name.size() - 10);
-    if (!digits.empty() && std::all_of(digits.begin(), digits.end(), ::isdigit)) frames.push_back(std::stoi(digits));
+    if (!digits.empty() && std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c); })) frames.push_back(std::stoi(digits));
   }
   std::sort(frames.begin(), frames.end());
   return frames;
@@ -304,7 +305,7 @@ StylizeJob::StylizeJob(StylizeJobConfig config) : config_(std::move(config)) {
   settings_ = settings_text(config_);
   const std::string base = hash_hex(settings_ + "\n" + file_stamp(config_.style) + "\n" + file_stamp(exemplar_path_));
   for (std::size_t i = 0; i < config_.frames.size(); ++i) {
-    std::string text = base + "\n" + file_stamp(target_path(config_.frames[i]));
+    std::string text = concat(base, "\n", config_.frames[i], "\n", file_stamp(target_path(config_.frames[i])));
     // A temporally chained frame depends on its predecessor's result too.
     if (has_temporal_predecessor(i) && config_.stylit.temporal_weight > 0) text += "\n" + keys_.back();
     keys_.push_back(hash_hex(text));
