@@ -304,12 +304,11 @@ StylizeJob::StylizeJob(StylizeJobConfig config) : config_(std::move(config)) {
     throw IoError(concat("cannot create the output folder '", config_.out, "'"));
   settings_ = settings_text(config_);
   const std::string base = hash_hex(settings_ + "\n" + file_stamp(config_.style) + "\n" + file_stamp(exemplar_path_));
-  for (std::size_t i = 0; i < config_.frames.size(); ++i) {
-    std::string text = concat(base, "\n", config_.frames[i], "\n", file_stamp(target_path(config_.frames[i])));
-    // A temporally chained frame depends on its predecessor's result too.
-    if (has_temporal_predecessor(i) && config_.stylit.temporal_weight > 0) text += "\n" + keys_.back();
-    keys_.push_back(hash_hex(text));
-  }
+  // The predecessor's result is deliberately not part of a frame's key: frames
+  // made on several machines (each chain starting at its own first frame) stay
+  // current when one run over the whole range assembles the sheet and video.
+  for (int frame : config_.frames)
+    keys_.push_back(hash_hex(concat(base, "\n", frame, "\n", file_stamp(target_path(frame)))));
 }
 
 // Every target frame has the light-path guides; motion guides are needed for

@@ -115,3 +115,15 @@ def test_stylize_frame_in_memory_and_tonemap():
     assert warm.shape == image.shape
     linear = np.array([[[-1.0, 0.0, 0.002], [0.5, 4.0, np.nan]]], np.float32)
     np.testing.assert_allclose(_native.tonemap_guide(linear), tonemap(linear), atol=1e-7)
+
+
+def test_frames_split_over_machines_stay_current(inputs):
+    def split_job(frames):
+        return StylizeJob(inputs / "paint.png", inputs / "exemplar", inputs / "cache", frames, inputs / "out",
+                          temporal_weight=0.5, threads=2)
+
+    for frames in ([1, 2], [3]):  # two machines, one shared output folder
+        j = split_job(frames)
+        assert [j.run_frame(i)["status"] for i in range(len(frames))] == ["stylized"] * len(frames)
+    whole = split_job([1, 2, 3])
+    assert [whole.run_frame(i)["status"] for i in range(3)] == ["skipped"] * 3
