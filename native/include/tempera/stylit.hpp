@@ -27,7 +27,6 @@ struct GuideFrame {
   std::map<std::string, Image> guides;
   std::string origin = "memory";  // the file they came from, for error messages
 
-  bool has(const std::string& name) const { return guides.count(name) != 0; }
   // ValueError naming the guide and `origin` when it is missing.
   const Image& get(const std::string& name) const;
 

@@ -43,7 +43,6 @@ class StylizeJob {
 
   const std::vector<int>& frames() const { return config_.frames; }
   const std::vector<std::string>& warnings() const { return warnings_; }
-  const StylizeJobConfig& config() const { return config_; }
   std::string output_path(int frame) const;
   std::string report_path() const;
 
