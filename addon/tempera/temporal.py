@@ -2,14 +2,13 @@
 Blender: per-frame motion and visibility (Bénard et al. 2013's χ−) from
 Blender's Vector passes, and the flicker figure of two stylized frames.
 
-(A temporal guide built from the previous stylized frame advected along the
-motion was tried in the demo: at weights 0.3-1 it cut the flicker from 0.031
-to 0.012-0.006 but washed the paint out over the frames, so it waits for a
-proper temporal method.)
+The temporal guide itself (the previous stylized frame advected along the
+motion, weighted by χ−) is part of StyLit per frame: tempera.stylize
+(native/src/stylit.cpp); flicker() here is the same native figure.
 """
 import numpy as np
 
-from . import guides
+from . import _native, guides
 from .guide_cache import velocities_from_vector_pass
 
 
@@ -24,8 +23,10 @@ def motion(vector_pass, previous_vector_pass, epsilon=2.0):
 def flicker(previous_stylized, stylized, velocity_backward, visible):
     """Mean absolute colour change along valid motion between two stylized
     frames (0 = the paint moves perfectly with the surface)."""
-    advected = guides.warp_backward(previous_stylized, velocity_backward)
-    mask = np.asarray(visible, bool)
-    if not mask.any():
-        return 0.0
-    return float(np.abs(np.asarray(stylized) - advected)[mask].mean())
+    def image(a):
+        a = np.ascontiguousarray(a, dtype=np.float32)
+        return a[:, :, None] if a.ndim == 2 else a
+
+    visible = np.asarray(visible)
+    return _native.flicker(image(previous_stylized), image(stylized), image(velocity_backward),
+                           image((visible != 0).astype(np.float32)))

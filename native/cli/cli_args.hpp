@@ -46,5 +46,22 @@ class ArgReader {
 
 int run_synth(const Args& args);
 int run_render_guides(const Args& args);
+int run_stylize(const Args& args);
+
+// Which Blender renders guides, and where it finds the tempera package.
+struct BlenderSetup {
+  std::string blender;  // $TEMPERA_BLENDER or "blender"
+  std::string addon;    // $TEMPERA_ADDON_PATH or this build's addon folder
+};
+BlenderSetup default_blender_setup();
+
+// Renders `scene`'s guide cache in background Blender with the add-on's
+// renderer; `options` are render-guides options (--frames, --out, ...).
+// Returns Blender's exit status. FileNotFoundError for a missing scene,
+// Blender or package.
+int render_guides_in_blender(const BlenderSetup& setup, const std::string& scene, const Args& options);
+
+// Sorted unique frames of "1-24" or "1-10,15" (ValueError naming the bad part).
+std::vector<int> parse_frames(const std::string& text);
 
 }  // namespace tempera::cli

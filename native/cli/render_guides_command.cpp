@@ -1,15 +1,17 @@
 // `tempera render-guides SCENE.blend --frames A-B --out DIR [...]`: renders a
 // scene's guide cache by running Blender in the background on the file (which
 // is opened, never written) with the add-on's guide renderer.
-#include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <charconv>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
 
 #include "cli_args.hpp"
 #include "tempera/error.hpp"
+#include "tempera/process.hpp"
 
 namespace fs = std::filesystem;
 
@@ -46,26 +48,33 @@ std::string env_or(const char* name, const std::string& fallback) {
   return value && *value ? value : fallback;
 }
 
-// Runs argv, waits, and returns its exit status (128 + signal if killed).
-int run_process(const std::vector<std::string>& argv) {
-  std::vector<char*> raw;
-  for (const auto& a : argv) raw.push_back(const_cast<char*>(a.c_str()));
-  raw.push_back(nullptr);
-  const pid_t pid = fork();
-  if (pid < 0) throw IoError("cannot start Blender: fork failed");
-  if (pid == 0) {
-    execvp(raw[0], raw.data());
-    std::cerr << "tempera render-guides: error: cannot run '" << argv[0]
-              << "' (install Blender or pass --blender PATH)\n";
-    _exit(127);
-  }
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0) {
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}  // namespace
+
+BlenderSetup default_blender_setup() {
+  return {env_or("TEMPERA_BLENDER", "blender"),
+          env_or("TEMPERA_ADDON_PATH", fs::path(TEMPERA_PYTHON_PACKAGE_DIR).parent_path().string())};
 }
 
-}  // namespace
+int render_guides_in_blender(const BlenderSetup& setup, const std::string& scene, const Args& options) {
+  std::error_code ec;
+  if (!fs::is_regular_file(scene, ec)) throw FileNotFoundError(concat("scene file not found: '", scene, "'"));
+  if (!fs::is_directory(fs::path(setup.addon) / "tempera", ec))
+    throw FileNotFoundError(concat("no tempera package in '", setup.addon, "' (pass --addon-path)"));
+  const bool found = setup.blender.find('/') != std::string::npos ? access(setup.blender.c_str(), X_OK) == 0
+                                                                   : !find_on_path(setup.blender).empty();
+  if (!found)
+    throw FileNotFoundError(concat("cannot run '", setup.blender, "' (install Blender or pass --blender PATH)"));
+  // The package path travels as an argument, not inside the Python code, so
+  // no quoting of paths is ever needed.
+  const std::string bootstrap =
+      "import sys; sys.path.insert(0, sys.argv[sys.argv.index('--') + 1]); "
+      "del sys.argv[sys.argv.index('--') + 1]; "
+      "from tempera.blender.render_guides_main import main; main()";
+  std::vector<std::string> argv = {setup.blender, "-b", "--factory-startup", scene, "--python-exit-code", "1",
+                                   "--python-expr", bootstrap, "--", setup.addon};
+  argv.insert(argv.end(), options.begin(), options.end());
+  return run_process(argv);
+}
 
 int run_render_guides(const Args& args) {
   ArgReader in(args, "render-guides");
@@ -75,36 +84,51 @@ int run_render_guides(const Args& args) {
   }
   const std::string scene = args[0];
   if (scene.rfind("--", 0) == 0) throw ValueError("the first argument must be the .blend file");
-  std::error_code ec;
-  if (!fs::is_regular_file(scene, ec)) throw FileNotFoundError(concat("scene file not found: '", scene, "'"));
-  std::string blender = env_or("TEMPERA_BLENDER", "blender");
-  std::string addon = env_or("TEMPERA_ADDON_PATH", fs::path(TEMPERA_PYTHON_PACKAGE_DIR).parent_path().string());
-  std::vector<std::string> forwarded;
+  BlenderSetup setup = default_blender_setup();
+  Args forwarded;
   bool has_frames = false, has_out = false;
   for (std::size_t i = 1; i < args.size(); ++i) {
     const std::string& a = args[i];
     if ((a == "--blender" || a == "--addon-path") && i + 1 < args.size()) {
-      (a == "--blender" ? blender : addon) = args[++i];
+      (a == "--blender" ? setup.blender : setup.addon) = args[++i];
       continue;
     }
     has_frames |= a == "--frames";
     has_out |= a == "--out";
     forwarded.push_back(a);
   }
+  std::error_code ec;
+  if (!fs::is_regular_file(scene, ec)) throw FileNotFoundError(concat("scene file not found: '", scene, "'"));
   if (!has_frames) throw ValueError("--frames is required (e.g. --frames 1-24)");
   if (!has_out) throw ValueError("--out is required (the guide cache folder)");
-  if (!fs::is_directory(fs::path(addon) / "tempera", ec))
-    throw FileNotFoundError(concat("no tempera package in '", addon, "' (pass --addon-path)"));
-  // The package path travels as an argument, not inside the Python code, so
-  // no quoting of paths is ever needed.
-  const std::string bootstrap =
-      "import sys; sys.path.insert(0, sys.argv[sys.argv.index('--') + 1]); "
-      "del sys.argv[sys.argv.index('--') + 1]; "
-      "from tempera.blender.render_guides_main import main; main()";
-  std::vector<std::string> argv = {blender, "-b", "--factory-startup", scene, "--python-exit-code", "1",
-                                   "--python-expr", bootstrap, "--", addon};
-  argv.insert(argv.end(), forwarded.begin(), forwarded.end());
-  return run_process(argv);
+  return render_guides_in_blender(setup, scene, forwarded);
+}
+
+std::vector<int> parse_frames(const std::string& text) {
+  const char* hint = " (write e.g. 1-24 or 1-10,15)";
+  std::vector<int> frames;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t end = std::min(text.find(',', start), text.size());
+    const std::string part = text.substr(start, end - start);
+    if (part.empty()) throw ValueError(concat("empty part in frame range '", text, "'", hint));
+    const std::size_t dash = part.find('-', 1);
+    int first = 0, last = 0;
+    const auto read = [&](const std::string& number, int& out) {
+      const auto [ptr, ec] = std::from_chars(number.data(), number.data() + number.size(), out);
+      if (ec != std::errc() || ptr != number.data() + number.size() || number.empty())
+        throw ValueError(concat("cannot read '", part, "' in frame range '", text, "'", hint));
+    };
+    read(part.substr(0, dash), first);
+    if (dash == std::string::npos) last = first;
+    else read(part.substr(dash + 1), last);
+    if (last < first) throw ValueError(concat("frame range '", part, "' ends before it starts"));
+    for (int f = first; f <= last; ++f) frames.push_back(f);
+    start = end + 1;
+  }
+  std::sort(frames.begin(), frames.end());
+  frames.erase(std::unique(frames.begin(), frames.end()), frames.end());
+  return frames;
 }
 
 }  // namespace tempera::cli

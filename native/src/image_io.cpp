@@ -1,5 +1,6 @@
 #include "tempera/image_io.hpp"
 
+#include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -180,6 +181,20 @@ void write_image(const std::string& path, const ImageView& image,
     fs::remove(temp, ec);
     throw IoError(concat("cannot move finished image into place at '", path, "': ", ec.message()));
   }
+}
+
+Image resize_image(const ImageView& image, int width, int height) {
+  require_nonempty(image, "image to resize");
+  if (width <= 0 || height <= 0) throw ValueError(concat("cannot resize to ", width, "x", height));
+  const OIIO::ImageSpec spec(image.width, image.height, image.channels, OIIO::TypeDesc::FLOAT);
+  // OIIO only reads through this pointer; its wrapping constructor takes it non-const.
+  const OIIO::ImageBuf src(spec, const_cast<float*>(image.data));
+  OIIO::ImageBuf dst(OIIO::ImageSpec(width, height, image.channels, OIIO::TypeDesc::FLOAT));
+  if (!OIIO::ImageBufAlgo::resize(dst, src))
+    throw IoError(concat("resizing to ", width, "x", height, " failed: ", dst.geterror()));
+  Image out(width, height, image.channels);
+  dst.get_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, out.data());
+  return out;
 }
 
 }  // namespace tempera

@@ -34,4 +34,8 @@ Image read_image_layer(const std::string& path, const std::string& layer);
 void write_image(const std::string& path, const ImageView& image,
                  const std::vector<std::string>& channel_names = {});
 
+// `image` resampled to width x height with OIIO's default filter for the
+// scale (a good downsampling filter, not point sampling). Any channel count.
+Image resize_image(const ImageView& image, int width, int height);
+
 }  // namespace tempera

@@ -1,0 +1,287 @@
+// `tempera stylize`: a whole shot in one command. Renders the guides through
+// background Blender when given .blend files (or takes existing guide caches,
+// as a render farm does), runs the StylizeJob frame by frame with resume, and
+// writes a contact sheet and a video.
+#include <csignal>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <optional>
+#include <sstream>
+
+#include "cli_args.hpp"
+#include "tempera/error.hpp"
+#include "tempera/process.hpp"
+#include "tempera/stylize_job.hpp"
+
+namespace fs = std::filesystem;
+
+namespace tempera::cli {
+namespace {
+
+const char* kStylizeHelp =
+    "usage: tempera stylize SCENE.blend --exemplar STYLE.png (--exemplar-scene EXEMPLAR.blend |\n"
+    "                       --exemplar-guides DIR) --frames A-B --out DIR [options]\n"
+    "       tempera stylize --guides DIR --exemplar STYLE.png --exemplar-guides DIR --frames A-B\n"
+    "                       --out DIR [options]\n"
+    "\n"
+    "Stylizes an animation with StyLit (light-path guides) from a painted exemplar.\n"
+    "With SCENE.blend the scene's guides are rendered first with background Blender into\n"
+    "--guides (default OUT/guides), and with --exemplar-scene the exemplar's guides into\n"
+    "OUT/exemplar_guides; guide frames already current are reused. The second form needs\n"
+    "no Blender: it reads existing guide caches (render farms).\n"
+    "\n"
+    "outputs:\n"
+    "  OUT/frames/frame_0001.png ...   stylized frames (each written atomically)\n"
+    "  OUT/frames/tempera_stylize.json settings, resume key and flicker per frame\n"
+    "  OUT/contact_sheet.png           the painting followed by the frames\n"
+    "  OUT/stylized.mp4                H.264 video (needs ffmpeg on PATH; PNG frames)\n"
+    "\n"
+    "inputs:\n"
+    "  --exemplar FILE         the painting, made on the exemplar render (same aspect)\n"
+    "  --exemplar-scene FILE   .blend of the exemplar render (guides rendered by Blender)\n"
+    "  --exemplar-guides DIR   guide cache of the exemplar render\n"
+    "  --exemplar-frame N      frame of the exemplar (default: 1 with --exemplar-scene,\n"
+    "                          else the only frame in --exemplar-guides)\n"
+    "  --guides DIR            guide cache of the animation (default OUT/guides with SCENE)\n"
+    "  --frames RANGE          frames to stylize, e.g. 1-24 or 1-10,15\n"
+    "  --out DIR               output folder\n"
+    "\n"
+    "stylization:\n"
+    "  --weights LIST          light-path guide weights (default FULL=1,LDE=2,LSE=1,LDDE=0.5,LD12E=0);\n"
+    "                          guides not listed keep their default, 0 leaves a guide out\n"
+    "  --temporal W            weight of the temporal guide: the previous stylized frame\n"
+    "                          advected along the motion (default 0 = frames independent)\n"
+    "  --quality Q             final (default) | preview (about 5x faster, for trying settings)\n"
+    "  --usage MODE            none | penalty | uniform | budget (default budget)\n"
+    "  --patch-size N          odd patch width (default 5)\n"
+    "  --seed N                random seed (default 1)\n"
+    "  --threads N             worker threads (default 0 = all cores)\n"
+    "  --format F              png (default) | exr (float, linear as painted)\n"
+    "  --fps F                 frame rate of the video (default 24)\n"
+    "  --no-video              do not encode OUT/stylized.mp4\n"
+    "  --no-resume             stylize every frame again, even if current\n"
+    "\n"
+    "guide rendering (SCENE.blend / --exemplar-scene only):\n"
+    "  --samples N             Cycles samples of the guide renders (default 16)\n"
+    "  --blender PATH          Blender to run (default: $TEMPERA_BLENDER or 'blender')\n"
+    "  --addon-path DIR        folder holding the tempera package\n"
+    "\n"
+    "Resume: a frame is skipped when its output exists and was made with the same settings,\n"
+    "painting and guide files (sizes and modification times); rerun the same command after\n"
+    "an interruption. Ctrl-C stops within the current frame; finished frames are kept.\n"
+    "Exit status: 0 done, 1 error, 2 bad usage, 130 interrupted.\n";
+
+volatile std::sig_atomic_t g_interrupted = 0;
+
+void on_sigint(int) { g_interrupted = 1; }
+
+struct Options {
+  std::string scene, exemplar, exemplar_scene, exemplar_guides, guides, frames_text, out, samples;
+  std::optional<int> exemplar_frame;
+  std::vector<int> frames;
+  StylitOptions stylit;
+  std::string format = "png";
+  double fps = 24;
+  bool video = true, resume = true;
+  BlenderSetup blender = default_blender_setup();
+};
+
+void parse_weights(const std::string& text, StylitOptions& opt) {
+  std::size_t start = 0;
+  while (start < text.size()) {
+    const std::size_t end = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, end - start);
+    const std::size_t eq = item.find('=');
+    if (eq == std::string::npos) throw ValueError(concat("--weights expects NAME=W items, got '", item, "'"));
+    const std::string name = item.substr(0, eq);
+    auto it = std::find_if(opt.weights.begin(), opt.weights.end(), [&](auto& w) { return w.first == name; });
+    if (it == opt.weights.end())
+      throw ValueError(concat("unknown guide '", name, "' in --weights (FULL, LDE, LSE, LDDE, LD12E)"));
+    const std::string number = item.substr(eq + 1);
+    float w = 0;
+    const auto [ptr, ec] = std::from_chars(number.data(), number.data() + number.size(), w);
+    if (ec != std::errc() || ptr != number.data() + number.size() || number.empty())
+      throw ValueError(concat("--weights: '", number, "' is not a number (in '", item, "')"));
+    it->second = w;
+    start = end + 1;
+  }
+}
+
+Options parse(const Args& args) {
+  Options o;
+  std::size_t first = 0;
+  if (!args.empty() && args[0].rfind("--", 0) != 0) o.scene = args[first++];  // SCENE.blend
+  const Args tail(args.begin() + first, args.end());
+  ArgReader r(tail, "stylize");
+  while (r.more()) {
+    const std::string flag = r.flag();
+    if (flag == "--exemplar") o.exemplar = r.value(flag);
+    else if (flag == "--exemplar-scene") o.exemplar_scene = r.value(flag);
+    else if (flag == "--exemplar-guides") o.exemplar_guides = r.value(flag);
+    else if (flag == "--exemplar-frame") o.exemplar_frame = r.number<int>(flag);
+    else if (flag == "--guides") o.guides = r.value(flag);
+    else if (flag == "--frames") o.frames = parse_frames(o.frames_text = r.value(flag));
+    else if (flag == "--out") o.out = r.value(flag);
+    else if (flag == "--weights") parse_weights(r.value(flag), o.stylit);
+    else if (flag == "--temporal") o.stylit.temporal_weight = r.number<float>(flag);
+    else if (flag == "--quality") o.stylit.quality = parse_quality(r.value(flag));
+    else if (flag == "--usage") o.stylit.synthesis.usage = parse_patch_usage(r.value(flag));
+    else if (flag == "--patch-size") o.stylit.synthesis.patch_size = r.number<int>(flag);
+    else if (flag == "--seed") o.stylit.synthesis.seed = r.number<std::uint64_t>(flag);
+    else if (flag == "--threads") o.stylit.synthesis.threads = r.number<int>(flag);
+    else if (flag == "--format") o.format = r.value(flag);
+    else if (flag == "--fps") o.fps = r.number<double>(flag);
+    else if (flag == "--no-video") o.video = false;
+    else if (flag == "--no-resume") o.resume = false;
+    else if (flag == "--samples") o.samples = std::to_string(r.number<int>(flag));
+    else if (flag == "--blender") o.blender.blender = r.value(flag);
+    else if (flag == "--addon-path") o.blender.addon = r.value(flag);
+    else throw ValueError(concat("unknown option '", flag, "' (see tempera stylize --help)"));
+  }
+  if (o.exemplar.empty()) throw ValueError("--exemplar is required (the painting)");
+  if (o.frames.empty()) throw ValueError("--frames is required (e.g. --frames 1-24)");
+  if (o.out.empty()) throw ValueError("--out is required (the output folder)");
+  if (o.exemplar_scene.empty() == o.exemplar_guides.empty())
+    throw ValueError("give one of --exemplar-scene EXEMPLAR.blend or --exemplar-guides DIR");
+  if (o.scene.empty() && o.guides.empty())
+    throw ValueError("give SCENE.blend as the first argument, or --guides DIR with an existing guide cache");
+  if (!(o.fps > 0)) throw ValueError(concat("--fps must be > 0, got ", o.fps));
+  if (o.guides.empty()) o.guides = (fs::path(o.out) / "guides").string();
+  return o;
+}
+
+void render_guides(const Options& o, const std::string& scene, const std::string& frames, const std::string& out) {
+  Args options = {"--frames", frames, "--out", out};
+  if (!o.samples.empty()) options.insert(options.end(), {"--samples", o.samples, "--ld12e-samples", o.samples});
+  std::cerr << "tempera stylize: rendering the guides of " << scene << " (frames " << frames << ") into " << out
+            << "\n";
+  const int status = render_guides_in_blender(o.blender, scene, options);
+  if (g_interrupted) throw CancelledError("interrupted while rendering guides");
+  if (status != 0)
+    throw IoError(concat("rendering the guides of '", scene, "' failed (Blender exit status ", status, ")"));
+}
+
+std::string clock_text(double seconds) {
+  const long s = std::lround(seconds);
+  std::ostringstream out;
+  out << s / 60 << ":" << std::setw(2) << std::setfill('0') << s % 60;
+  return out.str();
+}
+
+bool consecutive(const std::vector<int>& frames) {
+  for (std::size_t i = 1; i < frames.size(); ++i)
+    if (frames[i] != frames[i - 1] + 1) return false;
+  return true;
+}
+
+// Runs every frame with a progress line each; returns false if interrupted.
+bool run_frames(StylizeJob& job, std::vector<FrameResult>& results) {
+  const std::size_t n = job.frames().size();
+  double spent = 0;
+  int stylized = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    try {
+      results.push_back(job.run_frame(i, [](double) { return !g_interrupted; }));
+    } catch (const CancelledError&) {
+      return false;
+    }
+    const FrameResult& r = results.back();
+    std::cout << "frame " << i + 1 << "/" << n << " (#" << r.frame << "): ";
+    if (r.status == "skipped") {
+      std::cout << "skipped, already current";
+    } else {
+      spent += r.seconds;
+      ++stylized;
+      std::cout << std::fixed << std::setprecision(2) << r.seconds << " s";
+    }
+    if (std::isfinite(r.flicker)) std::cout << ", flicker " << std::fixed << std::setprecision(4) << r.flicker;
+    if (stylized > 0 && i + 1 < n) std::cout << ", ETA " << clock_text(spent / stylized * double(n - i - 1));
+    std::cout << std::defaultfloat << std::endl;
+  }
+  return true;
+}
+
+void print_summary(const std::vector<FrameResult>& results, const std::string& out) {
+  int stylized = 0, skipped = 0, counted = 0;
+  double seconds = 0, flicker_sum = 0;
+  for (const auto& r : results) {
+    (r.status == "skipped" ? skipped : stylized)++;
+    seconds += r.seconds;
+    if (std::isfinite(r.flicker)) flicker_sum += r.flicker, ++counted;
+  }
+  std::cout << "tempera stylize: " << stylized << " frame(s) stylized, " << skipped
+            << " skipped (already current) in " << std::fixed << std::setprecision(1) << seconds << " s";
+  if (counted) std::cout << "; mean flicker " << std::setprecision(4) << flicker_sum / counted;
+  std::cout << std::defaultfloat << "; results in " << out << "\n";
+}
+
+void write_extras(const StylizeJob& job, const Options& o) {
+  const fs::path sheet = fs::path(o.out) / "contact_sheet.png";
+  job.write_contact_sheet(sheet.string());
+  std::cout << "contact sheet: " << sheet.string() << "\n";
+  if (!o.video) return;
+  if (o.format != "png" || !consecutive(o.frames)) {
+    std::cout << "no video: it needs consecutive PNG frames\n";
+    return;
+  }
+  const fs::path video = fs::path(o.out) / "stylized.mp4";
+  const std::string pattern = (fs::path(o.out) / "frames" / "frame_%04d.png").string();
+  if (encode_video(pattern, o.frames.front(), o.fps, video.string()))
+    std::cout << "video: " << video.string() << "\n";
+  else
+    std::cout << "no video: ffmpeg is not on PATH\n";
+}
+
+int interrupted(const std::vector<FrameResult>& results) {
+  std::cerr << "tempera stylize: interrupted after " << results.size()
+            << " frame(s); they are kept, rerun the same command to resume\n";
+  return 130;
+}
+
+}  // namespace
+
+int run_stylize(const Args& args) {
+  if (ArgReader(args, "stylize").wants_help() || args.empty()) {
+    std::cout << kStylizeHelp;
+    return args.empty() ? 2 : 0;
+  }
+  Options o = parse(args);  // usage errors propagate: exit status 2
+  struct sigaction action {};
+  action.sa_handler = on_sigint;
+  sigaction(SIGINT, &action, nullptr);
+  std::vector<FrameResult> results;
+  try {
+    if (!o.scene.empty()) render_guides(o, o.scene, o.frames_text, o.guides);
+    if (!o.exemplar_scene.empty()) {
+      o.exemplar_guides = (fs::path(o.out) / "exemplar_guides").string();
+      o.exemplar_frame = o.exemplar_frame.value_or(1);
+      render_guides(o, o.exemplar_scene, std::to_string(*o.exemplar_frame), o.exemplar_guides);
+    }
+    StylizeJobConfig config;
+    config.style = o.exemplar;
+    config.exemplar_guides = o.exemplar_guides;
+    config.exemplar_frame = o.exemplar_frame;
+    config.guides = o.guides;
+    config.frames = o.frames;
+    config.out = (fs::path(o.out) / "frames").string();
+    config.format = o.format;
+    config.stylit = o.stylit;
+    config.resume = o.resume;
+    StylizeJob job(config);
+    for (const auto& w : job.warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
+    if (!run_frames(job, results)) return interrupted(results);
+    write_extras(job, o);
+    print_summary(results, o.out);
+  } catch (const CancelledError&) {
+    return interrupted(results);
+  } catch (const ValueError& e) {  // bad data, not bad usage
+    std::cerr << "tempera stylize: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace tempera::cli

@@ -1,0 +1,23 @@
+#pragma once
+// Child processes without a shell (argument lists, never command strings):
+// Blender for guide renders, ffmpeg for videos.
+#include <string>
+#include <vector>
+
+namespace tempera {
+
+// Encodes frames `pattern` (printf style, e.g. "out/frame_%04d.png") from
+// `first_frame` on into an H.264 MP4 (yuv420p, dimensions rounded down to
+// even) with ffmpeg, atomically. Returns false, writing nothing, when ffmpeg
+// is not on PATH; IoError when ffmpeg fails.
+bool encode_video(const std::string& pattern, int first_frame, double fps, const std::string& out_path);
+
+// Runs argv (no shell; argv[0] looked up on PATH), waits, returns the exit
+// status (128 + signal if killed, 127 if it could not be started). With
+// `quiet`, stdin is /dev/null and stdout is discarded.
+int run_process(const std::vector<std::string>& argv, bool quiet = false);
+
+// Full path of `program` found on PATH, or "" when absent.
+std::string find_on_path(const std::string& program);
+
+}  // namespace tempera

@@ -1,0 +1,235 @@
+// Python binding of StyLit per frame and of the sequence driver (StylizeJob),
+// plus the contact sheet, flicker and video helpers they use. Configuration
+// comes as dicts whose unknown keys are errors; tempera.stylize wraps these
+// with keyword arguments. The GIL is released while native code runs.
+#include <pybind11/functional.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <set>
+
+#include "numpy_bridge.hpp"
+#include "tempera/contact_sheet.hpp"
+#include "tempera/process.hpp"
+#include "tempera/stylit.hpp"
+#include "tempera/stylize_job.hpp"
+
+namespace py = pybind11;
+using namespace tempera;
+using py_bridge::FloatArray;
+
+namespace {
+
+const std::set<std::string> kStylitKeys = {"weights", "temporal_weight", "quality", "usage",
+                                           "patch_size", "seed", "threads"};
+const std::set<std::string> kJobKeys = {"style", "exemplar_guides", "exemplar_frame", "guides", "frames",
+                                        "out", "format", "prefix", "resume"};
+
+void reject_unknown(const py::dict& d, const std::set<std::string>& a, const std::set<std::string>& b,
+                    const char* what) {
+  std::string unknown;
+  for (const auto& [key, value] : d) {
+    const std::string k = py::str(key);
+    if (!a.count(k) && !b.count(k)) unknown += (unknown.empty() ? "'" : ", '") + k + "'";
+  }
+  if (!unknown.empty()) throw ValueError(concat("unknown ", what, " key(s) ", unknown));
+}
+
+// Named weights replace the defaults of those guides; the others keep theirs.
+void set_weights(StylitOptions& opt, const py::dict& weights) {
+  for (const auto& [key, value] : weights) {
+    const std::string name = py::str(key);
+    auto it = std::find_if(opt.weights.begin(), opt.weights.end(), [&](auto& w) { return w.first == name; });
+    if (it == opt.weights.end()) {
+      std::string known;
+      for (const auto& g : light_path_guides()) known += (known.empty() ? "" : ", ") + g;
+      throw ValueError(concat("unknown guide '", name, "' in weights (StyLit guides: ", known, ")"));
+    }
+    it->second = value.cast<float>();
+  }
+}
+
+StylitOptions parse_stylit(const py::dict& d) {
+  StylitOptions opt;
+  if (d.contains("weights")) set_weights(opt, d["weights"].cast<py::dict>());
+  if (d.contains("temporal_weight")) opt.temporal_weight = d["temporal_weight"].cast<float>();
+  if (d.contains("quality")) opt.quality = parse_quality(d["quality"].cast<std::string>());
+  if (d.contains("usage")) opt.synthesis.usage = parse_patch_usage(d["usage"].cast<std::string>());
+  if (d.contains("patch_size")) opt.synthesis.patch_size = d["patch_size"].cast<int>();
+  if (d.contains("seed")) opt.synthesis.seed = d["seed"].cast<std::uint64_t>();
+  if (d.contains("threads")) opt.synthesis.threads = d["threads"].cast<int>();
+  active_guides(opt);  // errors now, not in the middle of a run
+  return opt;
+}
+
+StylizeJobConfig parse_job_config(const py::dict& d) {
+  reject_unknown(d, kJobKeys, kStylitKeys, "StylizeJob config");
+  for (const char* key : {"style", "exemplar_guides", "guides", "frames", "out"})
+    if (!d.contains(key)) throw ValueError(concat("StylizeJob config needs '", key, "'"));
+  StylizeJobConfig c;
+  c.style = d["style"].cast<std::string>();
+  c.exemplar_guides = d["exemplar_guides"].cast<std::string>();
+  if (d.contains("exemplar_frame") && !d["exemplar_frame"].is_none()) c.exemplar_frame = d["exemplar_frame"].cast<int>();
+  c.guides = d["guides"].cast<std::string>();
+  c.frames = d["frames"].cast<std::vector<int>>();
+  c.out = d["out"].cast<std::string>();
+  if (d.contains("format")) c.format = d["format"].cast<std::string>();
+  if (d.contains("prefix")) c.prefix = d["prefix"].cast<std::string>();
+  if (d.contains("resume")) c.resume = d["resume"].cast<bool>();
+  c.stylit = parse_stylit(d);
+  return c;
+}
+
+// Progress for code running without the GIL: re-take it to call Python, let
+// Ctrl-C through, and treat anything but an explicit False as "go on".
+ProgressCallback python_progress(const py::object& progress) {
+  return [progress](double fraction) {
+    py::gil_scoped_acquire acquire;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    if (progress.is_none()) return true;
+    return !progress(fraction).is(py::bool_(false));
+  };
+}
+
+py::dict frame_result(const FrameResult& r) {
+  py::dict d;
+  d["frame"] = r.frame;
+  d["path"] = r.path;
+  d["status"] = r.status;
+  d["seconds"] = r.seconds;
+  d["flicker"] = r.flicker;
+  d["source_coverage"] = r.source_coverage;
+  return d;
+}
+
+// Arrays stay referenced by `keep` while the frame views them.
+GuideFrame guide_frame(const py::dict& arrays, const char* what, std::vector<FloatArray>& keep) {
+  GuideFrame frame;
+  frame.origin = what;
+  for (const auto& [key, value] : arrays) {
+    const std::string name = py::str(key);
+    keep.push_back(value.cast<FloatArray>());
+    frame.guides[name] = Image::copy_of(py_bridge::view_of(keep.back(), concat(what, " guide '", name, "'")));
+  }
+  return frame;
+}
+
+py::tuple stylize_frame_py(const FloatArray& style, const py::dict& exemplar, const py::dict& target,
+                           const py::dict& options, const py::object& temporal, const py::object& progress) {
+  reject_unknown(options, kStylitKeys, {}, "stylize_frame option");
+  const StylitOptions opt = parse_stylit(options);
+  std::vector<FloatArray> keep;
+  const GuideFrame ex = guide_frame(exemplar, "exemplar", keep), tg = guide_frame(target, "target", keep);
+  TemporalInput t;
+  const bool has_temporal = !temporal.is_none();
+  if (has_temporal) {
+    const py::dict d = temporal.cast<py::dict>();
+    reject_unknown(d, {"previous", "velocity_backward", "occlusion_backward"}, {}, "temporal");
+    for (const char* key : {"previous", "velocity_backward", "occlusion_backward"}) {
+      if (!d.contains(key)) throw ValueError(concat("temporal needs '", key, "'"));
+      keep.push_back(d[key].cast<FloatArray>());
+    }
+    const std::size_t n = keep.size();
+    t = {py_bridge::view_of(keep[n - 3], "previous"), py_bridge::view_of(keep[n - 2], "velocity_backward"),
+         py_bridge::view_of(keep[n - 1], "occlusion_backward")};
+  }
+  const ImageView style_view = py_bridge::view_of(style, "style");
+  const ProgressCallback callback = python_progress(progress);
+  SynthesisResult result;
+  {
+    py::gil_scoped_release release;
+    result = stylize_frame(style_view, ex, tg, has_temporal ? &t : nullptr, opt, callback);
+  }
+  py::dict stats;
+  stats["seconds"] = result.seconds;
+  stats["source_coverage"] = result.source_coverage;
+  stats["guide_channels"] = result.guide_channels;
+  return py::make_tuple(py_bridge::to_numpy(std::move(result.image)), stats);
+}
+
+void bind_job(py::module_& m) {
+  py::class_<StylizeJob>(m, "StylizeJob", "Stylization of a frame sequence; use tempera.stylize.StylizeJob.")
+      .def(py::init([](const py::dict& config) {
+             StylizeJobConfig c = parse_job_config(config);
+             py::gil_scoped_release release;  // reads the painting and checks every cache frame
+             return std::make_unique<StylizeJob>(std::move(c));
+           }),
+           py::arg("config"))
+      .def_property_readonly("frames", &StylizeJob::frames)
+      .def_property_readonly("warnings", &StylizeJob::warnings)
+      .def_property_readonly("report_path", &StylizeJob::report_path)
+      .def("output_path", &StylizeJob::output_path, py::arg("frame"))
+      .def(
+          "run_frame",
+          [](StylizeJob& job, std::size_t index, const py::object& progress) {
+            const ProgressCallback callback = python_progress(progress);
+            FrameResult r;
+            {
+              py::gil_scoped_release release;
+              r = job.run_frame(index, callback);
+            }
+            return frame_result(r);
+          },
+          py::arg("index"), py::arg("progress") = py::none())
+      .def(
+          "write_contact_sheet",
+          [](const StylizeJob& job, const std::string& path, int columns) {
+            py::gil_scoped_release release;
+            job.write_contact_sheet(path, columns);
+          },
+          py::arg("path"), py::arg("columns") = 0);
+}
+
+}  // namespace
+
+void bind_stylize(py::module_& m) {
+  bind_job(m);
+  m.def("stylize_frame", &stylize_frame_py, py::arg("style"), py::arg("exemplar"), py::arg("target"),
+        py::arg("options"), py::arg("temporal") = py::none(), py::arg("progress") = py::none(),
+        "One StyLit frame from in-memory guides; use tempera.stylize.stylize_frame.");
+  m.def(
+      "flicker",
+      [](const FloatArray& previous, const FloatArray& current, const FloatArray& velocity, const FloatArray& visible) {
+        const ImageView p = py_bridge::view_of(previous, "previous"), c = py_bridge::view_of(current, "current"),
+                        v = py_bridge::view_of(velocity, "velocity_backward"), m = py_bridge::view_of(visible, "visible");
+        py::gil_scoped_release release;
+        return flicker(p, c, v, m);
+      },
+      py::arg("previous"), py::arg("current"), py::arg("velocity_backward"), py::arg("visible"),
+      "Mean absolute colour change along valid motion; use tempera.temporal.flicker.");
+  m.def(
+      "tonemap_guide",
+      [](const FloatArray& linear) {
+        const ImageView v = py_bridge::view_of(linear, "linear");
+        Image out;
+        {
+          py::gil_scoped_release release;
+          out = tonemap_guide(v);
+        }
+        return py_bridge::to_numpy(std::move(out));
+      },
+      py::arg("linear"), "x/(1+x) then sRGB, as tempera.stylit_guides.tonemap.");
+  m.def(
+      "contact_sheet",
+      [](const std::vector<FloatArray>& images, int columns, int gap, int margin, std::vector<float> background) {
+        std::vector<ImageView> views;
+        for (std::size_t i = 0; i < images.size(); ++i)
+          views.push_back(py_bridge::view_of(images[i], concat("contact_sheet: image ", i)));
+        Image sheet;
+        {
+          py::gil_scoped_release release;
+          sheet = contact_sheet(views, ContactSheetLayout{columns, gap, margin, std::move(background)});
+        }
+        return py_bridge::to_numpy(std::move(sheet));
+      },
+      py::arg("images"), py::arg("columns"), py::arg("gap"), py::arg("margin"), py::arg("background"),
+      "Grid of images; use tempera.contact_sheet.");
+  m.def(
+      "encode_video",
+      [](const std::string& pattern, int first_frame, double fps, const std::string& out) {
+        py::gil_scoped_release release;
+        return encode_video(pattern, first_frame, fps, out);
+      },
+      py::arg("pattern"), py::arg("first_frame"), py::arg("fps"), py::arg("out"),
+      "H.264 MP4 of numbered frames with ffmpeg, atomically; False (no file) without ffmpeg.");
+}

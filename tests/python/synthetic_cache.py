@@ -1,0 +1,51 @@
+"""A tiny synthetic guide cache for the stylization tests: a shaded gradient
+with a bright blob moving right by `speed` pixels per frame, written with
+tempera.guide_cache like the Blender renderer writes it."""
+import numpy as np
+
+from tempera import guide_cache, write_image
+
+H, W = 48, 64
+
+
+def light_paths(blob_x, h=H, w=W):
+    """Linear FULL, LDE, LSE, LDDE of a frame with the blob centred at blob_x."""
+    yy, xx = np.mgrid[0:h, 0:w].astype(np.float32)
+    blob = np.exp(-((xx - blob_x) ** 2 + (yy - h / 2) ** 2) / (2 * (h / 6) ** 2))
+    diffuse = 0.15 + 0.6 * xx / w + 1.5 * blob
+    tint = np.stack([diffuse, 0.8 * diffuse, 0.5 * diffuse + 0.2 * yy / h], -1)
+    spec = np.stack([blob**8] * 3, -1) * 2
+    indirect = 0.1 * np.stack([1 - yy / h, 0.5 * np.ones_like(yy), yy / h], -1)
+    return {"FULL": tint + spec + indirect, "LDE": tint, "LSE": spec, "LDDE": indirect}
+
+
+def write_frame(cache, frame, blob_x, speed):
+    guides = light_paths(blob_x)
+    guides["velocity_backward"] = np.stack([np.full((H, W), speed, np.float32), np.zeros((H, W), np.float32)], -1)
+    visible = np.ones((H, W), np.float32)
+    visible[:, : int(np.ceil(speed))] = 0  # entered from outside the frame
+    guides["occlusion_backward"] = visible
+    guides["alpha"] = np.ones((H, W), np.float32)
+    return guide_cache.write_frame(cache, frame, guides)
+
+
+def make_cache(cache, frames=(1, 2, 3), speed=2.0, start=20.0):
+    for i, frame in enumerate(frames):
+        write_frame(cache, frame, start + speed * i, speed)
+    guide_cache.write_manifest(cache, {"frames": {str(f): {"key": "synthetic"} for f in frames},
+                                       "guides": ["FULL", "LDE", "LSE", "LDDE", "velocity_backward",
+                                                  "occlusion_backward", "alpha"]})
+    return cache
+
+
+def make_exemplar(folder, painting_path, size=(W, H), frame=1):
+    """Exemplar cache (blob centred) and a painting of it: coloured noise whose
+    brightness follows the shading, at `size` (w, h)."""
+    write_frame(folder, frame, W / 2, 0.0)
+    rng = np.random.default_rng(3)
+    w, h = size
+    yy, xx = np.mgrid[0:h, 0:w].astype(np.float32)
+    shade = np.clip(0.2 + 0.6 * xx / w + 0.8 * np.exp(-((xx - w / 2) ** 2 + (yy - h / 2) ** 2) / (2 * (h / 6) ** 2)), 0, 1)
+    paint = shade[..., None] * np.array([0.9, 0.6, 0.3], np.float32) + 0.25 * rng.random((h, w, 3), dtype=np.float32)
+    write_image(str(painting_path), np.clip(paint, 0, 1).astype(np.float32))
+    return folder, painting_path

@@ -1,0 +1,136 @@
+"""`tempera stylize`: a shot from guide caches (render farm form) and from a .blend."""
+import os
+import shutil
+import signal
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import tempera
+from synthetic_cache import H, W, make_cache, make_exemplar
+
+ROOT = Path(__file__).resolve().parents[2]
+BLENDER = os.environ.get("TEMPERA_BLENDER", "blender")
+
+
+def stylize(cli_path, *args, timeout=300):
+    return subprocess.run([str(cli_path), "stylize", *map(str, args)], capture_output=True, text=True,
+                          timeout=timeout, env=dict(os.environ, TEMPERA_BLENDER=BLENDER))
+
+
+@pytest.fixture()
+def caches(tmp_path):
+    make_cache(tmp_path / "cache")
+    make_exemplar(tmp_path / "exemplar", tmp_path / "paint.png")
+    return tmp_path
+
+
+def farm_args(p, *extra):
+    return ("--guides", p / "cache", "--exemplar", p / "paint.png", "--exemplar-guides", p / "exemplar",
+            "--frames", "1-3", "--out", p / "out", "--threads", "2", *extra)
+
+
+def video_frames(path):
+    result = subprocess.run(["ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
+                             "stream=nb_read_frames", "-of", "csv=p=0", str(path)], capture_output=True, text=True)
+    return int(result.stdout.strip())
+
+
+def test_farm_form_writes_frames_sheet_and_video_then_resumes(cli_path, caches):
+    result = stylize(cli_path, *farm_args(caches, "--temporal", "0.5"))
+    assert result.returncode == 0, result.stderr
+    out = caches / "out"
+    for f in (1, 2, 3):
+        assert tempera.read_image(str(out / "frames" / f"frame_{f:04d}.png")).shape == (H, W, 3)
+    assert "frame 3/3 (#3)" in result.stdout and "mean flicker" in result.stdout
+    assert tempera.image_info(str(out / "contact_sheet.png"))["width"] == 2 * W + 4
+    if shutil.which("ffmpeg"):
+        assert video_frames(out / "stylized.mp4") == 3
+    assert [f.name for f in out.rglob("*") if f.name.startswith(".")] == []
+
+    again = stylize(cli_path, *farm_args(caches, "--temporal", "0.5"))
+    assert again.returncode == 0, again.stderr
+    assert again.stdout.count("skipped, already current") == 3
+    assert "0 frame(s) stylized, 3 skipped" in again.stdout
+    changed = stylize(cli_path, *farm_args(caches, "--temporal", "0.5", "--weights", "LDE=3", "--no-video"))
+    assert "3 frame(s) stylized, 0 skipped" in changed.stdout
+
+
+def test_exr_output_and_preview_quality(cli_path, caches):
+    result = stylize(cli_path, *farm_args(caches, "--format", "exr", "--quality", "preview"))
+    assert result.returncode == 0, result.stderr
+    assert (caches / "out" / "frames" / "frame_0002.exr").is_file()
+    assert "no video: it needs consecutive PNG frames" in result.stdout
+
+
+def test_errors_and_exit_codes(cli_path, caches):
+    missing = caches / "missing.png"
+    result = stylize(cli_path, "--guides", caches / "cache", "--exemplar", missing, "--exemplar-guides",
+                     caches / "exemplar", "--frames", "1-3", "--out", caches / "out")
+    assert result.returncode == 1 and str(missing) in result.stderr, result.stderr
+    result = stylize(cli_path, *farm_args(caches, "--sparkle"))
+    assert result.returncode == 2 and "unknown option '--sparkle'" in result.stderr
+    result = stylize(cli_path, *farm_args(caches, "--weights", "SSS=1"))
+    assert result.returncode == 2 and "unknown guide 'SSS'" in result.stderr
+    result = stylize(cli_path, "--exemplar", caches / "paint.png", "--frames", "1", "--out", caches / "o",
+                     "--exemplar-guides", caches / "exemplar")
+    assert result.returncode == 2 and "--guides DIR" in result.stderr
+    result = stylize(cli_path, *farm_args(caches)[:-4], "--frames", "1-5", "--out", caches / "o")
+    assert result.returncode == 1 and "frame(s) 4, 5" in result.stderr
+    help_text = stylize(cli_path, "--help")
+    assert help_text.returncode == 0
+    for option in ("--exemplar-scene", "--weights", "--temporal", "--quality", "--no-resume", "--fps", "--samples"):
+        assert option in help_text.stdout
+
+
+def test_ctrl_c_keeps_finished_frames(cli_path, tmp_path):
+    # Frames big enough to take a while, so the interrupt lands mid-run.
+    from tempera import guide_cache
+    from synthetic_cache import light_paths
+
+    h, w = 192, 256
+    for f in range(1, 5):
+        guides = light_paths(100 + 2 * f, h, w)
+        guides["velocity_backward"] = np.zeros((h, w, 2), np.float32)
+        guides["occlusion_backward"] = np.ones((h, w), np.float32)
+        guide_cache.write_frame(tmp_path / "cache", f, guides)
+    guide_cache.write_frame(tmp_path / "exemplar", 1, light_paths(128, h, w))
+    tempera.write_image(str(tmp_path / "paint.png"), np.random.default_rng(0).random((h, w, 3), dtype=np.float32))
+    process = subprocess.Popen([str(cli_path), "stylize", *map(str, farm_args(tmp_path)[:-2]), "--threads", "1",
+                                "--frames", "1-4"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    first = process.stdout.readline()
+    process.send_signal(signal.SIGINT)
+    stdout, stderr = process.communicate(timeout=120)
+    assert first.startswith("frame 1/4")
+    assert process.returncode == 130, stderr
+    assert "rerun the same command to resume" in stderr
+    frames = tmp_path / "out" / "frames"
+    assert (frames / "frame_0001.png").is_file() and not (frames / "frame_0004.png").exists()
+    assert [f.name for f in frames.iterdir() if f.name.startswith(".")] == []
+
+
+@pytest.mark.skipif(shutil.which(BLENDER) is None, reason="Blender not installed")
+def test_scene_form_renders_guides_with_blender(cli_path, tmp_path):
+    blend = tmp_path / "shot.blend"
+    code = (f"import sys, bpy; sys.path.insert(0, {str(ROOT / 'scenes')!r}); import demo_scene; "
+            "scene = bpy.context.scene; demo_scene.build_scene(scene); "
+            "scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = 64, 48, 50; "
+            f"bpy.ops.wm.save_as_mainfile(filepath={str(blend)!r})")
+    made = subprocess.run([BLENDER, "-b", "--factory-startup", "--python-exit-code", "1", "--python-expr", code],
+                          capture_output=True, text=True, timeout=120)
+    assert made.returncode == 0, made.stderr[-2000:]
+    painting = tmp_path / "paint.png"
+    tempera.write_image(str(painting), np.random.default_rng(1).random((24, 32, 3), dtype=np.float32))
+    out = tmp_path / "out"
+    result = stylize(cli_path, blend, "--exemplar", painting, "--exemplar-scene", blend, "--frames", "2-3",
+                     "--out", out, "--samples", "2", "--temporal", "0.5", "--threads", "2", timeout=600)
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    assert (out / "guides" / "frame_0003.exr").is_file() and (out / "exemplar_guides" / "frame_0001.exr").is_file()
+    assert tempera.read_image(str(out / "frames" / "frame_0003.png")).shape == (24, 32, 3)
+    assert "flicker" in result.stdout and (out / "contact_sheet.png").is_file()
+    again = stylize(cli_path, blend, "--exemplar", painting, "--exemplar-scene", blend, "--frames", "2-3",
+                    "--out", out, "--samples", "2", "--temporal", "0.5", "--threads", "2", "--no-video", timeout=600)
+    assert again.returncode == 0, again.stderr[-2000:]
+    assert "0 frame(s) stylized, 2 skipped" in again.stdout

@@ -1,0 +1,129 @@
+"""tempera.stylize: StyLit over a guide cache through the native StylizeJob."""
+import json
+import math
+
+import numpy as np
+import pytest
+
+import tempera
+from tempera import _native, guide_cache
+from tempera.stylit_guides import tonemap
+from tempera.stylize import StylizeJob, stylize_frame
+
+from conftest import assert_releases_gil
+from synthetic_cache import H, W, light_paths, make_cache, make_exemplar
+
+
+@pytest.fixture()
+def inputs(tmp_path):
+    make_cache(tmp_path / "cache")
+    make_exemplar(tmp_path / "exemplar", tmp_path / "paint.png")
+    return tmp_path
+
+
+def job(p, **kwargs):
+    return StylizeJob(p / "paint.png", p / "exemplar", p / "cache", [1, 2, 3], p / "out", **kwargs)
+
+
+def leftovers(folder):
+    return [f.name for f in folder.iterdir() if f.name.startswith(".") or ".tmp" in f.name]
+
+
+def test_job_end_to_end_then_resume_skips(inputs):
+    j = job(inputs, temporal_weight=1.0, threads=2)
+    assert j.frames == [1, 2, 3] and j.warnings == []
+    results = [j.run_frame(i) for i in range(3)]
+    assert [r["status"] for r in results] == ["stylized"] * 3
+    assert math.isnan(results[0]["flicker"]) and all(0 <= r["flicker"] < 0.2 for r in results[1:])
+    for r in results:
+        assert r["path"] == j.output_path(r["frame"]) == str(inputs / "out" / f"frame_{r['frame']:04d}.png")
+        assert tempera.read_image(r["path"]).shape == (H, W, 3)
+        assert 0 < r["source_coverage"] <= 1 and r["seconds"] > 0
+    report = json.loads((inputs / "out" / "tempera_stylize.json").read_text())
+    assert sorted(report["frames"]) == ["1", "2", "3"]
+
+    again = job(inputs, temporal_weight=1.0, threads=2)
+    skipped = [again.run_frame(i) for i in range(3)]
+    assert [r["status"] for r in skipped] == ["skipped"] * 3
+    assert skipped[1]["flicker"] == pytest.approx(results[1]["flicker"], rel=1e-6)
+    assert leftovers(inputs / "out") == []
+
+    sheet = inputs / "sheet.png"
+    again.write_contact_sheet(sheet)
+    assert tempera.image_info(str(sheet))["width"] == 2 * W + 4  # painting + 3 frames on a 2x2 grid
+
+
+def test_changed_settings_redo_the_frames(inputs):
+    j = job(inputs, threads=2)
+    j.run_frame(0)
+    assert job(inputs, threads=2, seed=5).run_frame(0)["status"] == "stylized"
+    assert job(inputs, threads=2, seed=5, resume=False).run_frame(0)["status"] == "stylized"
+
+
+def test_unknown_config_keys_are_named():
+    with pytest.raises(ValueError, match="'colour'.*'speed'|'speed'.*'colour'"):
+        _native.StylizeJob(dict(style="a", exemplar_guides="b", guides="c", frames=[1], out="d", colour=1, speed=2))
+    with pytest.raises(ValueError, match="unknown guide 'DIFFUSE'"):
+        _native.StylizeJob(dict(style="a", exemplar_guides="b", guides="c", frames=[1], out="d",
+                                weights={"DIFFUSE": 1.0}))
+
+
+def test_missing_files_and_guides_are_named(inputs):
+    with pytest.raises(FileNotFoundError, match="nope.png"):
+        StylizeJob(inputs / "nope.png", inputs / "exemplar", inputs / "cache", [1], inputs / "out")
+    with pytest.raises(FileNotFoundError, match="frame\\(s\\) 7, 8"):
+        StylizeJob(inputs / "paint.png", inputs / "exemplar", inputs / "cache", [1, 7, 8], inputs / "out")
+    with pytest.raises(ValueError, match="guide 'LD12E' missing from '.*frame_0001.exr'"):
+        job(inputs, weights={"LD12E": 1.0})
+    guide_cache.write_frame(inputs / "exemplar", 2, light_paths(10))
+    with pytest.raises(ValueError, match="exemplar_frame"):
+        job(inputs)
+    assert job(inputs, exemplar_frame=1).frames == [1, 2, 3]
+
+
+def test_run_frame_releases_the_gil(inputs):
+    j = job(inputs, threads=1, resume=False)
+    assert_releases_gil(lambda: [j.run_frame(i) for i in range(3)])
+
+
+def test_cancel_from_progress_leaves_no_file(inputs):
+    j = job(inputs, threads=2)
+    seen = []
+
+    def progress(fraction):
+        seen.append(fraction)
+        return len(seen) < 3
+
+    with pytest.raises(tempera.Cancelled):
+        j.run_frame(0, progress)
+    assert len(seen) == 3
+    out = inputs / "out"
+    assert not (out / "frame_0001.png").exists() and leftovers(out) == []
+    assert j.run_frame(0, lambda f: None)["status"] == "stylized"  # None means "go on"
+
+
+def test_stylize_frame_in_memory_and_tonemap():
+    rng = np.random.default_rng(0)
+    guides = light_paths(W / 2)
+    style = rng.random((H, W, 3), dtype=np.float32)
+    image, stats = stylize_frame(style, guides, guides, usage="none", threads=2)
+    assert image.shape == (H, W, 3) and stats["seconds"] > 0
+    assert np.abs(image - style)[6:-6, 6:-6].mean() < 0.02
+    velocity = np.zeros((H, W, 2), np.float32)
+    warm, _ = stylize_frame(style, guides, guides, previous=image, velocity_backward=velocity,
+                            occlusion_backward=np.ones((H, W)), temporal_weight=1.0, threads=2)
+    assert warm.shape == image.shape
+    linear = np.array([[[-1.0, 0.0, 0.002], [0.5, 4.0, np.nan]]], np.float32)
+    np.testing.assert_allclose(_native.tonemap_guide(linear), tonemap(linear), atol=1e-7)
+
+
+def test_frames_split_over_machines_stay_current(inputs):
+    def split_job(frames):
+        return StylizeJob(inputs / "paint.png", inputs / "exemplar", inputs / "cache", frames, inputs / "out",
+                          temporal_weight=0.5, threads=2)
+
+    for frames in ([1, 2], [3]):  # two machines, one shared output folder
+        j = split_job(frames)
+        assert [j.run_frame(i)["status"] for i in range(len(frames))] == ["stylized"] * len(frames)
+    whole = split_job([1, 2, 3])
+    assert [whole.run_frame(i)["status"] for i in range(3)] == ["skipped"] * 3
