@@ -110,8 +110,8 @@ def test_exemplar_kit_outputs(tmp_path):
 
     kit = exemplar_kit.make_kit(tmp_path / "kit", "sphere_and_box", (48, 36), samples=2, dpi=40)
     folder = kit.parent
-    assert sorted(p.name for p in folder.iterdir()) == ["guides.exr", "kit.json", "render.png", "template.pdf",
-                                                       "template.png"]
+    assert sorted(p.name for p in folder.iterdir()) == ["guides", "guides.exr", "kit.json", "render.png", "style.png",
+                                                       "template.pdf", "template.png"]
     info = json.loads(kit.read_text())
     assert info["variant"] == "sphere_and_box" and info["resolution"] == [48, 36] and len(info["marks"]) == 4
     assert tempera.image_info(str(folder / "guides.exr"))["width"] == 48
@@ -121,3 +121,9 @@ def test_exemplar_kit_outputs(tmp_path):
     x0, y0, x1, y1 = info["picture"]
     assert 0 < x0 < x1 < page.shape[1] and 0 < y0 < y1 < page.shape[0]
     assert (folder / "template.pdf").read_bytes().startswith(b"%PDF")
+    # Ready to stylize with: the painting and the guide cache, at the kit's resolution.
+    from tempera import kit as bundled
+
+    style, guides = bundled.kit_exemplar(folder.name, kit_dir=folder.parent)
+    assert tempera.read_image(str(style)).shape[:2] == (36, 48)
+    assert tempera.image_info(str(guides / "frame_0001.exr"))["width"] == 48

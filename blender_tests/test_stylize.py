@@ -5,6 +5,7 @@ the painting; the moving cube's frames must carry the painting's colours.
 Cancelling, resuming and the errors an artist can run into are checked
 through the operator (its report) and the job (its exception)."""
 import subprocess
+import time
 
 import bpy
 import numpy as np
@@ -111,6 +112,23 @@ def test_stylize_frame_does_only_the_current_frame(scene, tmp_path):
     assert f"Tempera frames {FRAMES[1]}" in bpy.data.images
 
 
+def hold_until_esc(job, op):
+    """From now on the solver's progress reports wait for Esc, so that Esc
+    surely comes while a frame is being stylized, however fast the machine."""
+    run_frame = job.run_frame
+
+    def held_run_frame(index, progress=None):
+        def held(fraction):
+            deadline = time.monotonic() + 60
+            while not op._stop and time.monotonic() < deadline:
+                time.sleep(0.01)
+            return progress(fraction)
+
+        return run_frame(index, held)
+
+    job.run_frame = held_run_frame
+
+
 def test_esc_during_the_second_frame_keeps_the_first_and_a_rerun_completes(scene, tmp_path):
     from tempera.blender.stylize_operator import TEMPERA_OT_stylize, StylizeRun
 
@@ -124,6 +142,7 @@ def test_esc_during_the_second_frame_keeps_the_first_and_a_rerun_completes(scene
             yield ("TIMER", "NOTHING")
             if op._future is None and run.index == len(FRAMES) + 1:
                 break
+        hold_until_esc(run.job, op)
         yield ("TIMER", "NOTHING")
         yield ("ESC", "PRESS")
 

@@ -234,11 +234,18 @@ class TEMPERA_OT_stylize(JobOperator, Operator):
             sheet = os.path.join(job.out, CONTACT_SHEET)
             job.job.write_contact_sheet(sheet)
             if settings.make_video:
-                from ..stylize import encode_video
-
-                fps = context.scene.render.fps / context.scene.render.fps_base
-                if not encode_video(job.job, os.path.join(job.out, VIDEO), fps):
-                    self.report({"WARNING"}, "ffmpeg not found: no mp4 written (the frames are there)")
+                self._encode_video(context.scene, job)
         results.load(context.scene, paths, job.frames, settings.load_result if job.mode == "ANIMATION" else "IMAGE")
         for warning in job.warnings:
             self.report({"WARNING"}, warning)
+
+    def _encode_video(self, scene, job):
+        from ..stylize import encode_video
+
+        if job.config["format"] != "png":
+            self.report({"INFO"}, "No mp4: the video is made from PNG frames (Format is OpenEXR)")
+            return
+        pattern = os.path.join(job.config["out"], "frame_%04d.png")
+        fps = scene.render.fps / scene.render.fps_base
+        if not encode_video(pattern, job.frames[0], os.path.join(job.out, VIDEO), fps):
+            self.report({"WARNING"}, "ffmpeg not found: no mp4 written (the frames are there)")
