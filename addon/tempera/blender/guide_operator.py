@@ -22,7 +22,7 @@ import bpy
 from bpy.types import Operator
 
 from .. import guide_cache
-from .guide_render import GuideRenderError, check_scene, render_guides, scene_fingerprint
+from .guide_render import GuideRenderError, check_lpe_expressions, check_scene, render_guides, scene_fingerprint
 from .properties import GUIDE_MASK_MODES
 
 TIMER_STEP = 0.1  # seconds between the end of a frame and the start of the next (redraws, Esc)
@@ -41,6 +41,8 @@ def guide_params(settings):
         "line_d_max": float(settings.guide_line_d_max),
         "masks": GUIDE_MASK_MODES[settings.guide_masks],
         "orientation_aov": settings.guide_orientation_aov.strip(),
+        "lpe": guide_cache.split_expressions(settings.guide_lpe),
+        "lpe_samples": settings.guide_lpe_samples,
     }
 
 
@@ -96,6 +98,7 @@ class GuideJob:
         self.params = params
         self.index = 0  # frames done (rendered or skipped)
         self.rendered, self.skipped = [], []
+        self.warnings = []  # what the light-path tracer approximated, once each
         self.render_seconds = 0.0  # time spent on rendered frames (skipped ones take none)
 
     @classmethod
@@ -106,7 +109,9 @@ class GuideJob:
         folder = resolve_guide_dir(settings.guide_dir)
         frames = guide_frames(scene, settings)
         check_scene(scene)
-        return cls(scene, frames, folder, guide_params(settings))
+        params = guide_params(settings)
+        check_lpe_expressions(params["lpe"])
+        return cls(scene, frames, folder, params)
 
     @property
     def total(self):
@@ -132,6 +137,7 @@ class GuideJob:
 
         start = time.monotonic()
         report = render_guide_frame(self.scene(), frame, self.folder, self.params, frame_progress)
+        self.warnings += [w for w in report["warnings"] if w not in self.warnings]
         if report["rendered"]:
             self.rendered.append(frame)
             self.render_seconds += time.monotonic() - start
@@ -188,6 +194,7 @@ def cache_status(scene):
         folder = resolve_guide_dir(settings.guide_dir)
         frames = guide_frames(scene, settings)
         check_scene(scene)
+        check_lpe_expressions(guide_cache.split_expressions(settings.guide_lpe))
     except (ValueError, GuideRenderError) as exc:
         return str(exc), "ERROR"
     try:
@@ -265,7 +272,7 @@ class TEMPERA_OT_render_guides(Operator):
         finally:
             wm.progress_end()
             type(self)._running = False
-        self.report({"INFO"}, job.summary())
+        self._report_done(job)
         return {"FINISHED"}
 
     # -- UI: one frame per timer step
@@ -304,12 +311,17 @@ class TEMPERA_OT_render_guides(Operator):
             return {"CANCELLED"}
         if job.finished:
             self._finish(context)
-            self.report({"INFO"}, job.summary())
+            self._report_done(job)
             return {"FINISHED"}
         wm.progress_update(job.index)
         self._show(context, job)
         self._timer = wm.event_timer_add(TIMER_STEP, window=context.window)
         return {"PASS_THROUGH"}
+
+    def _report_done(self, job):
+        for warning in job.warnings:  # approximations of the light-path tracer, e.g. unsupported nodes
+            self.report({"WARNING"}, warning)
+        self.report({"INFO"}, job.summary())
 
     def cancel(self, context):
         """Blender ends the operator (a file is loaded, the window closes)."""
