@@ -134,7 +134,7 @@ def check_scene(scene):
 def check_lpe_expressions(expressions):
     """Raises GuideRenderError naming the first malformed light path
     expression and where it goes wrong, before anything is rendered."""
-    from .._native import check_lpe
+    from ..lpe import check_lpe
 
     seen = {}
     for i, expression in enumerate(expressions, start=1):
@@ -154,11 +154,18 @@ def trace_lpe_guides(scene, layer, frame, size, params):
     """({guide name: (H, W, 3) radiance}, warnings) of the frame's light path
     expressions, traced on the scene as the view layer evaluates it at
     `frame`, with the Cycles scene's bounce limit."""
-    from .._native import trace_lpe
+    from ..lpe import trace_lpe
 
     scene.frame_set(frame)
+    # After bpy.ops.render.render, Blender 3.4 can leave the scene's evaluated
+    # objects without their transforms while the depsgraph counts as current
+    # (seen: every mesh at the origin). Tagging every object re-evaluates them.
+    for obj in scene.objects:
+        obj.update_tag(refresh={"OBJECT", "DATA"} if obj.data is not None else {"OBJECT"})
+    depsgraph = layer.depsgraph
+    depsgraph.update()
     try:
-        scene_dict, warnings = export_scene(scene, layer.depsgraph, size)
+        scene_dict, warnings = export_scene(scene, depsgraph, size)
     except SceneExportError as exc:
         raise GuideRenderError(str(exc)) from None
     images, _alpha = trace_lpe(scene_dict, params["lpe"], samples=params["lpe_samples"], seed=params["seed"],
