@@ -5,10 +5,10 @@ sphere under one light, seen from the front with background above the wall.
 
     scene = build_scene("LPE", size=(96, 72), sphere="metal", light="POINT")
 
-sphere: "metal" (rough gold), "mirror" (perfect mirror), "diffuse" or None;
-diffuse_only=True makes every surface a plain Diffuse BSDF (no glossy lobe
-anywhere, so Cycles' DiffInd with caustics off is exactly L.*DDE); objects=False
-leaves only the floor (light power checks).
+sphere: "metal" (rough gold), "mirror" (perfect mirror), "diffuse" (a Diffuse
+BSDF) or None; diffuse_only=True makes the floor, wall and cube plain Diffuse
+BSDFs (no glossy lobe: with a diffuse sphere, Cycles' DiffInd with caustics
+off is exactly L.*DDE); objects=False leaves only the floor (light power checks).
 """
 import math
 
@@ -16,13 +16,16 @@ import bmesh
 import bpy
 from mathutils import Vector
 
-LIGHTS = {  # type -> (power or strength, location, rotation (Euler, radians), extra settings)
-    "POINT": (400.0, (1.5, -1.5, 3.0), (0, 0, 0), {"shadow_soft_size": 0.1}),
-    "SPOT": (600.0, (1.0, -1.5, 3.0), (math.radians(30), 0, math.radians(30)),
+SPHERE_CENTRE = (0.75, -0.1, 0.55)
+# name -> (type, power or strength, location, point it aims at, extra settings)
+LIGHTS = {
+    "POINT": ("POINT", 400.0, (1.5, -1.5, 3.0), (0, 0, 0), {"shadow_soft_size": 0.1}),
+    "SPOT": ("SPOT", 600.0, (1.0, -1.5, 3.0), (0, 0, 0),
              {"shadow_soft_size": 0.1, "spot_size": math.radians(70), "spot_blend": 0.2}),
-    "SUN": (3.0, (0, 0, 5), (math.radians(35), 0, math.radians(40)), {"angle": math.radians(2)}),
-    "AREA": (300.0, (0.5, -1.0, 2.5), (math.radians(20), 0, 0), {"shape": "RECTANGLE", "size": 1.0,
-                                                                  "size_y": 0.5}),
+    "SUN": ("SUN", 3.0, (0, 0, 5), (-1.5, 2.0, 2.0), {"angle": math.radians(2)}),
+    "AREA": ("AREA", 300.0, (0.5, -1.0, 2.5), (0.3, 0, 0), {"shape": "RECTANGLE", "size": 1.0, "size_y": 0.5}),
+    # Low and to the side, aimed at the sphere: a mirror sphere throws a caustic onto the floor.
+    "CAUSTIC": ("AREA", 300.0, (2.0, -0.8, 1.8), SPHERE_CENTRE, {"shape": "DISK", "size": 0.3}),
 }
 
 
@@ -58,6 +61,11 @@ def _object(scene, name, build, material, location=(0, 0, 0), rotation=(0, 0, 0)
     return obj
 
 
+def _aim(location, target):
+    """Euler rotation pointing local -Z from `location` at `target`, +Y up."""
+    return (Vector(target) - Vector(location)).to_track_quat("-Z", "Y").to_euler()
+
+
 def build_scene(name="LPE", size=(96, 72), sphere="metal", light="POINT", diffuse_only=False, objects=True):
     scene = bpy.data.scenes.new(name)
     scene.render.engine = "CYCLES"
@@ -83,29 +91,29 @@ def build_scene(name="LPE", size=(96, 72), sphere="metal", light="POINT", diffus
                 _material("Red", (0.7, 0.15, 0.1), diffuse_only, Roughness=0.5),
                 location=(-0.8, 0.3, 0.4), rotation=(0, 0, math.radians(30)))
         if sphere:
-            kind = "diffuse" if diffuse_only else sphere
+            kind = sphere
             settings = {"metal": ((0.9, 0.65, 0.3), {"Metallic": 1.0, "Roughness": 0.25}),
                         "mirror": ((0.95, 0.95, 0.95), {"Metallic": 1.0, "Roughness": 0.0}),
                         "diffuse": ((0.2, 0.3, 0.7), {"Specular": 0.0})}[kind]
             _object(scene, "Sphere",
                     lambda bm: bmesh.ops.create_uvsphere(bm, u_segments=48, v_segments=24, radius=0.55),
                     _material("Sphere", settings[0], diffuse_only or kind == "diffuse", **settings[1]),
-                    location=(0.75, -0.1, 0.55), smooth=True)
+                    location=SPHERE_CENTRE, smooth=True)
 
-    power, location, rotation, extra = LIGHTS[light]
-    data = bpy.data.lights.new(f"{name} {light}", light)
+    kind, power, location, target, extra = LIGHTS[light]
+    data = bpy.data.lights.new(f"{name} {light}", kind)
     data.energy = power
     for key, value in extra.items():
         setattr(data, key, value)
     lamp = bpy.data.objects.new(f"{name} light", data)
-    lamp.location, lamp.rotation_euler = location, rotation
+    lamp.location = location
+    lamp.rotation_euler = _aim(location, target)  # lights shine down their local -Z
     scene.collection.objects.link(lamp)
 
     camera = bpy.data.objects.new(f"{name} camera", bpy.data.cameras.new(f"{name} camera"))
     camera.data.lens = 35
     camera.location = (0.0, -5.5, 2.4)
-    direction = Vector((0.0, 0.4, 0.6)) - camera.location
-    camera.rotation_euler = direction.to_track_quat("-Z", "Y").to_euler()
+    camera.rotation_euler = _aim(camera.location, (0.0, 0.4, 0.6))
     scene.collection.objects.link(camera)
     scene.camera = camera
     return scene
