@@ -287,6 +287,7 @@ bool sample(const Surface& s, Rng& rng, Scatter& out) {
 struct LightSample {
   Float3 wi;
   float distance = 0;   // to the sampled point (infinite for the sun)
+  Float3 shadow_end;    // where the shadow ray stops: the point, off any surface it lies on
   Float3 radiance;      // incoming radiance divided by the sample's pdf
   float pdf = 0;        // solid angle; 0 for lights BSDF rays cannot hit
 };
@@ -514,6 +515,7 @@ class Tracer {
         const Float3 to_x = x - p;
         out.distance = length(to_x);
         out.wi = to_x / out.distance;
+        out.shadow_end = x;
         // Radiance I / (pi r^2) over the pdf 1 / (pi r^2) per area, to solid angle.
         const float cos_l = dot(frame.n, out.wi);
         out.radiance = l.intensity * (cos_l / (out.distance * out.distance));
@@ -548,6 +550,7 @@ class Tracer {
           a = disk[0] / 2, b = disk[1] / 2;
         }
         const Float3 x = l.center + l.axis_u * (a * l.size_u) + l.axis_v * (b * l.size_v);
+        out.shadow_end = x;
         return to_area_sample(x - p, l.normal, l.radiance, 1 / area_of(l), out);
       }
     }
@@ -570,7 +573,7 @@ class Tracer {
     return true;
   }
 
-  bool sample_emissive_triangle(Float3 p, Rng& rng, LightSample& out, float& surface_offset) const {
+  bool sample_emissive_triangle(Float3 p, Rng& rng, LightSample& out) const {
     const double u = rng.uniform();
     const std::size_t i = std::min(std::size_t(std::lower_bound(emissive_cdf_.begin(), emissive_cdf_.end(), u) -
                                                emissive_cdf_.begin()),
@@ -579,7 +582,7 @@ class Tracer {
     const float r1 = std::sqrt(rng.uniform()), r2 = rng.uniform();
     const Float3 x = corner(t, 0) * (1 - r1) + corner(t, 1) * (r1 * (1 - r2)) + corner(t, 2) * (r1 * r2);
     const Float3 n = normalize(cross(corner(t, 1) - corner(t, 0), corner(t, 2) - corner(t, 0)));
-    surface_offset = 2e-5f * (1 + std::max({std::fabs(x.x), std::fabs(x.y), std::fabs(x.z)}));
+    out.shadow_end = offset(x, n, p - x);  // so that the shadow ray cannot reach the emitter
     return to_area_sample(x - p, n, material(t).emission, triangle_light_pdf_[t], out, true);
   }
 
@@ -597,7 +600,7 @@ class Tracer {
     wanted[kGlossy] &= s.pick[kGlossy] > 0 && !s.mirror;
     if (!wanted[kDiffuse] && !wanted[kGlossy]) return;
 
-    auto shade = [&](const LightSample& ls, float end_offset) {
+    auto shade = [&](const LightSample& ls) {
       LobeValue values[2];
       bool any = false;
       for (int lobe = 0; lobe < 2; ++lobe)
@@ -606,9 +609,16 @@ class Tracer {
           any |= values[lobe].pdf > 0;
         }
       if (!any) return;
+      // Both ends are off their surfaces, so the segment between them can
+      // only hit other geometry.
       const Float3 origin = offset(s.p, s.ng, ls.wi);
-      const float t_far = std::isinf(ls.distance) ? ls.distance : ls.distance * (1 - 1e-5f) - end_offset;
-      if (bvh_.occluded(origin, ls.wi, t_far)) return;
+      if (std::isinf(ls.distance)) {
+        if (bvh_.occluded(origin, ls.wi, ls.distance)) return;
+      } else {
+        const Float3 segment = ls.shadow_end - origin;
+        const float span = length(segment);
+        if (!(span > 0) || bvh_.occluded(origin, segment / span, span)) return;
+      }
       for (int lobe = 0; lobe < 2; ++lobe) {
         if (!(values[lobe].pdf > 0)) continue;
         const float weight = ls.pdf > 0 ? power_heuristic(ls.pdf, values[lobe].pdf) : 1.0f;
@@ -619,9 +629,8 @@ class Tracer {
     };
     LightSample ls;
     for (const Light& l : scene_.lights)
-      if (sample_light(l, s.p, rng, ls)) shade(ls, 0);
-    float end_offset;
-    if (!emissive_.empty() && sample_emissive_triangle(s.p, rng, ls, end_offset)) shade(ls, end_offset);
+      if (sample_light(l, s.p, rng, ls)) shade(ls);
+    if (!emissive_.empty() && sample_emissive_triangle(s.p, rng, ls)) shade(ls);
   }
 
   const Scene& scene_;
