@@ -17,7 +17,6 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -659,7 +658,7 @@ TraceResult trace_lpe(const Scene& scene, const std::vector<std::string>& expres
   result.alpha = Image(width, height, 1);
   const Tracer tracer(scene, dfas, options);
 
-  std::atomic<int> rows_done{0};
+  int rows_done = 0;
   std::mutex progress_mutex;
   parallel_for(height, options.threads, [&](int y) {
     std::vector<int> states(dfas.size());
@@ -681,10 +680,10 @@ TraceResult trace_lpe(const Scene& scene, const std::vector<std::string>& expres
       }
       result.alpha.at(x, y, 0) = alpha * inv;
     }
-    const int done = ++rows_done;
     if (progress) {
+      // Counted under the lock so that reports never go backwards.
       std::lock_guard lock(progress_mutex);
-      if (!progress(double(done) / height)) throw CancelledError("tracing cancelled");
+      if (!progress(double(++rows_done) / height)) throw CancelledError("tracing cancelled");
     }
   });
   return result;
