@@ -74,6 +74,7 @@ void bind_io(py::module_& m) {
 
 void bind_synthesis(py::module_& m);  // bind_synthesis.cpp
 void bind_guides(py::module_& m);     // bind_guides.cpp
+void bind_tracer(py::module_& m);     // bind_tracer.cpp
 
 PYBIND11_MODULE(_native, m) {
   m.doc() = "Tempera native engine";
@@ -82,4 +83,5 @@ PYBIND11_MODULE(_native, m) {
   bind_io(m);
   bind_synthesis(m);
   bind_guides(m);
+  bind_tracer(m);
 }
