@@ -25,7 +25,7 @@ LIGHTS = {
     "SUN": ("SUN", 3.0, (0, 0, 5), (-1.5, 2.0, 2.0), {"angle": math.radians(2)}),
     "AREA": ("AREA", 300.0, (0.5, -1.0, 2.5), (0.3, 0, 0), {"shape": "RECTANGLE", "size": 1.0, "size_y": 0.5}),
     # Low and to the side, aimed at the sphere: a mirror sphere throws a caustic onto the floor.
-    "CAUSTIC": ("AREA", 300.0, (2.0, -0.8, 1.8), SPHERE_CENTRE, {"shape": "DISK", "size": 0.3}),
+    "CAUSTIC": ("AREA", 500.0, (2.0, -0.8, 1.8), SPHERE_CENTRE, {"shape": "DISK", "size": 1.0}),
 }
 
 
