@@ -266,7 +266,7 @@ def test_camera_rays_follow_blenders_projection(kind, size, fit, shift_x, shift_
 
 
 def test_export_follows_animation_and_expands_instances():
-    """Frame-evaluated transforms, collection instances, and the sun's units."""
+    """Frame-evaluated transforms, collection instances, render visibility and the sun's units."""
     from guide_scene import CUBE_START, CUBE_STEP, build_scene, remove_scene
     from tempera.blender.scene_export import export_scene
 
@@ -290,6 +290,12 @@ def test_export_follows_animation_and_expands_instances():
                 near = np.linalg.norm(vertices - np.array(centre + offset), axis=1) < 1.31  # 0.75 * sqrt(3)
                 assert near.sum() >= 8
             assert warnings == []
+        # Disabling the collection in renders hides its cube, not the instance of it.
+        bpy.data.collections["Movers"].hide_render = True
+        exported, _ = export_scene(scene, depsgraph, (65, 48))
+        assert len(exported["triangles"]) == 24
+        centre = CUBE_START + 3 * CUBE_STEP
+        assert not (np.linalg.norm(exported["vertices"] - np.array(centre), axis=1) < 1.31).any()
         sun = exported["lights"][0]
         assert sun["type"] == "sun"
         np.testing.assert_allclose(sun["irradiance"], [3.0] * 3)

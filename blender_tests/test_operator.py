@@ -217,7 +217,7 @@ def _modal_run(scene, events, after_start=None):
 
     class FakeOperator:  # the operator's own methods on a plain object
         invoke, modal, cancel, execute = Op.invoke, Op.modal, Op.cancel, Op.execute
-        _job, _step, _show, _finish = Op._job, Op._step, Op._show, Op._finish
+        _job, _step, _show, _finish, _report_done = Op._job, Op._step, Op._show, Op._finish, Op._report_done
         _running = False
 
         def report(self, kind, message):

@@ -32,14 +32,18 @@ def export_scene(scene, depsgraph, size):
     """(scene dict, [warning, ...]) of `scene` as `depsgraph` evaluates it,
     seen by the scene's camera at `size` = (width, height) pixels."""
     warnings = []
+    rendered = _rendered_objects(depsgraph.view_layer, warnings)
     materials = _Materials(warnings)
     geometry = {"vertices": [], "triangles": [], "triangle_materials": [], "normals": [], "uvs": []}
     lights = []
-    meshes = {}  # object name -> its triangles in object space: instances share them
+    meshes = {}  # evaluated object and data -> its triangles in object space: instances share them
     offset = 0
     for instance in depsgraph.object_instances:
         obj = instance.object
-        if obj.original.hide_render or not instance.show_self:
+        # An instance renders if its instancer does (the instanced original
+        # often sits in a collection hidden on purpose).
+        owner = instance.parent if instance.is_instance else obj
+        if owner.original.name not in rendered or not instance.show_self:
             continue
         matrix = np.array(instance.matrix_world, np.float64)
         if obj.type == "LIGHT":
@@ -47,9 +51,10 @@ def export_scene(scene, depsgraph, size):
             continue
         if obj.type not in GEOMETRY_TYPES:
             continue
-        if obj.name not in meshes:
-            meshes[obj.name] = _triangles(obj, materials, warnings)
-        local = meshes[obj.name]
+        key = (obj.name, obj.data.as_pointer() if obj.data is not None else 0)
+        if key not in meshes:
+            meshes[key] = _triangles(obj, materials, warnings)
+        local = meshes[key]
         if local is None:
             continue
         verts, tris, mats, normals, uvs = local
@@ -75,6 +80,31 @@ def export_scene(scene, depsgraph, size):
         "camera": export_camera(scene, depsgraph, size),
     }
     return out, warnings
+
+
+def _rendered_objects(view_layer, warnings):
+    """Names of the objects a render of the view layer shows: not disabled in
+    renders, in collections neither excluded nor disabled in renders. Those
+    disabled in viewports are missing from the depsgraph (warned)."""
+    names = set()
+
+    def walk(layer_collection, hidden_in_viewport):
+        collection = layer_collection.collection
+        if layer_collection.exclude or collection.hide_render:
+            return
+        hidden_in_viewport = hidden_in_viewport or collection.hide_viewport
+        for obj in collection.objects:
+            if obj.hide_render or obj.name in names:
+                continue
+            names.add(obj.name)
+            if hidden_in_viewport or obj.hide_viewport:
+                warnings.append(f"Object '{obj.name}' is disabled in viewports: the light-path tracer, which "
+                                "sees the scene as the viewport evaluates it, leaves it out.")
+        for child in layer_collection.children:
+            walk(child, hidden_in_viewport)
+
+    walk(view_layer.layer_collection, False)
+    return names
 
 
 def _stack(parts, empty_shape, dtype):
