@@ -145,6 +145,42 @@ def test_light_power_matches_cycles(light, tmp_path):
     assert mean_error <= MEAN_TOLERANCE and block_error <= BLOCK_TOLERANCE
 
 
+def test_emission_and_world_match_cycles(tmp_path):
+    """A diffuse floor lit only by an emissive Principled panel and a constant
+    world: emission colour x strength and background colour x strength."""
+    scene = lpe_scene.build_scene("LPE emission", SIZE, diffuse_only=True, objects=False)
+    panel_mesh = bpy.data.meshes.new("LPE panel")
+    panel_mesh.from_pydata([(-0.6, -0.4, 0), (0.6, -0.4, 0), (0.6, 0.4, 0), (-0.6, 0.4, 0)], [], [(0, 1, 2, 3)])
+    material = bpy.data.materials.new("LPE panel")
+    material.use_nodes = True
+    bsdf = material.node_tree.nodes["Principled BSDF"]
+    bsdf.inputs["Base Color"].default_value = (0, 0, 0, 1)
+    bsdf.inputs["Emission"].default_value = (1.0, 0.8, 0.6, 1)
+    bsdf.inputs["Emission Strength"].default_value = 20.0
+    panel_mesh.materials.append(material)
+    panel = bpy.data.objects.new("LPE panel", panel_mesh)
+    panel.location, panel.rotation_euler = (0.3, 0.2, 1.5), (math.radians(180 - 25), 0, 0)  # facing down
+    scene.collection.objects.link(panel)
+    world = bpy.data.worlds.new("LPE world")
+    world.use_nodes = True
+    background = world.node_tree.nodes["Background"]
+    background.inputs["Color"].default_value = (0.3, 0.4, 0.5, 1)
+    background.inputs["Strength"].default_value = 0.5
+    scene.world = world
+    for obj in [o for o in scene.objects if o.type == "LIGHT"]:
+        bpy.data.objects.remove(obj)
+    try:
+        guides, report = render(scene, tmp_path / "cache", ["LDE"], samples=64)
+    finally:
+        lpe_scene.remove_scene(scene)
+        bpy.data.worlds.remove(world)
+        bpy.data.materials.remove(material)
+    assert report["warnings"] == []
+    mean_error, block_error = compare(traced(guides, "LDE"), guides["LDE"], guides["alpha"])
+    print(f"emission and world: mean error {mean_error:.4f}, block error {block_error:.4f}")
+    assert mean_error <= MEAN_TOLERANCE and block_error <= BLOCK_TOLERANCE
+
+
 def test_caustics_under_a_mirror_sphere():
     """LS+DE, light reflected by the mirror sphere onto the diffuse floor
     (which Cycles cannot isolate), lights the floor in front of the sphere;
