@@ -181,6 +181,40 @@ def test_emission_and_world_match_cycles(tmp_path):
     assert mean_error <= MEAN_TOLERANCE and block_error <= BLOCK_TOLERANCE
 
 
+def test_image_texture_matches_cycles(tmp_path):
+    """A floor textured with an asymmetric 8-bit sRGB image: its colours
+    (decoded to linear) and its orientation (UVs, image rows) as Cycles'."""
+    scene = lpe_scene.build_scene("LPE texture", SIZE, diffuse_only=True, objects=False)
+    # 4 x 2 blocks of 16 x 16 texels: filtering only matters at block edges
+    # (Cycles filters 8-bit sRGB images before decoding them, the tracer after).
+    colours = np.array([[(0.9, 0.1, 0.1), (0.1, 0.8, 0.1), (0.1, 0.1, 0.9), (0.9, 0.9, 0.2)],  # bottom row
+                        [(0.5, 0.5, 0.5), (0.9, 0.4, 0.7), (0.2, 0.7, 0.8), (0.05, 0.05, 0.05)]])
+    texels = np.dstack([colours.repeat(16, axis=0).repeat(16, axis=1), np.ones((32, 64))])
+    image = bpy.data.images.new("LPE checker", 64, 32)
+    image.pixels.foreach_set(texels.astype(np.float32).ravel())
+    floor = next(o for o in scene.objects if o.name.startswith("Floor"))
+    material = floor.material_slots[0].material
+    tree = material.node_tree
+    texture = tree.nodes.new("ShaderNodeTexImage")
+    texture.image = image  # Linear interpolation: bilinear, as the tracer samples textures
+    tree.links.new(texture.outputs["Color"], tree.nodes["Diffuse BSDF"].inputs["Color"])
+    mesh = floor.data
+    uvs = mesh.uv_layers.new(name="UVMap")
+    corners = np.array([mesh.vertices[loop.vertex_index].co[:2] for loop in mesh.loops])
+    low, high = corners.min(axis=0), corners.max(axis=0)
+    for loop, corner in zip(uvs.data, corners):
+        loop.uv = (corner - low) / (high - low)  # the image once over the floor
+    try:
+        guides, report = render(scene, tmp_path / "cache", ["LDE"], samples=32)
+    finally:
+        lpe_scene.remove_scene(scene)
+        bpy.data.images.remove(image)
+    assert report["warnings"] == []
+    mean_error, block_error = compare(traced(guides, "LDE"), guides["LDE"], guides["alpha"])
+    print(f"image texture: mean error {mean_error:.4f}, block error {block_error:.4f}")
+    assert mean_error <= MEAN_TOLERANCE and block_error <= BLOCK_TOLERANCE
+
+
 def test_caustics_under_a_mirror_sphere():
     """LS+DE, light reflected by the mirror sphere onto the diffuse floor
     (which Cycles cannot isolate), lights the floor in front of the sphere;
