@@ -351,12 +351,7 @@ class Tracer {
       if (bounce == 0 && hit_geometry) alpha += 1;
       if (!any_alive) return;
       const float t_geometry = hit_geometry ? hit.t : t_far;
-      Float3 light_radiance;
-      float light_pdf;
-      if (hit_area_light(origin, direction, t_near, t_geometry, light_radiance, light_pdf)) {
-        add_emission(states, sums, throughput * light_radiance, mis_weight(previous_pdf, light_pdf));
-        return;
-      }
+      add_area_lights_crossed(origin, direction, t_near, t_geometry, throughput, previous_pdf, states, sums);
       if (!hit_geometry) {
         add_emission(states, sums, throughput * scene_.world_radiance, 1.0f);
         return;
@@ -472,10 +467,11 @@ class Tracer {
     return s;
   }
 
-  // Closest area light hit in (t_near, t_far) from its emitting side, with
-  // the solid-angle pdf of NEE choosing that point.
-  bool hit_area_light(Float3 o, Float3 d, float t_near, float t_far, Float3& radiance, float& pdf) const {
-    bool found = false;
+  // Adds the area lights the ray crosses from their emitting side within
+  // (t_near, t_far). Lights are transparent, as in Cycles: rays go on behind
+  // them, and they cast no shadows either.
+  void add_area_lights_crossed(Float3 o, Float3 d, float t_near, float t_far, Float3 throughput, float previous_pdf,
+                               const std::vector<int>& states, std::vector<Float3>& sums) const {
     for (const Light& l : scene_.lights) {
       if (l.type != Light::Type::area) continue;
       const float cos_l = -dot(d, l.normal);
@@ -486,12 +482,9 @@ class Tracer {
       const float a = 2 * dot(q, l.axis_u) / l.size_u, b = 2 * dot(q, l.axis_v) / l.size_v;
       const bool inside = l.shape == Light::Shape::rect ? std::fabs(a) <= 1 && std::fabs(b) <= 1 : a * a + b * b <= 1;
       if (!inside) continue;
-      found = true;
-      t_far = t;
-      radiance = l.radiance;
-      pdf = t * t / (area_of(l) * cos_l);
+      const float light_pdf = t * t / (area_of(l) * cos_l);  // of NEE choosing this point
+      add_emission(states, sums, throughput * l.radiance, mis_weight(previous_pdf, light_pdf));
     }
-    return found;
   }
 
   static float area_of(const Light& l) {
