@@ -21,6 +21,7 @@ import bpy
 import numpy as np
 
 from .. import guide_cache, guides, read_image
+from ..lpe import check_lpe, trace_lpe
 from ..stylit_guides import tonemap
 from .scene_export import SceneExportError, export_scene
 
@@ -134,8 +135,9 @@ def check_scene(scene):
 def check_lpe_expressions(expressions):
     """Raises GuideRenderError naming the first malformed light path
     expression and where it goes wrong, before anything is rendered."""
-    from ..lpe import check_lpe
-
+    if isinstance(expressions, str):
+        raise GuideRenderError(f"The light path expressions must be a list of strings, got the string "
+                               f"'{expressions}'.")
     seen = {}
     for i, expression in enumerate(expressions, start=1):
         if not isinstance(expression, str) or not expression.strip():
@@ -154,8 +156,6 @@ def trace_lpe_guides(scene, layer, frame, size, params):
     """({guide name: (H, W, 3) radiance}, warnings) of the frame's light path
     expressions, traced on the scene as the view layer evaluates it at
     `frame`, with the Cycles scene's bounce limit."""
-    from ..lpe import trace_lpe
-
     scene.frame_set(frame)
     # After bpy.ops.render.render, Blender 3.4 can leave the scene's evaluated
     # objects without their transforms while the depsgraph counts as current
@@ -431,8 +431,9 @@ def render_guides(scene, frames, out_dir, params=None, progress=None):
     if unknown:
         raise ValueError(f"unknown guide parameters {sorted(unknown)}; known: {sorted(guide_cache.DEFAULT_PARAMS)}")
     params = {**guide_cache.DEFAULT_PARAMS, **(params or {})}
-    # A list as JSON gives it back, so that the manifest's params compare equal.
-    params["lpe"] = [e.strip() if isinstance(e, str) else e for e in params["lpe"]]
+    # A list of stripped strings: as JSON gives it back, so that the manifest's params compare equal.
+    lpe = params["lpe"]
+    params["lpe"] = lpe if isinstance(lpe, str) else [e.strip() if isinstance(e, str) else e for e in lpe]
     check_lpe_expressions(params["lpe"])
     check_scene(scene)
     frames = sorted({int(f) for f in frames})
