@@ -60,12 +60,10 @@ def render(scene, cache, expressions, samples=SAMPLES):
 
 def trace(scene, expressions, samples=SAMPLES):
     """The tracer's images and alpha of the scene at its current frame."""
-    from tempera.blender.scene_export import export_scene
+    from tempera.blender.scene_export import evaluated_depsgraph, export_scene
     from tempera.lpe import trace_lpe
 
-    scene.frame_set(scene.frame_current)  # evaluates the scene, creating its depsgraph if needed
-    depsgraph = scene.view_layers[0].depsgraph
-    depsgraph.update()
+    depsgraph = evaluated_depsgraph(scene, scene.view_layers[0], scene.frame_current)
     scene_dict, warnings = export_scene(scene, depsgraph, SIZE)
     images, alpha = trace_lpe(scene_dict, expressions, samples=samples, max_bounces=scene.cycles.max_bounces)
     return images, alpha, warnings
@@ -127,6 +125,34 @@ def test_alpha_matches_cycles(metal):
     print(f"alpha IoU {iou:.4f}")
     assert 0.1 < cycles.mean() < 0.9  # background and geometry both in view
     assert iou >= 0.99
+
+
+@pytest.mark.parametrize("kind,size,fit,shift", [("PERSP", (60, 90), "HORIZONTAL", (0.15, -0.1)),
+                                                 ("PERSP", (96, 60), "VERTICAL", (-0.1, 0.2)),
+                                                 ("ORTHO", (96, 72), "AUTO", (0.1, 0.15))])
+def test_alpha_matches_cycles_for_other_cameras(kind, size, fit, shift, tmp_path):
+    """The tracer's own camera (not only the exported numbers) against Cycles:
+    portrait and landscape, sensor fits, shifts, orthographic."""
+    from tempera import guide_cache
+    from tempera.blender.guide_render import render_guides
+    from tempera.blender.scene_export import evaluated_depsgraph, export_scene
+    from tempera.lpe import trace_lpe
+
+    scene = lpe_scene.build_scene(f"LPE {kind} {fit}", size)
+    camera = scene.camera.data
+    camera.type, camera.sensor_fit, camera.ortho_scale = kind, fit, 5.0
+    camera.shift_x, camera.shift_y = shift
+    try:
+        render_guides(scene, [1], tmp_path / "cache", {"samples": 32, "ld12e_samples": 1, "masks": "none"})
+        cycles = guide_cache.read_frame(tmp_path / "cache", 1, ["alpha"])["alpha"] > 0.5
+        scene_dict, _ = export_scene(scene, evaluated_depsgraph(scene, scene.view_layers[0], 1), size)
+        _, alpha = trace_lpe(scene_dict, ["LDE"], samples=32, max_bounces=0)  # edge pixels: enough samples
+    finally:
+        lpe_scene.remove_scene(scene)
+    ours = alpha > 0.5
+    iou = (cycles & ours).sum() / (cycles | ours).sum()
+    print(f"alpha IoU {kind} {fit} {size}: {iou:.4f}")
+    assert 0.1 < cycles.mean() < 0.95 and iou >= 0.99
 
 
 @pytest.mark.parametrize("light", ["POINT", "SUN", "AREA",
@@ -302,7 +328,7 @@ def test_camera_rays_follow_blenders_projection(kind, size, fit, shift_x, shift_
     """Points on the exported camera's pixel rays land on the same pixel
     centres under Blender's own projection matrix."""
     from tempera import scene_units
-    from tempera.blender.scene_export import export_camera
+    from tempera.blender.scene_export import evaluated_depsgraph, export_camera
 
     scene = bpy.data.scenes.new("LPE camera")
     camera = bpy.data.objects.new("LPE camera", bpy.data.cameras.new("LPE camera"))
@@ -314,9 +340,7 @@ def test_camera_rays_follow_blenders_projection(kind, size, fit, shift_x, shift_
         data.lens, data.sensor_width, data.sensor_height, data.ortho_scale = 42.0, 36.0, 20.0, 5.0
         camera.location, camera.rotation_euler = (1.0, -4.0, 2.0), (1.2, 0.1, 0.3)
         scene.render.resolution_x, scene.render.resolution_y = size
-        scene.frame_set(1)  # a new scene's view layer has no depsgraph before this
-        depsgraph = scene.view_layers[0].depsgraph
-        depsgraph.update()
+        depsgraph = evaluated_depsgraph(scene, scene.view_layers[0], 1)
         exported = export_camera(scene, depsgraph, size)
         to_world = np.array(exported["camera_to_world"], np.float64)
         evaluated = camera.evaluated_get(depsgraph)
@@ -338,7 +362,7 @@ def test_camera_rays_follow_blenders_projection(kind, size, fit, shift_x, shift_
 def test_export_follows_animation_and_expands_instances():
     """Frame-evaluated transforms, collection instances, render visibility and the sun's units."""
     from guide_scene import CUBE_START, CUBE_STEP, build_scene, remove_scene
-    from tempera.blender.scene_export import export_scene
+    from tempera.blender.scene_export import evaluated_depsgraph, export_scene
 
     scene = build_scene("LPE export")
     instance = bpy.data.objects.new("Movers instance", None)
@@ -348,9 +372,7 @@ def test_export_follows_animation_and_expands_instances():
     scene.collection.objects.link(instance)
     try:
         for frame in (2, 4):
-            scene.frame_set(frame)
-            depsgraph = scene.view_layers[0].depsgraph
-            depsgraph.update()
+            depsgraph = evaluated_depsgraph(scene, scene.view_layers[0], frame)
             exported, warnings = export_scene(scene, depsgraph, (65, 48))
             vertices = exported["vertices"]
             centre = CUBE_START + (frame - 1) * CUBE_STEP

@@ -23,7 +23,7 @@ import numpy as np
 from .. import guide_cache, guides, read_image
 from ..lpe import check_lpe, trace_lpe
 from ..stylit_guides import tonemap
-from .scene_export import SceneExportError, export_scene
+from .scene_export import SceneExportError, evaluated_depsgraph, export_scene
 
 
 class GuideRenderError(RuntimeError):
@@ -156,16 +156,8 @@ def trace_lpe_guides(scene, layer, frame, size, params):
     """({guide name: (H, W, 3) radiance}, warnings) of the frame's light path
     expressions, traced on the scene as the view layer evaluates it at
     `frame`, with the Cycles scene's bounce limit."""
-    scene.frame_set(frame)
-    # After bpy.ops.render.render, Blender 3.4 can leave the scene's evaluated
-    # objects without their transforms while the depsgraph counts as current
-    # (seen: every mesh at the origin). Tagging every object re-evaluates them.
-    for obj in scene.objects:
-        obj.update_tag(refresh={"OBJECT", "DATA"} if obj.data is not None else {"OBJECT"})
-    depsgraph = layer.depsgraph
-    depsgraph.update()
     try:
-        scene_dict, warnings = export_scene(scene, depsgraph, size)
+        scene_dict, warnings = export_scene(scene, evaluated_depsgraph(scene, layer, frame), size)
     except SceneExportError as exc:
         raise GuideRenderError(str(exc)) from None
     images, _alpha = trace_lpe(scene_dict, params["lpe"], samples=params["lpe_samples"], seed=params["seed"],

@@ -1,5 +1,6 @@
 """The evaluated Blender scene as the scene dict of Tempera's light-path tracer.
 
+    depsgraph = evaluated_depsgraph(scene, view_layer, frame)
     scene_dict, warnings = export_scene(scene, depsgraph, (width, height))
 
 Geometry comes from the depsgraph (modifiers applied, instances expanded,
@@ -26,6 +27,23 @@ PRINCIPLED_IGNORED = {"Subsurface": 0.0, "Sheen": 0.0, "Clearcoat": 0.0, "Anisot
 
 class SceneExportError(ValueError):
     """A scene the tracer cannot render at all (e.g. a panoramic camera)."""
+
+
+def evaluated_depsgraph(scene, view_layer, frame):
+    """The view layer's depsgraph with the scene evaluated afresh at `frame`.
+
+    After bpy.ops.render.render, Blender 3.4 can leave a scene's evaluated
+    objects without their transforms while the depsgraph counts as current
+    (seen: every mesh at the origin), so every object is tagged for
+    re-evaluation, its animation included (a tag without TIME puts animated
+    objects back at their unanimated values). frame_set then evaluates the
+    tags at `frame`, and creates the depsgraph of a scene never evaluated."""
+    for obj in scene.objects:
+        obj.update_tag(refresh={"OBJECT", "DATA", "TIME"} if obj.data is not None else {"OBJECT", "TIME"})
+    scene.frame_set(frame)
+    depsgraph = view_layer.depsgraph
+    depsgraph.update()
+    return depsgraph
 
 
 def export_scene(scene, depsgraph, size):
