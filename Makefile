@@ -1,7 +1,7 @@
 # Tempera: one entry point for humans and CI.
 #   make demo    install deps, build, stylize the bundled demo scene in background Blender
 #   make test    install deps, build, run C++, Python and in-Blender tests
-# Other targets: deps, build, addon-zip, wheel, bench, sanitize, clean.
+# Other targets: deps, build, addon-zip, wheel, bench, bench-tracer, sanitize, clean.
 
 PYTHON   := /usr/bin/python3
 BLENDER  ?= blender
@@ -11,7 +11,7 @@ VERSION  := $(shell sed -n 's/^project.tempera VERSION \([0-9.]*\).*/\1/p' CMake
 ADDON_ZIP := dist/tempera-addon-$(VERSION).zip
 DEMO_OUT ?= out/demo
 
-.PHONY: all deps build addon-zip wheel test demo bench sanitize clean
+.PHONY: all deps build addon-zip wheel test demo bench bench-tracer sanitize clean
 
 all: build
 
@@ -38,6 +38,9 @@ demo: build addon-zip
 
 bench: build
 	PYTHONPATH=addon $(PYTHON) bench/bench_synthesis.py --size 1024 --json docs/bench_synthesis_1024.json
+
+bench-tracer: build
+	PYTHONPATH=addon $(PYTHON) bench/bench_tracer.py --size 1024 --samples 64 --json docs/bench_tracer_1024.json
 
 sanitize: deps
 	cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DTEMPERA_SANITIZE=ON \

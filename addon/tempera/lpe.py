@@ -47,8 +47,6 @@ def _prepare_scene(scene: dict) -> dict:
             out[key] = _int_array(out[key], key)
     if isinstance(out.get("materials"), (list, tuple)):
         out["materials"] = [_prepare_material(m) for m in out["materials"]]
-    if isinstance(out.get("lights"), (list, tuple)):
-        out["lights"] = list(out["lights"])
     return out
 
 

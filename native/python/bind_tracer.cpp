@@ -192,8 +192,10 @@ Scene parse_scene(const py::handle& object) {
     std::array<std::uint32_t, 3> tri;
     for (int c = 0; c < 3; ++c) {
       const std::int64_t v = triangles.at(t, c);
-      // Out-of-range indices map to an invalid one that validate_scene names.
-      tri[c] = v < 0 || v >= std::int64_t(s.vertices.size()) ? std::uint32_t(-1) : std::uint32_t(v);
+      if (v < 0 || v >= std::int64_t(s.vertices.size()))
+        throw ValueError(concat("scene: triangle ", t, " uses vertex ", v, " but there are only ", s.vertices.size(),
+                                " vertices"));
+      tri[c] = std::uint32_t(v);
     }
     s.triangles.push_back(tri);
   }

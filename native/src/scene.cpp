@@ -9,8 +9,10 @@ namespace {
 
 bool finite(Float3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-void require(bool ok, const std::string& message) {
-  if (!ok) throw ValueError("scene: " + message);
+// The message is only built on failure: this runs once per vertex.
+template <typename... Parts>
+void require(bool ok, const Parts&... message) {
+  if (!ok) throw ValueError(concat("scene: ", message...));
 }
 
 void require_finite3(Float3 v, const std::string& what) { require(finite(v), what + " is not finite"); }
@@ -63,7 +65,7 @@ void validate_light(const Light& l, const std::string& what) {
 }
 
 void validate_camera(const Camera& c) {
-  require(c.width > 0 && c.height > 0, concat("camera size ", c.width, "x", c.height, " is empty"));
+  require(c.width > 0 && c.height > 0, "camera size ", c.width, "x", c.height, " is empty");
   for (float f : c.camera_to_world) require(std::isfinite(f), "camera camera_to_world is not finite");
   for (float f : {c.shift_x, c.shift_y, c.clip_start, c.clip_end})
     require(std::isfinite(f), "camera has a non-finite parameter");
@@ -82,25 +84,24 @@ void validate_camera(const Camera& c) {
 
 void validate_scene(const Scene& s) {
   for (std::size_t i = 0; i < s.vertices.size(); ++i)
-    require(finite(s.vertices[i]), concat("vertex ", i, " is not finite"));
+    require(finite(s.vertices[i]), "vertex ", i, " is not finite");
   for (std::size_t t = 0; t < s.triangles.size(); ++t)
     for (std::uint32_t v : s.triangles[t])
-      require(v < s.vertices.size(), concat("triangle ", t, " uses vertex ", v, " but there are only ",
-                                            s.vertices.size(), " vertices"));
+      require(v < s.vertices.size(), "triangle ", t, " uses vertex ", v, " but there are only ", s.vertices.size(),
+              " vertices");
   require(s.triangle_materials.size() == s.triangles.size(),
-          concat("triangle_materials has ", s.triangle_materials.size(), " entries for ", s.triangles.size(),
-                 " triangles"));
+          "triangle_materials has ", s.triangle_materials.size(), " entries for ", s.triangles.size(), " triangles");
   for (std::size_t t = 0; t < s.triangle_materials.size(); ++t) {
     const auto m = s.triangle_materials[t];
     require(m >= 0 && std::size_t(m) < s.materials.size(),
-            concat("triangle ", t, " uses material ", m, " but there are ", s.materials.size(), " materials"));
+            "triangle ", t, " uses material ", m, " but there are ", s.materials.size(), " materials");
   }
   require(s.normals.empty() || s.normals.size() == 3 * s.triangles.size(), "normals must be (T, 3, 3)");
   for (std::size_t i = 0; i < s.normals.size(); ++i)
-    require(finite(s.normals[i]) && length(s.normals[i]) > 0, concat("normal ", i / 3, ",", i % 3, " is invalid"));
+    require(finite(s.normals[i]) && length(s.normals[i]) > 0, "normal ", i / 3, ",", i % 3, " is invalid");
   require(s.uvs.empty() || s.uvs.size() == 3 * s.triangles.size(), "uvs must be (T, 3, 2)");
   for (std::size_t i = 0; i < s.uvs.size(); ++i)
-    require(std::isfinite(s.uvs[i][0]) && std::isfinite(s.uvs[i][1]), concat("uv ", i / 3, ",", i % 3, " is not finite"));
+    require(std::isfinite(s.uvs[i][0]) && std::isfinite(s.uvs[i][1]), "uv ", i / 3, ",", i % 3, " is not finite");
   for (std::size_t i = 0; i < s.materials.size(); ++i) validate_material(s.materials[i], concat("material ", i));
   for (std::size_t i = 0; i < s.lights.size(); ++i) validate_light(s.lights[i], concat("light ", i));
   require_finite3(s.world_radiance, "world radiance");

@@ -284,3 +284,34 @@ TEST(Tracer, ProgressCanCancel) {
   int calls = 0;
   EXPECT_THROW(trace_lpe(sun_scene(1), {"LDE"}, options(1), [&](double) { return ++calls < 2; }), CancelledError);
 }
+
+TEST(Tracer, TextureIsBilinearWithRepeatAndBottomLeftOrigin) {
+  Material m;
+  m.base_color_texture = Image(2, 2, 3);
+  m.base_color_texture.at(0, 0, 0) = 1;  // top-left texel: red
+  m.base_color_texture.at(1, 1, 2) = 1;  // bottom-right texel: blue
+  EXPECT_FLOAT_EQ(base_color_at(m, 0.25f, 0.75f).x, 1);  // texel centres
+  EXPECT_FLOAT_EQ(base_color_at(m, 0.75f, 0.25f).z, 1);
+  EXPECT_FLOAT_EQ(base_color_at(m, 1.75f, -0.75f).z, 1);  // repeat
+  EXPECT_FLOAT_EQ(base_color_at(m, 0.5f, 0.75f).x, 0.5f);  // halfway between texel centres
+  EXPECT_FLOAT_EQ(base_color_at(m, 0.0f, 0.75f).x, 0.5f);  // blends with the wrapped column
+}
+
+TEST(Tracer, SpotLightIsAPointLightInsideItsCone) {
+  Scene s;
+  s.materials = {lambert(0.5f)};
+  add_floor(s, 100, 0);
+  Light spot;
+  spot.type = Light::Type::spot;
+  spot.position = {0, 0, 1};
+  spot.direction = {0, 0, -1};
+  spot.intensity = {10, 10, 10};
+  spot.spot_half_angle = 0.5f;  // reaches tan(0.5) = 0.546 m on the floor
+  s.lights = {spot};
+  s.camera = top_camera(5, 4, 16);  // pixels 0.25 m wide
+  const TraceResult r = trace_lpe(s, {"LDE"}, options(16));
+  EXPECT_EQ(r.images[0].at(0, 0, 0), 0.0f);  // outside the cone
+  // The pixel at (0.125, 0.125) m is well inside; compare with the point light law.
+  const double d2 = 2 * 0.125 * 0.125 + 1;
+  EXPECT_NEAR(r.images[0].at(8, 7, 0), 0.5 / kPi * 10 / std::pow(d2, 1.5), 0.03);
+}

@@ -78,7 +78,7 @@ def test_bad_arrays_raise_value_error():
         tempera.trace_lpe(scene, ["LDE"], samples=1)
     scene = plane_scene()
     scene["triangles"] = np.array([[0, 1, 2], [0, 2, 7]], np.int32)
-    with pytest.raises(ValueError, match="triangle 1"):
+    with pytest.raises(ValueError, match="triangle 1 uses vertex 7 but there are only 4 vertices"):
         tempera.trace_lpe(scene, ["LDE"], samples=1)
     scene = plane_scene()
     scene["camera"]["width"] = 0
