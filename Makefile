@@ -1,7 +1,7 @@
 # Tempera: one entry point for humans and CI.
 #   make demo    install deps, build, stylize the bundled demo scene in background Blender
 #   make test    install deps, build, run C++, Python and in-Blender tests
-# Other targets: deps, build, kit, addon-zip, wheel, bench, sanitize, clean.
+# Other targets: deps, build, kit, addon-zip, wheel, bench, bench-tracer, sanitize, clean.
 
 PYTHON   := /usr/bin/python3
 BLENDER  ?= blender
@@ -15,7 +15,7 @@ KIT_SOURCES := scenes/exemplar_kit.py scenes/scene_kit.py addon/tempera/exemplar
                addon/tempera/blender/guide_render.py addon/tempera/guide_cache.py
 DEMO_OUT ?= out/demo
 
-.PHONY: all deps build kit addon-zip wheel test demo bench sanitize clean
+.PHONY: all deps build kit addon-zip wheel test demo bench bench-tracer sanitize clean
 
 all: build
 
@@ -48,6 +48,9 @@ demo: build addon-zip
 
 bench: build
 	PYTHONPATH=addon $(PYTHON) bench/bench_synthesis.py --size 1024 --json docs/bench_synthesis_1024.json
+
+bench-tracer: build
+	PYTHONPATH=addon $(PYTHON) bench/bench_tracer.py --size 1024 --samples 64 --json docs/bench_tracer_1024.json
 
 sanitize: deps
 	cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DTEMPERA_SANITIZE=ON \

@@ -160,11 +160,20 @@ def test_output_panel_draws_version_and_settings():
                      "output_dir", "output_format", "make_video", "load_result",
                      "guide_dir", "guide_frame_range", "guide_samples",
                      "guide_occlusion_epsilon", "guide_line_d_max", "guide_masks",
-                     "guide_orientation_aov"]
+                     "guide_orientation_aov", "guide_lpe"]
     assert f"Version {tempera.__version__}" in labels
     assert {"Exemplar", "Light Path Guides", "Synthesis", "Output", "Guides"} <= set(labels)
     assert [name for kind, name in calls if kind == "operator"] == [
         "tempera.render_guides", "tempera.stylize", "tempera.stylize"]
+    # LPE Samples only matter, and only show, once there are expressions.
+    settings = bpy.context.scene.tempera
+    settings.guide_lpe = "LDE"
+    try:
+        calls.clear()
+        bpy.types.TEMPERA_PT_output.draw(fake, bpy.context)
+    finally:
+        settings.guide_lpe = ""
+    assert [name for kind, name in calls if kind == "prop"][-2:] == ["guide_lpe", "guide_lpe_samples"]
 
 
 def test_preferences_draw_reports_the_cli(tmp_path):

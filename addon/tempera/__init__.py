@@ -32,15 +32,18 @@ except ImportError as exc:  # not built, or built for another Python
 
 # Python API on top of the native module; public entry points are listed in __all__.
 from .contact_sheet import contact_sheet
+from .lpe import check_lpe, trace_lpe
 from .synthesis import USAGE_MODES, synthesize
 
 __all__ = [
     "__version__",
     "Cancelled",
+    "check_lpe",
     "contact_sheet",
     "image_info",
     "read_image",
     "synthesize",
+    "trace_lpe",
     "USAGE_MODES",
     "write_image",
 ]

@@ -7,7 +7,8 @@ Layout of a cache folder (documented in docs/guide_cache.md):
     ...
 
 Channel names are "<guide>.<component>" (GUIDES below); masks are
-"mask.<OB_|CO_><name>.V". All values are float32 and linear (light-path
+"mask.<OB_|CO_><name>.V"; light path expression guides are "lpe_<name>.R/G/B"
+(lpe_guide below). All values are float32 and linear (light-path
 guides are radiance, not tone-mapped: apply tempera.stylit_guides.tonemap).
 Images are rows top-down; x runs right and y down, velocities are in pixels
 with the conventions of tempera.guides.
@@ -21,6 +22,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import re
 import tempfile
 from pathlib import Path
 
@@ -63,13 +65,21 @@ DEFAULT_PARAMS = {
     # write the stroke direction in screen space (R = x right, G = y up);
     # "" computes the orientation from the render instead.
     "orientation_aov": "",
+    # Light path expressions (docs/lpe_guides.md) traced by Tempera's own path
+    # tracer, each written as an RGB guide named by lpe_guide(); [] for none.
+    "lpe": [],
+    "lpe_samples": 64,  # tracer samples per pixel of every expression
 }
+
+LPE_PREFIX = "lpe_"
 
 
 def channel_names(guide):
     """EXR channel names of one guide, e.g. ['velocity_forward.X', 'velocity_forward.Y']."""
     if guide.startswith("mask."):
         return [f"{guide}.V"]
+    if guide.startswith(LPE_PREFIX):
+        return [f"{guide}.{c}" for c in "RGB"]
     try:
         return [f"{guide}.{c}" for c in GUIDES[guide]]
     except KeyError:
@@ -82,6 +92,35 @@ def mask_guide(kind, name):
     if kind not in ("OB", "CO"):
         raise ValueError(f"mask kind must be 'OB' or 'CO', got {kind!r}")
     return f"mask.{kind}_{name.replace('.', '_')}"
+
+
+def lpe_guide(expression):
+    """Guide name of a light path expression: "lpe_" and the expression if it
+    is only letters and digits ("LDE" -> "lpe_LDE"); otherwise every run of
+    other characters becomes "_" and 8 hex digits of the expression's SHA-1
+    follow ("L.*DDE" -> "lpe_L_DDE_<hash>"), so no two expressions share a name
+    and no dot splits the EXR layer. The manifest maps names to expressions."""
+    safe = re.sub(r"[^A-Za-z0-9]+", "_", expression).strip("_")
+    if safe == expression:
+        return LPE_PREFIX + expression
+    digest = hashlib.sha1(expression.encode()).hexdigest()[:8]
+    return f"{LPE_PREFIX}{safe}_{digest}" if safe else f"{LPE_PREFIX}{digest}"
+
+
+def split_expressions(text):
+    """Light path expressions of a ';' or ',' separated list, e.g. the
+    add-on's text field: "L.*SDE; LD{1,2}E" -> ["L.*SDE", "LD{1,2}E"]. Commas
+    inside braces belong to a repeat count, not the list."""
+    out, depth, current = [], 0, ""
+    for char in text:
+        depth += {"{": 1, "}": -1}.get(char, 0)
+        if char == ";" or (char == "," and depth <= 0):
+            out.append(current)
+            current = ""
+        else:
+            current += char
+    out.append(current)
+    return [e.strip() for e in out if e.strip()]
 
 
 def frame_path(cache_dir, frame):

@@ -39,6 +39,9 @@ const char* kRenderGuidesHelp =
     "  --line-depth-threshold T, --line-normal-angle DEG, --d-max D   line guide\n"
     "  --masks MODE            objects+collections | objects | collections | none\n"
     "  --orientation-aov NAME  Color shader AOV holding the artist's stroke directions\n"
+    "  --lpe EXPR              also trace this light path expression as a guide (repeatable),\n"
+    "                          e.g. --lpe 'L.*SDE' --lpe 'LD{2}E' (docs/lpe_guides.md)\n"
+    "  --lpe-samples N         path-tracer samples per pixel of each expression (default 64)\n"
     "  --blender PATH          Blender to run (default: $TEMPERA_BLENDER or 'blender')\n"
     "  --addon-path DIR        folder holding the tempera package\n"
     "                          (default: $TEMPERA_ADDON_PATH or this build's addon folder)\n";

@@ -75,6 +75,7 @@ void bind_io(py::module_& m) {
 void bind_synthesis(py::module_& m);  // bind_synthesis.cpp
 void bind_guides(py::module_& m);     // bind_guides.cpp
 void bind_stylize(py::module_& m);    // bind_stylize.cpp
+void bind_tracer(py::module_& m);     // bind_tracer.cpp
 
 PYBIND11_MODULE(_native, m) {
   m.doc() = "Tempera native engine";
@@ -84,4 +85,5 @@ PYBIND11_MODULE(_native, m) {
   bind_synthesis(m);
   bind_guides(m);
   bind_stylize(m);
+  bind_tracer(m);
 }

@@ -78,3 +78,21 @@ def test_clear_errors(cli_path, user_blend, tmp_path):
         result = render_guides(cli_path, *args)
         assert result.returncode != 0, args
         assert message in result.stderr, (args, result.stderr[-1500:])
+
+
+def test_lpe_options_reach_the_guide_cache(cli_path, user_blend, tmp_path):
+    out = tmp_path / "cache"
+    result = render_guides(cli_path, user_blend, "--frames", "2", "--out", out, "--samples", "2", "--ld12e-samples",
+                           "2", "--masks", "none", "--lpe", "LDE", "--lpe", "L.*SDE", "--lpe-samples", "4")
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    manifest = guide_cache.read_manifest(out)
+    assert manifest["params"]["lpe"] == ["LDE", "L.*SDE"] and manifest["params"]["lpe_samples"] == 4
+    caustics = guide_cache.lpe_guide("L.*SDE")
+    assert manifest["lpe"] == {"lpe_LDE": "LDE", caustics: "L.*SDE"}
+    guides = guide_cache.read_frame(out, 2, ["lpe_LDE", caustics])
+    assert guides["lpe_LDE"].shape == (36, 48, 3) and guides["lpe_LDE"].max() > 0
+
+    bad = render_guides(cli_path, user_blend, "--frames", "2", "--out", tmp_path / "bad", "--lpe", "L(DE")
+    assert bad.returncode != 0
+    assert "Light path expression 1 'L(DE' is malformed" in bad.stderr and "position 4" in bad.stderr
+    assert not (tmp_path / "bad").exists()

@@ -17,6 +17,23 @@ def test_channel_names_of_the_documented_guides():
         guide_cache.channel_names("NOPE")
 
 
+def test_lpe_guide_names_are_exr_safe_and_distinct():
+    assert guide_cache.lpe_guide("LDE") == "lpe_LDE"
+    assert guide_cache.channel_names("lpe_LDE") == ["lpe_LDE.R", "lpe_LDE.G", "lpe_LDE.B"]
+    expressions = ["L.*DDE", "L.*D.E", "L.*D*E", "LD{2}E", "LD{1,2}E", "LD+E", "LD*E", "L(D|S)E", "L[DS]E",
+                   "L_DDE", "LD2E", "...", "LDE"]
+    names = [guide_cache.lpe_guide(e) for e in expressions]
+    assert len(set(names)) == len(names)
+    for name in names:
+        assert name.startswith("lpe_") and all(c.isalnum() or c == "_" for c in name), name
+    assert guide_cache.lpe_guide("L.*DDE").startswith("lpe_L_DDE_") and len(guide_cache.lpe_guide("L.*DDE")) == 18
+
+
+def test_split_expressions_keeps_braced_commas():
+    assert guide_cache.split_expressions("L.*SDE; LD{1,2}E, LSE ;") == ["L.*SDE", "LD{1,2}E", "LSE"]
+    assert guide_cache.split_expressions("  ") == []
+
+
 def test_frames_round_trip_by_guide_name(tmp_path):
     rng = np.random.default_rng(0)
     frame = {

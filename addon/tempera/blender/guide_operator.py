@@ -21,7 +21,7 @@ import bpy
 from bpy.types import Operator
 
 from .. import guide_cache
-from .guide_render import GuideRenderError, check_scene, render_guides, scene_fingerprint
+from .guide_render import GuideRenderError, check_lpe_expressions, check_scene, render_guides, scene_fingerprint
 from .job_operator import JobOperator
 from .properties import GUIDE_MASK_MODES
 
@@ -39,6 +39,8 @@ def guide_params(settings):
         "line_d_max": float(settings.guide_line_d_max),
         "masks": GUIDE_MASK_MODES[settings.guide_masks],
         "orientation_aov": settings.guide_orientation_aov.strip(),
+        "lpe": guide_cache.split_expressions(settings.guide_lpe),
+        "lpe_samples": settings.guide_lpe_samples,
     }
 
 
@@ -95,6 +97,7 @@ class GuideJob:
         self.index = 0  # frames done (rendered or skipped)
         self.rendered, self.skipped = [], []
         self.render_seconds = 0.0  # time spent on rendered frames (skipped ones take none)
+        self.warnings = []  # what the light-path tracer approximated, once each
 
     @classmethod
     def from_settings(cls, scene, frames=None):
@@ -105,7 +108,9 @@ class GuideJob:
         folder = resolve_guide_dir(settings.guide_dir)
         frames = guide_frames(scene, settings) if frames is None else list(frames)
         check_scene(scene)
-        return cls(scene, frames, folder, guide_params(settings))
+        params = guide_params(settings)
+        check_lpe_expressions(params["lpe"])
+        return cls(scene, frames, folder, params)
 
     @property
     def total(self):
@@ -137,6 +142,7 @@ class GuideJob:
 
         start = time.monotonic()
         report = render_guide_frame(self.scene(), frame, self.folder, self.params, frame_progress)
+        self.warnings += [w for w in report["warnings"] if w not in self.warnings]
         if report["rendered"]:
             self.rendered.append(frame)
             self.render_seconds += time.monotonic() - start
@@ -193,6 +199,7 @@ def cache_status(scene):
         folder = resolve_guide_dir(settings.guide_dir)
         frames = guide_frames(scene, settings)
         check_scene(scene)
+        check_lpe_expressions(guide_cache.split_expressions(settings.guide_lpe))
     except (ValueError, GuideRenderError) as exc:
         return str(exc), "ERROR"
     try:
@@ -229,3 +236,7 @@ class TEMPERA_OT_render_guides(JobOperator, Operator):
 
     def make_job(self, context):
         return GuideJob.from_settings(context.scene)
+
+    def job_finished(self, context, job):
+        for warning in job.warnings:  # approximations of the light-path tracer, e.g. unsupported nodes
+            self.report({"WARNING"}, warning)

@@ -6,6 +6,8 @@ Per frame: one main render with the light-path, motion, depth, normal and
 object-index passes, and a second render with one diffuse and no glossy or
 transmission bounce for LD{1,2}E. The derived guides (velocities, occlusion,
 structure tensor, lines, masks) are computed with numpy and tempera.guides.
+Guides of arbitrary light path expressions (params["lpe"]) come from
+Tempera's own path tracer on the exported scene (scene_export, tempera.lpe).
 
 Every setting changed for this (render, Cycles, passes, view layers, frame,
 objects' pass index) is put back exactly afterwards by GuideRenderSettings:
@@ -19,7 +21,9 @@ import bpy
 import numpy as np
 
 from .. import guide_cache, guides, read_image
+from ..lpe import check_lpe, trace_lpe
 from ..stylit_guides import tonemap
+from .scene_export import SceneExportError, evaluated_depsgraph, export_scene
 
 
 class GuideRenderError(RuntimeError):
@@ -126,6 +130,39 @@ def check_scene(scene):
     if scene.camera is None:
         raise GuideRenderError(f"Scene '{scene.name}' has no active camera to render the guides from.")
     guide_view_layer(scene)
+
+
+def check_lpe_expressions(expressions):
+    """Raises GuideRenderError naming the first malformed light path
+    expression and where it goes wrong, before anything is rendered."""
+    if isinstance(expressions, str):
+        raise GuideRenderError(f"The light path expressions must be a list of strings, got the string "
+                               f"'{expressions}'.")
+    seen = {}
+    for i, expression in enumerate(expressions, start=1):
+        if not isinstance(expression, str) or not expression.strip():
+            raise GuideRenderError(f"Light path expression {i} is empty.")
+        try:
+            check_lpe(expression)
+        except ValueError as exc:
+            raise GuideRenderError(f"Light path expression {i} '{expression}' is malformed: {exc}") from None
+        name = guide_cache.lpe_guide(expression)
+        if name in seen:
+            raise GuideRenderError(f"Light path expression {i} '{expression}' repeats expression {seen[name]}.")
+        seen[name] = i
+
+
+def trace_lpe_guides(scene, layer, frame, size, params):
+    """({guide name: (H, W, 3) radiance}, warnings) of the frame's light path
+    expressions, traced on the scene as the view layer evaluates it at
+    `frame`, with the Cycles scene's bounce limit."""
+    try:
+        scene_dict, warnings = export_scene(scene, evaluated_depsgraph(scene, layer, frame), size)
+    except SceneExportError as exc:
+        raise GuideRenderError(str(exc)) from None
+    images, _alpha = trace_lpe(scene_dict, params["lpe"], samples=params["lpe_samples"], seed=params["seed"],
+                               max_bounces=scene.cycles.max_bounces)
+    return {guide_cache.lpe_guide(e): image for e, image in zip(params["lpe"], images)}, warnings
 
 
 def check_orientation_aov(scene, layer, name):
@@ -377,13 +414,19 @@ def render_guides(scene, frames, out_dir, params=None, progress=None):
     Frames whose cache is current (same parameters, same scene at that frame)
     are skipped. `params` overrides tempera.guide_cache.DEFAULT_PARAMS.
     `progress(done, total, message)` is called as frames complete.
-    Returns {"rendered": [frames], "skipped": [frames], "manifest": path}.
-    Raises GuideRenderError with an explanation if the scene cannot be used.
+    Returns {"rendered": [frames], "skipped": [frames], "manifest": path,
+    "warnings": [what the light-path tracer approximates]}.
+    Raises GuideRenderError with an explanation if the scene cannot be used
+    or a light path expression is malformed (before rendering anything).
     """
     unknown = set(params or {}) - set(guide_cache.DEFAULT_PARAMS)
     if unknown:
         raise ValueError(f"unknown guide parameters {sorted(unknown)}; known: {sorted(guide_cache.DEFAULT_PARAMS)}")
     params = {**guide_cache.DEFAULT_PARAMS, **(params or {})}
+    # A list of stripped strings: as JSON gives it back, so that the manifest's params compare equal.
+    lpe = params["lpe"]
+    params["lpe"] = lpe if isinstance(lpe, str) else [e.strip() if isinstance(e, str) else e for e in lpe]
+    check_lpe_expressions(params["lpe"])
     check_scene(scene)
     frames = sorted({int(f) for f in frames})
     if not frames:
@@ -392,7 +435,7 @@ def render_guides(scene, frames, out_dir, params=None, progress=None):
     manifest = guide_cache.read_manifest(out_dir) or {}
     if manifest.get("params") != params:
         manifest = {}  # other parameters: no cached frame can be current
-    report = {"rendered": [], "skipped": [], "manifest": out_dir / guide_cache.MANIFEST_NAME}
+    report = {"rendered": [], "skipped": [], "manifest": out_dir / guide_cache.MANIFEST_NAME, "warnings": []}
     with shown_in_window(scene), guide_render_settings(scene):
         keys = {f: guide_cache.frame_key(params, scene_fingerprint(scene, f)) for f in frames}
         todo = [f for f in frames if not guide_cache.is_frame_current(out_dir, manifest, f, keys[f])]
@@ -401,7 +444,8 @@ def render_guides(scene, frames, out_dir, params=None, progress=None):
             guide_cache.write_manifest(out_dir, manifest)
         if todo:
             with tempfile.TemporaryDirectory(prefix="tempera-guides-") as tmp:
-                _render_frames(scene, todo, keys, manifest, out_dir, Path(tmp), params, progress)
+                report["warnings"] = _render_frames(scene, todo, keys, manifest, out_dir, Path(tmp), params,
+                                                    progress)
         report["rendered"] = todo
     return report
 
@@ -465,20 +509,27 @@ def _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress):
         path = _render(scene, tmp / f"motion_{frame}.exr", frame)
         return _read_passes(path, layer.name, MOTION_PASSES)["Vector"]
 
-    # 2. Derived guides, one cache EXR per frame, manifest after each.
+    # 2. Derived and traced guides, one cache EXR per frame, manifest after each.
     frame_entries = manifest.get("frames", {})
+    warnings = []
     for i, frame in enumerate(todo):
         main = _read_passes(renders[frame][0], layer.name, main_passes)
         ld12e = _read_passes(renders[frame][1], layer.name, LD12E_PASSES)
         _, v_plus_prev = guide_cache.velocities_from_vector_pass(vector_pass(frame - 1))
         v_minus_next, _ = guide_cache.velocities_from_vector_pass(vector_pass(frame + 1))
         frame_data = frame_guides(main, ld12e, v_plus_prev, v_minus_next, masks, params)
+        height, width = main["Combined"].shape[:2]
+        if params["lpe"]:
+            step(i, f"tracing the light path expressions of frame {frame}")
+            traced, frame_warnings = trace_lpe_guides(scene, layer, frame, (width, height), params)
+            frame_data.update(traced)
+            warnings += [w for w in frame_warnings if w not in warnings]
         path = guide_cache.write_frame(out_dir, frame, frame_data)
         frame_entries[str(frame)] = {"key": keys[frame], "file": path.name}
-        height, width = main["Combined"].shape[:2]
         manifest = _manifest(scene, layer, params, frame_entries, list(frame_data), masks, (width, height))
         guide_cache.write_manifest(out_dir, manifest)
         step(i + 1, f"guides of frame {frame} written")
+    return warnings
 
 
 @contextmanager
@@ -513,6 +564,7 @@ def _manifest(scene, layer, params, frames, guide_names, masks, size):
         "frames": frames,
         "guides": guide_names,
         "masks": {g: {"kind": kind, "name": name} for g, (kind, name, _) in masks.items()},
+        "lpe": {guide_cache.lpe_guide(e): e for e in params["lpe"]},
         "blender_version": bpy.app.version_string,
         "source_file": bpy.data.filepath or None,
         "params": params,

@@ -86,6 +86,9 @@ def draw_guides(box, scene, settings):
     col.prop(settings, "guide_line_d_max")
     col.prop(settings, "guide_masks")
     col.prop(settings, "guide_orientation_aov")
+    col.prop(settings, "guide_lpe")
+    if settings.guide_lpe.strip():
+        col.prop(settings, "guide_lpe_samples")
     try:
         text, icon = cache_status(scene)
     except Exception as exc:  # a status line must never break the panel

@@ -168,6 +168,21 @@ class TemperaSettings(PropertyGroup):
         items=_MASK_ITEMS,
         default=_DEFAULT_MASK_MODE,
     )
+    guide_lpe: StringProperty(
+        name="Light Path Expressions",
+        description=("Extra light-path guides traced by Tempera's own path tracer, one RGB guide per "
+                     "expression, separated by ';' or ','. Written light to eye: L light, D diffuse, "
+                     "S glossy/specular, T transmission, E eye; . any, * + ? {m,n} [..] | (..). "
+                     "E.g. 'L.*SDE; LD{2}E' (caustics; second diffuse bounce)"),
+        default="; ".join(guide_cache.DEFAULT_PARAMS["lpe"]),
+    )
+    guide_lpe_samples: IntProperty(
+        name="LPE Samples",
+        description="Path-tracer samples per pixel of each light path expression guide",
+        default=guide_cache.DEFAULT_PARAMS["lpe_samples"],
+        min=1,
+        soft_max=4096,
+    )
     guide_orientation_aov: StringProperty(
         name="Orientation AOV",
         description=("Color shader AOV of the view layer in which your materials write the stroke direction "

@@ -4,7 +4,7 @@ message on any problem. The .blend on disk is never written.
 
     blender -b --factory-startup SCENE.blend --python-exit-code 1 \\
         --python-expr "...; from tempera.blender.render_guides_main import main; main()" \\
-        -- --frames 1-24 --out DIR [--scene NAME] [--samples N] ...
+        -- --frames 1-24 --out DIR [--scene NAME] [--samples N] [--lpe EXPR ...] ...
 """
 import argparse
 import sys
@@ -28,6 +28,7 @@ PARAM_FLAGS = {
     "line_d_max": ("--d-max", float),
     "masks": ("--masks", str),
     "orientation_aov": ("--orientation-aov", str),
+    "lpe_samples": ("--lpe-samples", int),
 }
 
 
@@ -38,6 +39,8 @@ def parse_args(argv):
     parser.add_argument("--scene", help="scene name (default: the file's active scene)")
     for key, (flag, kind) in PARAM_FLAGS.items():
         parser.add_argument(flag, dest=key, type=kind, help=f"default {guide_cache.DEFAULT_PARAMS[key]}")
+    parser.add_argument("--lpe", action="append", metavar="EXPR",
+                        help="a light path expression to trace as a guide (repeat for more), e.g. 'L.*SDE'")
     return parser.parse_args(argv)
 
 
@@ -51,6 +54,8 @@ def main():
             names = ", ".join(s.name for s in bpy.data.scenes)
             raise ValueError(f"no scene named {args.scene!r} in {bpy.data.filepath} (it has: {names})")
         params = {key: getattr(args, key) for key in PARAM_FLAGS if getattr(args, key) is not None}
+        if args.lpe:
+            params["lpe"] = args.lpe
         started = time.monotonic()
 
         def progress(done, total, message):
@@ -59,6 +64,8 @@ def main():
             print(f"tempera render-guides: {done}/{total} {message} (ETA {eta:.0f} s)", flush=True)
 
         report = render_guides(scene, frames, args.out, params, progress)
+        for warning in report["warnings"]:
+            print(f"tempera render-guides: warning: {warning}", flush=True)
     except (GuideRenderError, ValueError, OSError) as exc:
         print(f"tempera render-guides: error: {exc}", file=sys.stderr, flush=True)
         sys.exit(1)

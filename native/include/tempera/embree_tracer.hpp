@@ -1,0 +1,38 @@
+#pragma once
+// Light-path-expression guides by path tracing (Embree 3 for ray queries).
+// One pass fills one radiance image per expression: every path's event string
+// is matched against every expression, and its contributions go to the
+// images of the expressions it matches (the sets need not be disjoint).
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "tempera/image.hpp"
+#include "tempera/scene.hpp"
+
+namespace tempera {
+
+struct TraceOptions {
+  int samples = 64;   // per pixel, stratified
+  std::uint64_t seed = 0;
+  int threads = 0;    // 0: all cores; the result does not depend on it
+  // Indirect bounces as Cycles counts them: 0 gives direct light only (one
+  // scattering event per path), 8 allows paths of up to nine.
+  int max_bounces = 8;
+};
+
+struct TraceResult {
+  std::vector<Image> images;  // (H, W, 3) linear radiance, one per expression
+  Image alpha;                // (H, W, 1) fraction of camera rays that hit geometry
+};
+
+// Called with the fraction done; returning false cancels (CancelledError).
+using TraceProgress = std::function<bool(double)>;
+
+// Throws ValueError for a malformed expression or scene, and a tempera error
+// carrying Embree's message if Embree fails.
+TraceResult trace_lpe(const Scene& scene, const std::vector<std::string>& expressions,
+                      const TraceOptions& options, const TraceProgress& progress = {});
+
+}  // namespace tempera

@@ -1,0 +1,111 @@
+#pragma once
+// The light-path tracer's scene: plain triangles, materials, lights, world and
+// camera in world space and physical units. Nothing here knows Blender; the
+// add-on's exporter converts Blender's data into exactly this.
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "tempera/image.hpp"
+
+namespace tempera {
+
+struct Float3 {
+  float x = 0, y = 0, z = 0;
+  float operator[](int i) const { return i == 0 ? x : i == 1 ? y : z; }
+};
+inline Float3 operator+(Float3 a, Float3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline Float3 operator-(Float3 a, Float3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline Float3 operator-(Float3 a) { return {-a.x, -a.y, -a.z}; }
+inline Float3 operator*(Float3 a, Float3 b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
+inline Float3 operator*(Float3 a, float s) { return {a.x * s, a.y * s, a.z * s}; }
+inline Float3 operator*(float s, Float3 a) { return a * s; }
+inline Float3 operator/(Float3 a, float s) { return a * (1.0f / s); }
+inline Float3& operator+=(Float3& a, Float3 b) { return a = a + b; }
+inline Float3& operator*=(Float3& a, Float3 b) { return a = a * b; }
+inline float dot(Float3 a, Float3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline Float3 cross(Float3 a, Float3 b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline float length(Float3 a) { return std::sqrt(dot(a, a)); }
+inline Float3 normalize(Float3 a) { return a / length(a); }
+inline float max_component(Float3 a) { return std::fmax(a.x, std::fmax(a.y, a.z)); }
+inline float luminance(Float3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+struct Material {
+  Float3 base_color{0.8f, 0.8f, 0.8f};
+  float metallic = 0;
+  float specular = 0.5f;   // Blender's: F0 = 0.08 * specular for dielectrics
+  float roughness = 0.5f;  // GGX alpha = roughness^2; below 0.01 a perfect mirror
+  float transmission = 0;
+  float ior = 1.45f;
+  Float3 emission{0, 0, 0};  // radiance W/m^2/sr, strength included; both sides emit
+  // Optional linear RGB (H, W, 3) texture; when present it replaces base_color.
+  // Sampled bilinearly with repeat; UV (0,0) is the bottom-left corner, so
+  // image row 0 is v = 1 (as Blender shows images).
+  Image base_color_texture;
+};
+
+struct Light {
+  enum class Type { point, spot, sun, area } type = Type::point;
+  enum class Shape { rect, disk } shape = Shape::rect;
+  Float3 position;        // point, spot
+  Float3 direction;       // spot: where it shines; sun: towards the light
+  float radius = 0;       // point, spot: a disk of this radius facing the shaded point
+  Float3 intensity;       // point, spot: W/sr
+  float spot_half_angle = 0.7853982f;  // spot cone half-angle, radians
+  float spot_blend = 0;                // spot: Blender's smoothstep blend in [0, 1]
+  float angle = 0;        // sun: angular diameter, radians
+  Float3 irradiance;      // sun: W/m^2 on a surface facing the sun
+  Float3 center, axis_u, axis_v, normal;  // area: unit axes; emits along +normal only
+  float size_u = 1, size_v = 1;           // area: full extents (disk: diameters)
+  Float3 radiance;        // area: W/m^2/sr
+};
+
+// Camera projection. The camera looks down its local -Z with +Y up; the
+// 4x4 row-major camera_to_world matrix maps camera space to world space
+// (Blender's matrix_world of the camera object, with unit scale).
+// Pixel (x, y) has rows top-down and its centre at (x + 0.5, y + 0.5); with
+// ndc_x = 2 (x + 0.5) / width - 1 and ndc_y = 1 - 2 (y + 0.5) / height:
+//   perspective:  ray from the camera origin along camera-space
+//                 (ndc_x * tan_half_fov_x + 2 * shift_x * t,
+//                  ndc_y * tan_half_fov_y + 2 * shift_y * t, -1)
+//                 where t = tan_half_fov of the larger image side (Blender's
+//                 sensor fit AUTO: shift is in units of the larger side);
+//   orthographic: ray along camera-space -Z from
+//                 (ndc_x * ortho_width / 2 + shift_x * s,
+//                  ndc_y * ortho_height / 2 + shift_y * s, 0)
+//                 where s = max(ortho_width, ortho_height) (Blender's ortho_scale).
+// Geometry counts only between clip_start and clip_end, measured along the
+// view axis (depth) as Blender clips; beyond that rays see the world.
+struct Camera {
+  enum class Type { perspective, orthographic } type = Type::perspective;
+  std::array<float, 16> camera_to_world{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  int width = 0, height = 0;
+  float tan_half_fov_x = 0.5f, tan_half_fov_y = 0.5f;
+  float shift_x = 0, shift_y = 0;
+  float ortho_width = 1, ortho_height = 1;
+  float clip_start = 0.1f, clip_end = 1000.0f;
+};
+
+struct Scene {
+  std::vector<Float3> vertices;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  std::vector<std::int32_t> triangle_materials;  // index into materials, per triangle
+  std::vector<Float3> normals;                   // optional: 3 per triangle (per corner)
+  std::vector<std::array<float, 2>> uvs;         // optional: 3 per triangle (per corner)
+  std::vector<Material> materials;
+  std::vector<Light> lights;
+  Float3 world_radiance;  // constant, W/m^2/sr
+  Camera camera;
+};
+
+// Throws ValueError naming the first problem: non-finite numbers, indices out
+// of range, wrong per-corner array sizes, an empty image, bad light shapes.
+void validate_scene(const Scene& scene);
+
+// Base colour at a surface point: the texture (bilinear, repeat) if any.
+Float3 base_color_at(const Material& material, float u, float v);
+
+}  // namespace tempera

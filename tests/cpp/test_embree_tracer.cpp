@@ -1,0 +1,317 @@
+// Analytic checks of the LPE tracer: each scene has a closed-form radiance.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "tempera/embree_tracer.hpp"
+#include "tempera/error.hpp"
+
+using namespace tempera;
+
+namespace {
+
+constexpr float kPi = 3.14159265358979f;
+
+void add_quad(Scene& s, Float3 a, Float3 b, Float3 c, Float3 d, int material) {
+  const auto base = std::uint32_t(s.vertices.size());
+  s.vertices.insert(s.vertices.end(), {a, b, c, d});
+  s.triangles.push_back({base, base + 1, base + 2});
+  s.triangles.push_back({base, base + 2, base + 3});
+  s.triangle_materials.insert(s.triangle_materials.end(), {material, material});
+}
+
+// A floor at z = 0 (counter-clockwise seen from above) of half size `half`.
+void add_floor(Scene& s, float half, int material) {
+  add_quad(s, {-half, -half, 0}, {half, -half, 0}, {half, half, 0}, {-half, half, 0}, material);
+}
+
+void add_sphere(Scene& s, Float3 centre, float radius, int material, int rings = 48, int segments = 96) {
+  const auto base = std::uint32_t(s.vertices.size());
+  for (int i = 0; i <= rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      const float theta = kPi * float(i) / float(rings), phi = 2 * kPi * float(j) / float(segments);
+      s.vertices.push_back(centre + Float3{std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                                           std::cos(theta)} * radius);
+    }
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      const std::uint32_t a = base + i * segments + j, b = base + i * segments + (j + 1) % segments;
+      const std::uint32_t c = a + segments, d = b + segments;
+      s.triangles.push_back({a, c, d});  // outward facing
+      s.triangles.push_back({a, d, b});
+      s.triangle_materials.insert(s.triangle_materials.end(), {material, material});
+    }
+}
+
+Material lambert(float albedo) {
+  Material m;
+  m.base_color = {albedo, albedo, albedo};
+  m.specular = 0;
+  m.roughness = 1;
+  return m;
+}
+
+// Orthographic camera at height z looking straight down at a square of side `size`.
+Camera top_camera(float z, float size, int pixels) {
+  Camera c;
+  c.type = Camera::Type::orthographic;
+  c.camera_to_world = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, z, 0, 0, 0, 1};
+  c.width = c.height = pixels;
+  c.ortho_width = c.ortho_height = size;
+  c.clip_start = 0.01f;
+  return c;
+}
+
+double mean(const Image& image, int channel = 0) {
+  double sum = 0;
+  for (int y = 0; y < image.height(); ++y)
+    for (int x = 0; x < image.width(); ++x) sum += image.at(x, y, channel);
+  return sum / double(image.pixel_count());
+}
+
+TraceOptions options(int samples) {
+  TraceOptions o;
+  o.samples = samples;
+  return o;
+}
+
+Scene sun_scene(float cos_sun) {
+  Scene s;
+  s.materials = {lambert(0.6f)};
+  add_floor(s, 100, 0);
+  Light sun;
+  sun.type = Light::Type::sun;
+  sun.direction = {std::sqrt(1 - cos_sun * cos_sun), 0, cos_sun};
+  sun.irradiance = {2, 3, 4};
+  s.lights = {sun};
+  s.camera = top_camera(5, 2, 16);
+  return s;
+}
+
+}  // namespace
+
+TEST(Tracer, SunOnLambertPlane) {
+  const float cos_sun = 0.8f;
+  const TraceResult r = trace_lpe(sun_scene(cos_sun), {"LDE", "LSE", "L.*E"}, options(64));
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(mean(r.images[0], c), 0.6 / kPi * (2 + c) * cos_sun, 0.02 * 0.6 / kPi * (2 + c) * cos_sun);
+  EXPECT_EQ(mean(r.images[1]), 0.0);  // no glossy lobe at all
+  EXPECT_NEAR(mean(r.images[2]), mean(r.images[0]), 1e-6);
+}
+
+TEST(Tracer, PointLightFollowsInverseSquareLaw) {
+  Scene s;
+  s.materials = {lambert(0.5f)};
+  add_floor(s, 100, 0);
+  Light point;
+  point.type = Light::Type::point;
+  point.position = {0, 0, 1};
+  point.intensity = {10, 10, 10};
+  s.lights = {point};
+  s.camera = top_camera(5, 4, 16);
+  const TraceResult r = trace_lpe(s, {"LDE"}, options(64));
+  for (int py = 0; py < 16; py += 3)
+    for (int px = 0; px < 16; px += 3) {
+      double expected = 0;  // the analytic radiance averaged over the pixel
+      for (int i = 0; i < 8; ++i)
+        for (int j = 0; j < 8; ++j) {
+          const double x = (px + (i + 0.5) / 8) / 16 * 4 - 2, y = 2 - (py + (j + 0.5) / 8) / 16 * 4;
+          expected += 0.5 / kPi * 10 / std::pow(x * x + y * y + 1, 1.5) / 64;
+        }
+      EXPECT_NEAR(r.images[0].at(px, py, 0), expected, 0.02 * expected) << px << "," << py;
+    }
+}
+
+TEST(Tracer, FurnaceWorldOnWhitePlane) {
+  Scene s;
+  s.materials = {lambert(1.0f)};
+  add_floor(s, 1000, 0);
+  s.world_radiance = {0.7f, 0.7f, 0.7f};
+  s.camera = top_camera(5, 2, 8);
+  const TraceResult r = trace_lpe(s, {"LDE", "LE", "L.*E"}, options(64));
+  EXPECT_NEAR(mean(r.images[0]), 0.7, 0.02 * 0.7);
+  EXPECT_EQ(mean(r.images[1]), 0.0);  // the camera sees only the plane
+}
+
+TEST(Tracer, DiskAreaLightMatchesClosedForm) {
+  // Irradiance under the centre of a disk of radius R at height h: pi L R^2 / (h^2 + R^2).
+  Scene s;
+  s.materials = {lambert(0.5f)};
+  add_floor(s, 100, 0);
+  Light disk;
+  disk.type = Light::Type::area;
+  disk.shape = Light::Shape::disk;
+  disk.center = {0, 0, 1};
+  disk.axis_u = {1, 0, 0};
+  disk.axis_v = {0, 1, 0};
+  disk.normal = {0, 0, -1};
+  disk.size_u = disk.size_v = 1.2f;
+  disk.radiance = {3, 3, 3};
+  s.lights = {disk};
+  s.camera = top_camera(5, 0.01f, 8);  // looks through the light's back (it emits downwards only)
+  const TraceResult r = trace_lpe(s, {"LDE"}, options(256));
+  const double expected = 0.5 / kPi * kPi * 3 * 0.36 / (1 + 0.36);
+  EXPECT_NEAR(mean(r.images[0]), expected, 0.02 * expected);
+}
+
+TEST(Tracer, EmissiveQuadLightsLikeAnAreaLight) {
+  // Camera between the light (z = 1) and the floor, so it only sees the floor.
+  Scene emissive;
+  emissive.materials = {lambert(0.5f), lambert(0.0f)};
+  emissive.materials[1].emission = {2, 2, 2};
+  add_floor(emissive, 100, 0);
+  add_quad(emissive, {-0.5f, -0.5f, 1}, {-0.5f, 0.5f, 1}, {0.5f, 0.5f, 1}, {0.5f, -0.5f, 1}, 1);
+  emissive.camera = top_camera(0.5f, 2, 8);
+  Scene area = emissive;
+  area.vertices.resize(4);
+  area.triangles.resize(2);
+  area.triangle_materials.resize(2);
+  Light rect;
+  rect.type = Light::Type::area;
+  rect.center = {0, 0, 1};
+  rect.axis_u = {1, 0, 0};
+  rect.axis_v = {0, 1, 0};
+  rect.normal = {0, 0, -1};
+  rect.radiance = {2, 2, 2};
+  area.lights = {rect};
+  const TraceResult a = trace_lpe(emissive, {"LDE"}, options(128));
+  const TraceResult b = trace_lpe(area, {"LDE"}, options(128));
+  EXPECT_GT(mean(a.images[0]), 0.1);
+  EXPECT_NEAR(mean(a.images[0]), mean(b.images[0]), 0.02 * mean(b.images[0]));
+}
+
+TEST(Tracer, CausticsNeedAMirror) {
+  Scene s;
+  s.materials = {lambert(0.8f)};
+  add_floor(s, 20, 0);
+  Light lamp;
+  lamp.type = Light::Type::area;
+  lamp.center = {1, 0, 4};
+  lamp.axis_u = {1, 0, 0};
+  lamp.axis_v = {0, 1, 0};
+  lamp.normal = {0, 0, -1};
+  lamp.size_u = lamp.size_v = 0.5f;
+  lamp.radiance = {40, 40, 40};
+  s.lights = {lamp};
+  s.camera = top_camera(6, 6, 24);
+  const std::vector<std::string> caustics = {"LS+DE", "LDE"};
+  const TraceResult without = trace_lpe(s, caustics, options(16));
+  EXPECT_EQ(mean(without.images[0]), 0.0);
+  EXPECT_GT(mean(without.images[1]), 0.0);
+
+  Material mirror;
+  mirror.base_color = {0.9f, 0.9f, 0.9f};
+  mirror.metallic = 1;
+  mirror.roughness = 0;
+  s.materials.push_back(mirror);
+  add_sphere(s, {0, 0, 1.5f}, 0.5f, 1);
+  const TraceResult with = trace_lpe(s, caustics, options(16));
+  EXPECT_GT(mean(with.images[0]), 0.0);
+}
+
+TEST(Tracer, NeverMatchingExpressionIsExactlyZero) {
+  const TraceResult r = trace_lpe(sun_scene(1), {"L[^LDST]E", "LTE", "LDE"}, options(4));
+  EXPECT_EQ(mean(r.images[0]), 0.0);
+  EXPECT_EQ(mean(r.images[1]), 0.0);
+  EXPECT_GT(mean(r.images[2]), 0.0);
+}
+
+TEST(Tracer, SameResultForAnyThreadCount) {
+  Scene s = sun_scene(0.9f);
+  s.world_radiance = {0.2f, 0.2f, 0.2f};
+  s.materials.push_back(lambert(0.5f));
+  s.materials[1].roughness = 0.3f;
+  s.materials[1].specular = 0.5f;
+  add_sphere(s, {0, 0, 0.5f}, 0.5f, 1, 12, 24);
+  TraceOptions one = options(8), two = options(8);
+  one.seed = two.seed = 7;
+  one.threads = 1;
+  two.threads = 2;
+  const TraceResult a = trace_lpe(s, {"L.*E", "L.*DDE"}, one);
+  const TraceResult b = trace_lpe(s, {"L.*E", "L.*DDE"}, two);
+  for (int k = 0; k < 2; ++k)
+    EXPECT_EQ(std::memcmp(a.images[k].data(), b.images[k].data(), a.images[k].pixel_count() * 3 * sizeof(float)), 0);
+  EXPECT_GT(mean(a.images[1]), 0.0);
+}
+
+TEST(Tracer, AlphaCoversTheGeometry) {
+  Scene s;
+  s.materials = {lambert(0.5f)};
+  add_quad(s, {-3, -3, 0}, {0, -3, 0}, {0, 3, 0}, {-3, 3, 0}, 0);  // the left half of the view
+  s.camera = top_camera(5, 4, 16);
+  const TraceResult r = trace_lpe(s, {"LDE"}, options(16));
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) EXPECT_FLOAT_EQ(r.alpha.at(x, y, 0), x < 8 ? 1.0f : 0.0f) << x << "," << y;
+}
+
+TEST(Tracer, PerspectiveCameraCentreAndShift) {
+  // A perspective camera looking down at a floor whose left half is black:
+  // shifting the view by half the width moves the boundary off the image.
+  Scene s;
+  s.materials = {lambert(0.5f), lambert(0.0f)};
+  add_quad(s, {-50, -50, 0}, {0, -50, 0}, {0, 50, 0}, {-50, 50, 0}, 1);
+  add_quad(s, {0, -50, 0}, {50, -50, 0}, {50, 50, 0}, {0, 50, 0}, 0);
+  s.world_radiance = {1, 1, 1};
+  Camera& c = s.camera;
+  c.camera_to_world = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 2, 0, 0, 0, 1};
+  c.width = 20;
+  c.height = 10;
+  c.tan_half_fov_x = 0.5f;
+  c.tan_half_fov_y = 0.25f;
+  const TraceResult centred = trace_lpe(s, {"LDE"}, options(4));
+  EXPECT_EQ(centred.images[0].at(9, 5, 0), 0.0f);
+  EXPECT_GT(centred.images[0].at(10, 5, 0), 0.0f);
+  c.shift_x = 0.5f;  // half the (larger) image width: the view now spans x in [0, 2] on the floor
+  const TraceResult shifted = trace_lpe(s, {"LDE"}, options(4));
+  EXPECT_GT(shifted.images[0].at(0, 5, 0), 0.0f);
+}
+
+TEST(Tracer, RejectsBadInput) {
+  Scene s = sun_scene(1);
+  EXPECT_THROW(trace_lpe(s, {"L(DE"}, options(1)), ValueError);
+  s.vertices[2].y = NAN;
+  EXPECT_THROW(trace_lpe(s, {"LDE"}, options(1)), ValueError);
+  s = sun_scene(1);
+  s.triangles[1][2] = 9;
+  EXPECT_THROW(trace_lpe(s, {"LDE"}, options(1)), ValueError);
+  s = sun_scene(1);
+  s.camera.width = 0;
+  EXPECT_THROW(trace_lpe(s, {"LDE"}, options(1)), ValueError);
+}
+
+TEST(Tracer, ProgressCanCancel) {
+  int calls = 0;
+  EXPECT_THROW(trace_lpe(sun_scene(1), {"LDE"}, options(1), [&](double) { return ++calls < 2; }), CancelledError);
+}
+
+TEST(Tracer, TextureIsBilinearWithRepeatAndBottomLeftOrigin) {
+  Material m;
+  m.base_color_texture = Image(2, 2, 3);
+  m.base_color_texture.at(0, 0, 0) = 1;  // top-left texel: red
+  m.base_color_texture.at(1, 1, 2) = 1;  // bottom-right texel: blue
+  EXPECT_FLOAT_EQ(base_color_at(m, 0.25f, 0.75f).x, 1);  // texel centres
+  EXPECT_FLOAT_EQ(base_color_at(m, 0.75f, 0.25f).z, 1);
+  EXPECT_FLOAT_EQ(base_color_at(m, 1.75f, -0.75f).z, 1);  // repeat
+  EXPECT_FLOAT_EQ(base_color_at(m, 0.5f, 0.75f).x, 0.5f);  // halfway between texel centres
+  EXPECT_FLOAT_EQ(base_color_at(m, 0.0f, 0.75f).x, 0.5f);  // blends with the wrapped column
+}
+
+TEST(Tracer, SpotLightIsAPointLightInsideItsCone) {
+  Scene s;
+  s.materials = {lambert(0.5f)};
+  add_floor(s, 100, 0);
+  Light spot;
+  spot.type = Light::Type::spot;
+  spot.position = {0, 0, 1};
+  spot.direction = {0, 0, -1};
+  spot.intensity = {10, 10, 10};
+  spot.spot_half_angle = 0.5f;  // reaches tan(0.5) = 0.546 m on the floor
+  s.lights = {spot};
+  s.camera = top_camera(5, 4, 16);  // pixels 0.25 m wide
+  const TraceResult r = trace_lpe(s, {"LDE"}, options(16));
+  EXPECT_EQ(r.images[0].at(0, 0, 0), 0.0f);  // outside the cone
+  // The pixel at (0.125, 0.125) m is well inside; compare with the point light law.
+  const double d2 = 2 * 0.125 * 0.125 + 1;
+  EXPECT_NEAR(r.images[0].at(8, 7, 0), 0.5 / kPi * 10 / std::pow(d2, 1.5), 0.03);
+}

@@ -1,0 +1,106 @@
+"""tempera.trace_lpe / check_lpe: the native light-path-expression tracer from Python."""
+import math
+
+import numpy as np
+import pytest
+
+import tempera
+from tempera.lpe import STYLIT_EXPRESSIONS, lpe_matches
+
+from conftest import assert_releases_gil
+
+
+def plane_scene(width=16, height=12, irradiance=2.0, albedo=0.5):
+    """A large Lambert floor at z=0 under a sun straight above, seen from z=5."""
+    s = 100.0
+    camera = np.eye(4, dtype=np.float32)
+    camera[2, 3] = 5.0
+    return {
+        "vertices": np.array([[-s, -s, 0], [s, -s, 0], [s, s, 0], [-s, s, 0]], np.float32),
+        "triangles": np.array([[0, 1, 2], [0, 2, 3]], np.int32),
+        "triangle_materials": np.zeros(2, np.int32),
+        "materials": [{"base_color": [albedo] * 3, "specular": 0.0, "roughness": 1.0}],
+        "lights": [{"type": "sun", "direction": [0.0, 0.0, 1.0], "irradiance": [irradiance] * 3}],
+        "world": {"radiance": [0.0, 0.0, 0.0]},
+        "camera": {"type": "perspective", "camera_to_world": camera, "width": width, "height": height,
+                   "tan_half_fov_x": 0.4, "tan_half_fov_y": 0.3},
+    }
+
+
+def test_sun_on_lambert_plane():
+    images, alpha = tempera.trace_lpe(plane_scene(), ["LDE", "LSE", "L.*E"], samples=16)
+    assert len(images) == 3
+    for image in images:
+        assert image.shape == (12, 16, 3) and image.dtype == np.float32
+    assert alpha.shape == (12, 16) and alpha.dtype == np.float32
+    np.testing.assert_allclose(alpha, 1.0)
+    expected = 0.5 / math.pi * 2.0
+    np.testing.assert_allclose(images[0].mean(), expected, rtol=1e-3)
+    assert images[1].max() < 1e-3 * expected
+    np.testing.assert_allclose(images[2], images[0], rtol=1e-5)
+
+
+def test_same_result_for_any_thread_count():
+    one, _ = tempera.trace_lpe(plane_scene(), ["L.*E"], samples=4, seed=3, threads=1)
+    two, _ = tempera.trace_lpe(plane_scene(), ["L.*E"], samples=4, seed=3, threads=2)
+    np.testing.assert_array_equal(one[0], two[0])
+
+
+def test_check_lpe_names_the_position():
+    for expression in STYLIT_EXPRESSIONS.values():
+        tempera.check_lpe(expression)
+    with pytest.raises(ValueError, match=r"position 4: expected '\)'"):
+        tempera.check_lpe("L(DE")
+    with pytest.raises(ValueError, match="position 1"):
+        tempera.trace_lpe(plane_scene(), ["LDE", "LX"], samples=1)
+    assert lpe_matches("LD{1,2}E", "LDDE") and not lpe_matches("LD{1,2}E", "LDDDE")
+
+
+def test_missing_and_unknown_keys_are_named():
+    scene = plane_scene()
+    del scene["camera"]["width"]
+    with pytest.raises(ValueError, match="scene camera: missing key 'width'"):
+        tempera.trace_lpe(scene, ["LDE"], samples=1)
+    scene = plane_scene()
+    scene["materials"][0]["colour"] = 1
+    with pytest.raises(ValueError, match="unknown keys 'colour'"):
+        tempera.trace_lpe(scene, ["LDE"], samples=1)
+
+
+def test_bad_arrays_raise_value_error():
+    scene = plane_scene()
+    scene["vertices"][1, 2] = np.nan
+    with pytest.raises(ValueError, match="vertex 1 is not finite"):
+        tempera.trace_lpe(scene, ["LDE"], samples=1)
+    scene = plane_scene()
+    scene["vertices"] = scene["vertices"][:, :2]
+    with pytest.raises(ValueError, match=r"'vertices' must have shape \(4, 3\)"):
+        tempera.trace_lpe(scene, ["LDE"], samples=1)
+    scene = plane_scene()
+    scene["triangles"] = np.array([[0, 1, 2], [0, 2, 7]], np.int32)
+    with pytest.raises(ValueError, match="triangle 1 uses vertex 7 but there are only 4 vertices"):
+        tempera.trace_lpe(scene, ["LDE"], samples=1)
+    scene = plane_scene()
+    scene["camera"]["width"] = 0
+    with pytest.raises(ValueError, match="empty"):
+        tempera.trace_lpe(scene, ["LDE"], samples=1)
+
+
+def test_releases_gil():
+    scene = plane_scene(width=160, height=120)
+    assert_releases_gil(lambda: tempera.trace_lpe(scene, ["LDE"], samples=64, threads=1))
+
+
+def test_progress_can_cancel():
+    fractions = []
+
+    def progress(fraction):
+        fractions.append(fraction)
+        return len(fractions) < 3
+
+    with pytest.raises(tempera.Cancelled):
+        tempera.trace_lpe(plane_scene(), ["LDE"], samples=1, threads=1, progress=progress)
+    assert len(fractions) == 3
+    done = []
+    tempera.trace_lpe(plane_scene(), ["LDE"], samples=1, progress=done.append)
+    assert done[-1] == 1.0
