@@ -16,6 +16,8 @@ import bmesh
 import bpy
 from mathutils import Vector
 
+import scene_kit  # noqa: E402  (scenes/ is on sys.path wherever this module is imported)
+
 SPHERE_CENTRE = (0.75, -0.1, 0.55)
 # name -> (type, power or strength, location, point it aims at, extra settings)
 LIGHTS = {
@@ -47,17 +49,9 @@ def _material(name, color, diffuse_only, **principled):
 
 
 def _object(scene, name, build, material, location=(0, 0, 0), rotation=(0, 0, 0), smooth=False):
-    mesh = bpy.data.meshes.new(name)
-    bm = bmesh.new()
-    build(bm)
-    bm.to_mesh(mesh)
-    bm.free()
-    for polygon in mesh.polygons:
-        polygon.use_smooth = smooth
-    mesh.materials.append(material)
-    obj = bpy.data.objects.new(name, mesh)
-    obj.location, obj.rotation_euler = location, rotation
-    scene.collection.objects.link(obj)
+    """scene_kit.mesh_object, turned by the Euler angles `rotation`."""
+    obj = scene_kit.mesh_object(scene, name, build, material, location, smooth)
+    obj.rotation_euler = rotation
     return obj
 
 

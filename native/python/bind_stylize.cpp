@@ -80,15 +80,12 @@ StylizeJobConfig parse_job_config(const py::dict& d) {
   return c;
 }
 
-// Progress for code running without the GIL: re-take it to call Python, let
-// Ctrl-C through, and treat anything but an explicit False as "go on".
+// Progress for code running without the GIL (py_bridge::with_gil); anything
+// but an explicit False from the Python callable means "go on".
 ProgressCallback python_progress(const py::object& progress) {
-  return [progress](double fraction) {
-    py::gil_scoped_acquire acquire;
-    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-    if (progress.is_none()) return true;
-    return !progress(fraction).is(py::bool_(false));
-  };
+  return py_bridge::with_gil([progress](double fraction) {
+    return progress.is_none() || !progress(fraction).is(py::bool_(false));
+  });
 }
 
 py::dict frame_result(const FrameResult& r) {

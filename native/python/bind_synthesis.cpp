@@ -109,11 +109,9 @@ py::tuple synthesize_py(const FloatArray& style, const std::vector<GuideArg>& gu
   }
   const SynthesisOptions opt = parse_options(options);
 
-  ProgressCallback callback = [&](double fraction) {
-    py::gil_scoped_acquire acquire;
-    if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // Ctrl-C
+  ProgressCallback callback = py_bridge::with_gil([&](double fraction) {
     return progress ? progress(fraction) : true;
-  };
+  });
   SynthesisResult result;
   {
     py::gil_scoped_release release;

@@ -282,11 +282,9 @@ void bind_tracer(py::module_& m) {
         options.seed = seed;
         options.threads = threads;
         options.max_bounces = max_bounces;
-        TraceProgress callback = [&](double fraction) {
-          py::gil_scoped_acquire acquire;
-          if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // Ctrl-C
+        TraceProgress callback = py_bridge::with_gil([&](double fraction) {
           return progress ? progress(fraction) : true;
-        };
+        });
         TraceResult result;
         {
           py::gil_scoped_release release;

@@ -4,6 +4,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -37,6 +38,16 @@ inline py::array_t<float> to_numpy(Image&& image) {
   return py::array_t<float>({h, w, c}, {w * c * py::ssize_t(sizeof(float)), c * py::ssize_t(sizeof(float)),
                                         py::ssize_t(sizeof(float))},
                             owned->data(), free_when_done);
+}
+
+// A progress callback for native code running without the GIL: re-takes it
+// to call `report`, and lets Ctrl-C through as a Python exception.
+inline std::function<bool(double)> with_gil(std::function<bool(double)> report) {
+  return [report = std::move(report)](double fraction) {
+    py::gil_scoped_acquire acquire;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // Ctrl-C
+    return report(fraction);
+  };
 }
 
 }  // namespace tempera::py_bridge
