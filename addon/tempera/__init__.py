@@ -22,7 +22,7 @@ bl_info = {
 __version__ = "0.1.0"  # keep equal to project(tempera VERSION ...) in CMakeLists.txt
 
 try:
-    from ._native import Cancelled, image_info, read_image, write_image
+    from ._native import Cancelled, image_info, max_image_pixels, read_image, set_max_image_pixels, write_image
 except ImportError as exc:  # not built, or built for another Python
     raise ImportError(
         f"tempera: the compiled module tempera._native cannot be loaded ({exc}). "
@@ -41,7 +41,9 @@ __all__ = [
     "check_lpe",
     "contact_sheet",
     "image_info",
+    "max_image_pixels",
     "read_image",
+    "set_max_image_pixels",
     "synthesize",
     "trace_lpe",
     "USAGE_MODES",

@@ -11,6 +11,7 @@
 
 #include "cli_args.hpp"
 #include "tempera/error.hpp"
+#include "tempera/paths.hpp"
 #include "tempera/process.hpp"
 
 namespace fs = std::filesystem;
@@ -76,7 +77,16 @@ int render_guides_in_blender(const BlenderSetup& setup, const std::string& scene
   std::vector<std::string> argv = {setup.blender, "-b", "--factory-startup", scene, "--python-exit-code", "1",
                                    "--python-expr", bootstrap, "--", setup.addon};
   argv.insert(argv.end(), options.begin(), options.end());
-  return run_process(argv);
+  const int status = run_process(argv);
+  // The renderer prints its own "tempera render-guides: error: ..." line;
+  // a Blender that fails before running it (or is not Blender) says nothing.
+  if (status == 127)
+    std::cerr << "tempera: cannot run '" << setup.blender << "' (install Blender or pass --blender PATH)\n";
+  else if (status != 0)
+    std::cerr << "tempera: Blender ('" << setup.blender << "') exited with status " << status
+              << " while rendering the guides of '" << scene << "'"
+              << (status >= 128 ? " (killed by a signal)" : "") << "\n";
+  return status;
 }
 
 int run_render_guides(const Args& args) {
@@ -118,9 +128,16 @@ std::vector<int> parse_frames(const std::string& text) {
     const std::size_t dash = part.find('-', 1);
     int first = 0, last = 0;
     const auto read = [&](const std::string& number, int& out) {
-      const auto [ptr, ec] = std::from_chars(number.data(), number.data() + number.size(), out);
+      long long value = 0;
+      const auto [ptr, ec] = std::from_chars(number.data(), number.data() + number.size(), value);
       if (ec != std::errc() || ptr != number.data() + number.size() || number.empty())
         throw ValueError(concat("cannot read '", part, "' in frame range '", text, "'", hint));
+      // Bounded by Blender's frame range: no range is endless, none holds a
+      // frame Blender would render as another (it clamps to its last frame).
+      if (value < 0 || value > kMaxFrame)
+        throw ValueError(concat("frame ", number, " in '", text, "' is outside 0-", kMaxFrame,
+                                " (the frames Blender can render)"));
+      out = int(value);
     };
     read(part.substr(0, dash), first);
     if (dash == std::string::npos) last = first;

@@ -11,6 +11,7 @@
 #include <iostream>
 
 #include "tempera/error.hpp"
+#include "tempera/image_io.hpp"
 
 namespace fs = std::filesystem;
 
@@ -50,15 +51,19 @@ int run_process(const std::vector<std::string>& argv, bool quiet) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
+std::string printf_escaped(const std::string& text) {
+  std::string out;
+  for (char c : text) out += c == '%' ? std::string("%%") : std::string(1, c);
+  return out;
+}
+
 bool encode_video(const std::string& pattern, int first_frame, double fps, const std::string& out_path) {
   if (!(fps > 0) || !std::isfinite(fps)) throw ValueError(concat("fps must be a positive number, got ", fps));
   const std::string ffmpeg = find_on_path("ffmpeg");
   if (ffmpeg.empty()) return false;
   const fs::path target(out_path);
-  static std::atomic<int> counter{0};
   // Same folder, so the final rename is atomic; .mp4 so ffmpeg picks the muxer.
-  const fs::path temp = target.parent_path() / concat(".", target.stem().string(), ".tmp", getpid(), "-",
-                                                      counter++, ".mp4");
+  const fs::path temp = target.parent_path() / temporary_name(target.stem().string(), ".mp4");
   const std::vector<std::string> argv = {
       ffmpeg, "-y", "-nostdin", "-loglevel", "error", "-framerate", concat(fps), "-start_number",
       std::to_string(first_frame), "-i", pattern,

@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "tempera/error.hpp"
+#include "tempera/limits.hpp"
 #include "tempera/guide_compression.hpp"
 #include "tempera/pyramid.hpp"
 #include "tempera/voting.hpp"
@@ -23,7 +24,7 @@ void validate(const SynthesisInput& in, const SynthesisOptions& opt) {
     throw ValueError(concat("patch size must be odd and >= 3, got ", opt.patch_size));
   if (opt.em_iterations < 1) throw ValueError(concat("em iterations must be >= 1, got ", opt.em_iterations));
   if (opt.pm_iterations < 0) throw ValueError(concat("pm iterations must be >= 0, got ", opt.pm_iterations));
-  if (opt.levels < 0) throw ValueError(concat("levels must be >= 0 (0 = automatic), got ", opt.levels));
+  check_levels(opt.levels);  // tempera/limits.hpp
   if (opt.threads < 0) throw ValueError(concat("threads must be >= 0 (0 = all cores), got ", opt.threads));
   if (!std::isfinite(opt.style_weight) || opt.style_weight < 0)
     throw ValueError(concat("style weight must be finite and >= 0, got ", opt.style_weight));

@@ -10,6 +10,10 @@ namespace tempera {
 // `first_frame` on into an H.264 MP4 (yuv420p, dimensions rounded down to
 // even) with ffmpeg, atomically. Returns false, writing nothing, when ffmpeg
 // is not on PATH; IoError when ffmpeg fails.
+// `text` with every '%' doubled, for a literal part of a printf-style pattern
+// (ffmpeg reads "frames%d/frame_%04d.png" as two numbers).
+std::string printf_escaped(const std::string& text);
+
 bool encode_video(const std::string& pattern, int first_frame, double fps, const std::string& out_path);
 
 // Runs argv (no shell; argv[0] looked up on PATH), waits, returns the exit
