@@ -78,15 +78,23 @@ int render_guides_in_blender(const BlenderSetup& setup, const std::string& scene
                                    "--python-expr", bootstrap, "--", setup.addon};
   argv.insert(argv.end(), options.begin(), options.end());
   const int status = run_process(argv);
-  // The renderer prints its own "tempera render-guides: error: ..." line;
-  // a Blender that fails before running it (or is not Blender) says nothing.
-  if (status == 127)
-    std::cerr << "tempera: cannot run '" << setup.blender << "' (install Blender or pass --blender PATH)\n";
-  else if (status != 0)
-    std::cerr << "tempera: Blender ('" << setup.blender << "') exited with status " << status
-              << " while rendering the guides of '" << scene << "'"
-              << (status >= 128 ? " (killed by a signal)" : "") << "\n";
-  return status;
+  // The renderer (render_guides_main.py) prints its own error line and exits
+  // 2 (bad values), 3 (files) or 130 (interrupted); anything else means
+  // Blender failed before or around it (or is not Blender) and said nothing.
+  switch (status) {
+    case 0:
+    case 2:
+    case 130: return status;
+    case 3: return 1;
+    case 127:
+      std::cerr << "tempera: cannot run '" << setup.blender << "' (install Blender or pass --blender PATH)\n";
+      return 1;
+    default:
+      std::cerr << "tempera: Blender ('" << setup.blender << "') exited with status " << status
+                << " while rendering the guides of '" << scene << "'"
+                << (status > 128 ? " (killed by a signal)" : "") << "\n";
+      return 1;
+  }
 }
 
 int run_render_guides(const Args& args) {

@@ -166,8 +166,8 @@ void render_guides(const Options& o, const std::string& scene, const std::string
             << "\n";
   const int status = render_guides_in_blender(o.blender, scene, options);
   if (g_interrupted) throw CancelledError("interrupted while rendering guides");
-  if (status != 0)
-    throw IoError(concat("rendering the guides of '", scene, "' failed (Blender exit status ", status, ")"));
+  if (status == 2) throw ValueError(concat("rendering the guides of '", scene, "' failed: bad values (see above)"));
+  if (status != 0) throw IoError(concat("rendering the guides of '", scene, "' failed (see above)"));
 }
 
 std::string clock_text(double seconds) {

@@ -64,8 +64,11 @@ std::string random_tag() {
 
 std::unique_ptr<OIIO::ImageInput> open_input(const std::string& path) {
   std::error_code ec;
-  if (!fs::exists(path, ec)) throw FileNotFoundError(concat("image file not found: '", path, "'"));
-  if (fs::is_directory(path, ec)) throw IoError(concat("'", path, "' is a folder, not an image file"));
+  const fs::file_status status = fs::status(path, ec);
+  if (ec && ec != std::errc::no_such_file_or_directory)  // e.g. a folder on the way that may not be entered
+    throw IoError(concat("cannot read image '", path, "': ", ec.message()));
+  if (!fs::exists(status)) throw FileNotFoundError(concat("image file not found: '", path, "'"));
+  if (fs::is_directory(status)) throw IoError(concat("'", path, "' is a folder, not an image file"));
   if (access(path.c_str(), R_OK) != 0)
     throw IoError(concat("cannot read image '", path, "': ", std::strerror(errno)));
   // Keep alpha as stored (straight): guides and exemplars are data, not

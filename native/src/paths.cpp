@@ -40,8 +40,17 @@ void refuse_output_on_inputs(const std::string& output, const std::vector<std::s
   }
 }
 
+namespace {
+// A folder is locked through itself (no lock file left behind), a file is created if missing.
+int open_for_lock(const std::string& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) return ::open(path.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  return ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+}
+}  // namespace
+
 FileLock::FileLock(const std::string& path) {
-  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  fd_ = open_for_lock(path);
   if (fd_ < 0) throw IoError(concat("cannot open the lock file '", path, "': ", std::strerror(errno)));
   while (::flock(fd_, LOCK_EX) != 0) {
     if (errno == EINTR) continue;
@@ -53,7 +62,7 @@ FileLock::FileLock(const std::string& path) {
 }
 
 std::unique_ptr<FileLock> FileLock::try_lock(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  const int fd = open_for_lock(path);
   if (fd < 0) throw IoError(concat("cannot open the lock file '", path, "': ", std::strerror(errno)));
   if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
     ::close(fd);

@@ -28,7 +28,6 @@ namespace {
 
 constexpr const char* kReportName = "tempera_stylize.json";
 constexpr const char* kReportFormat = "tempera-stylize 2";
-constexpr const char* kLockName = ".tempera_stylize.lock";
 constexpr int kSheetMaxWidth = 2000;
 constexpr int kSheetGap = 4;
 
@@ -385,7 +384,7 @@ std::string StylizeJob::output_path(int frame) const {
 
 std::string StylizeJob::report_path() const { return (fs::path(config_.out) / kReportName).string(); }
 
-std::string StylizeJob::lock_path() const { return (fs::path(config_.out) / kLockName).string(); }
+std::string StylizeJob::lock_path() const { return config_.out; }  // the folder itself: no lock file
 
 std::string StylizeJob::target_path(int frame) const { return guide_cache_frame(config_.guides, frame); }
 
@@ -478,7 +477,7 @@ void StylizeJob::write_contact_sheet(const std::string& path, int columns) const
   int widest = 0;
   for (const auto& [w, h] : sizes) widest = std::max(widest, w);
   const double scale = std::min(1.0, double(kSheetMaxWidth - (cols - 1) * kSheetGap) / (double(cols) * widest));
-  auto scaled = [&](int v) { return scale < 1.0 ? std::max(1, int(std::lround(v * scale))) : v; };
+  auto scaled = [&](int v) { return scale < 1.0 ? std::max(1, int(std::floor(v * scale))) : v; };
   int cell_w = 0, cell_h = 0;
   for (const auto& [w, h] : sizes) cell_w = std::max(cell_w, scaled(w)), cell_h = std::max(cell_h, scaled(h));
   const int channels = style_.channels() == 1 ? 3 : style_.channels();

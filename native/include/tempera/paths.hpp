@@ -20,8 +20,8 @@ bool same_path(const std::string& a, const std::string& b);
 void refuse_output_on_inputs(const std::string& output, const std::vector<std::string>& inputs,
                              const std::string& what);
 
-// An exclusive advisory lock (flock) on `path`, created if missing, held
-// until destruction. Blocks while another process holds it. IoError naming
+// An exclusive advisory lock (flock) on `path`, held until destruction: a
+// folder is locked through itself, a file is created if missing. Blocks while another process holds it. IoError naming
 // the file if it cannot be opened.
 class FileLock {
  public:
