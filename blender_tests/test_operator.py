@@ -196,7 +196,7 @@ def test_modal_steps_show_progress_and_finish(scene, tmp_path):
     assert statuses[0].startswith("Tempera: guides frame 1/2, ETA …")
     assert statuses[1].startswith("Tempera: guides frame 2/2, ETA 0:0") and statuses[-1] is None
     assert ("progress_update", 1) in log and log[-2:] == [("progress_end",), ("status", None)]
-    assert not timers and type(op)._running is False
+    assert not timers and __import__('tempera.blender.job_operator', fromlist=['x']).running_job() is None
     assert reports == [({"INFO"}, f"Tempera guides: 2 rendered in {tmp_path / 'guides'}")]
     assert sorted(p.name for p in (tmp_path / "guides").glob("*.exr")) == ["frame_0002.exr", "frame_0003.exr"]
 
@@ -229,7 +229,7 @@ def test_modal_error_is_reported_and_cleans_up(scene, tmp_path):
         settings.guide_dir = saved
     assert results == [{"CANCELLED"}]
     assert not timers and ("progress_end",) in log and log[-1] == ("status", None)
-    assert type(op)._running is False
+    assert __import__('tempera.blender.job_operator', fromlist=['x']).running_job() is None
     assert len(reports) == 1 and reports[0][0] == {"ERROR"}
     assert reports[0][1].startswith("Guides of frame 2 failed: Motion blur is on")
 

@@ -1,12 +1,21 @@
-"""Properties editor > Output tab > Tempera: the buttons on top, then one box
-per step of the workflow (exemplar, light paths, synthesis, output, guides)."""
+"""Properties editor > Output tab > Tempera: the buttons and the frames they
+use on top, then one box per step of the workflow (exemplar, light paths,
+synthesis, output, guides). Labels fit the default Properties width: long
+rows are split in two."""
+import os
+
 import bpy
 from bpy.types import Panel
 
 from .. import __version__
 from .guide_operator import TEMPERA_OT_render_guides, cache_status
+from .kit_operators import (TEMPERA_OT_choose_painting, TEMPERA_OT_painting_template, TEMPERA_OT_register_painting,
+                            painting_preview)
 from .properties import WEIGHT_PROPERTIES
-from .stylize_operator import TEMPERA_OT_stylize
+from .results import is_result_scene
+from .stylize_operator import TEMPERA_OT_stylize, exemplar_paths
+
+THUMBNAIL_SCALE = 6.0
 
 
 class TEMPERA_PT_output(Panel):
@@ -15,17 +24,26 @@ class TEMPERA_PT_output(Panel):
     bl_region_type = "WINDOW"
     bl_context = "output"
 
+    @classmethod
+    def poll(cls, context):
+        # Not in the scene that shows a result: stylizing it would stylize the stylized frames.
+        return context.scene is not None and hasattr(context.scene, "tempera") and not is_result_scene(context.scene)
+
+    def draw_header_preset(self, _context):
+        self.layout.label(text=f"v{__version__}")
+
     def draw(self, context):
         layout = self.layout
         layout.use_property_split = True
         layout.use_property_decorate = False
         settings = context.scene.tempera
 
-        layout.label(text=f"Version {__version__}")
-        row = layout.row(align=True)
-        row.operator(TEMPERA_OT_render_guides.bl_idname, icon="RENDERLAYERS")
+        col = layout.column(align=True)
+        row = col.row(align=True)
         row.operator(TEMPERA_OT_stylize.bl_idname, text="Stylize Frame", icon="RENDER_STILL").mode = "FRAME"
         row.operator(TEMPERA_OT_stylize.bl_idname, text="Stylize Animation", icon="RENDER_ANIMATION").mode = "ANIMATION"
+        col.operator(TEMPERA_OT_render_guides.bl_idname, text="Render Guides Only", icon="RENDERLAYERS")
+        draw_frames(layout.column(), settings)
 
         draw_exemplar(layout.box(), settings)
         draw_light_paths(layout.box(), settings)
@@ -34,13 +52,50 @@ class TEMPERA_PT_output(Panel):
         draw_guides(layout.box(), context.scene, settings)
 
 
+def draw_frames(col, settings):
+    """The frames Stylize Animation (and Render Guides) use, next to their buttons."""
+    col.prop(settings, "guide_frame_range")
+    if settings.guide_frame_range == "CUSTOM":
+        sub = col.column(align=True)
+        sub.prop(settings, "guide_frame_start", text="Start")
+        sub.prop(settings, "guide_frame_end", text="End")
+
+
 def draw_exemplar(box, settings):
     box.label(text="Exemplar", icon="BRUSH_DATA")
     box.prop(settings, "exemplar_source")
     if settings.exemplar_source == "CUSTOM":
-        box.prop(settings, "exemplar_style")
+        row = box.row(align=True)
+        row.prop(settings, "exemplar_style")
+        row.operator(TEMPERA_OT_choose_painting.bl_idname, text="", icon="FILE_IMAGE")
         box.prop(settings, "exemplar_guide_dir")
         box.prop(settings, "exemplar_frame")
+    draw_thumbnail(box, settings)
+    row = box.row(align=True)
+    row.operator(TEMPERA_OT_painting_template.bl_idname, text="Painting Template", icon="FILE_BLANK")
+    row.operator(TEMPERA_OT_register_painting.bl_idname, text="Register Photo", icon="IMAGE_DATA")
+
+
+def draw_thumbnail(box, settings):
+    """A thumbnail of the painting the exemplar setting points at (loaded
+    once per file version by the preview system, not decoded by draw())."""
+    try:
+        path = exemplar_painting_path(settings)
+    except (ValueError, OSError):
+        return
+    icon = painting_preview(path)
+    if icon:
+        box.template_icon(icon_value=icon, scale=THUMBNAIL_SCALE)
+        box.label(text=os.path.basename(path))
+
+
+def exemplar_painting_path(settings):
+    if settings.exemplar_source == "KIT":
+        return exemplar_paths(settings)[0]
+    path = bpy.path.abspath(settings.exemplar_style.strip()) if settings.exemplar_style.strip() else ""
+    if not path or not os.path.isfile(path):
+        raise FileNotFoundError(path)
+    return path
 
 
 def draw_light_paths(box, settings):
@@ -64,7 +119,9 @@ def draw_output(box, settings):
     box.label(text="Output", icon="OUTPUT")
     box.prop(settings, "output_dir")
     if settings.output_dir.startswith("//") and not bpy.data.filepath:
-        box.label(text="Save the .blend file first: '//' is relative to it", icon="ERROR")
+        col = box.column(align=True)
+        col.label(text="Save the .blend file first:", icon="ERROR")
+        col.label(text="'//' is relative to it")
     col = box.column()
     col.prop(settings, "output_format")
     col.prop(settings, "make_video")
@@ -75,11 +132,6 @@ def draw_guides(box, scene, settings):
     """The Guides box: settings of the guide cache and its status."""
     box.label(text="Guides", icon="RENDERLAYERS")
     box.prop(settings, "guide_dir")
-    box.prop(settings, "guide_frame_range")
-    if settings.guide_frame_range == "CUSTOM":
-        col = box.column(align=True)
-        col.prop(settings, "guide_frame_start")
-        col.prop(settings, "guide_frame_end")
     col = box.column()
     col.prop(settings, "guide_samples")
     col.prop(settings, "guide_occlusion_epsilon")
