@@ -103,8 +103,18 @@ def long_run_question(frames, seconds, what):
     None if the run is short enough to start at once."""
     if frames <= CONFIRM_FRAMES and seconds <= CONFIRM_SECONDS:
         return None
-    return (f"This will {what} {frames} frames, about {format_duration(seconds)} (h:mm:ss) on this machine.\n"
+    return (f"This will {what} {frames} frames, {rough_duration(seconds)} on a 2-core machine.\n"
             "Frames already done are skipped; Esc stops after the frame at hand.\nStart?")
+
+
+def rough_duration(seconds):
+    """'about 40 seconds', 'about 12 minutes', 'about 3 hours 5 minutes'."""
+    if seconds < 90:
+        return f"about {max(1, round(seconds))} seconds"
+    if seconds < 2 * 3600:
+        return f"about {round(seconds / 60)} minutes"
+    hours, minutes = divmod(round(seconds / 60), 60)
+    return f"about {hours} hours {minutes} minutes"
 
 
 def format_duration(seconds):

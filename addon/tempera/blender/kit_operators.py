@@ -33,16 +33,16 @@ def unregister_previews():
 
 
 def painting_preview(path):
-    """The icon id of a thumbnail of the image at `path` (0 if none): Blender's
-    preview system loads it once per file version, in the background."""
+    """A thumbnail (bpy.types.ImagePreview) of the image at `path`, or None:
+    Blender's preview system loads it once per file version. Its icon_id is
+    what template_icon shows (0 in background mode, which has no icons)."""
     if _previews is None:
-        return 0
+        return None
     try:
         key = f"{os.path.abspath(path)}|{os.stat(path).st_mtime_ns}"
     except OSError:
-        return 0
-    preview = _previews.get(key) or _previews.load(key, path, "IMAGE")
-    return preview.icon_id
+        return None
+    return _previews.get(key) or _previews.load(key, path, "IMAGE")
 
 
 def _kit_folder(settings):

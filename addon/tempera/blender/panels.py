@@ -83,9 +83,9 @@ def draw_thumbnail(box, settings):
         path = exemplar_painting_path(settings)
     except (ValueError, OSError):
         return
-    icon = painting_preview(path)
-    if icon:
-        box.template_icon(icon_value=icon, scale=THUMBNAIL_SCALE)
+    preview = painting_preview(path)
+    if preview is not None:
+        box.template_icon(icon_value=preview.icon_id, scale=THUMBNAIL_SCALE)
         box.label(text=os.path.basename(path))
 
 
