@@ -21,6 +21,7 @@ PACKAGES=(
   python3-setuptools python3-pip  # offline pyproject build (--no-build-isolation)
   libgtest-dev          # C++ unit tests
   ffmpeg                # mp4 previews of stylized sequences
+  xvfb xdotool imagemagick  # docs/make_panel_screenshots.py: the real panel in a window on a virtual display
 )
 
 missing=()

@@ -164,7 +164,7 @@ PARAM_RANGES = {
     "seed": (0, (1 << 31) - 1, "Cycles seed"),
     "occlusion_epsilon": (1e-6, 1e6, "occlusion epsilon (squared pixels)"),
     "tensor_sigma": (0.0, 1000.0, "structure tensor sigma (pixels)"),
-    "line_depth_threshold": (0.0, 1e6, "line depth threshold"),
+    "line_depth_threshold": (0.0, 1e30, "line depth threshold"),
     "line_normal_angle": (0.0, 180.0, "line normal angle (degrees)"),
     "line_d_max": (1e-3, 1e6, "line distance max (pixels)"),
     "lpe_samples": (1, 1 << 20, "path-tracer samples"),
