@@ -51,17 +51,19 @@ def main():
         print(Path(args.out) / name)
 
 
-def crop_empty_bottom(path, margin=8):
-    """Drops the empty editor background below the last panel."""
+def crop_empty_bottom(path, margin=8, footer=60):
+    """Drops the empty editor background below the last panel: rows that are
+    one flat colour beside the tab column (the bottom `footer` rows, where
+    Blender's status bar may be, are never content)."""
     sys.path.insert(0, str(ROOT / "addon"))
     import numpy as np
     import tempera
 
     image = tempera.read_image(str(path))
-    background = image[-1, image.shape[1] // 2]
-    busy = np.abs(image[:, 40:] - background).max(axis=(1, 2)) > 0.02  # beside the tab column on the left
+    rows = image[: image.shape[0] - footer, 40:-10, :3]
+    busy = (rows.max(axis=1) - rows.min(axis=1)).max(axis=1) > 0.03
     last = int(np.nonzero(busy)[0][-1]) if busy.any() else image.shape[0] - 1
-    tempera.write_image(str(path), np.ascontiguousarray(image[: min(image.shape[0], last + margin)]))
+    tempera.write_image(str(path), np.ascontiguousarray(image[: min(image.shape[0], last + 1 + margin)]))
 
 
 # --------------------------------------------------------------------------- inside Blender

@@ -521,3 +521,15 @@ def test_percent_in_the_output_folder_keeps_the_video(cli_path, caches):
                             capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr
     assert (out / "stylized.mp4").stat().st_size > 0
+
+
+def test_user_guide_shows_the_screenshots_the_script_takes():
+    """docs/make_panel_screenshots.py makes every panel picture of the user guide."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("shots", ROOT / "docs" / "make_panel_screenshots.py")
+    shots = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(shots)
+    guide = (ROOT / "docs" / "user_guide.md").read_text()
+    for name, _ in shots.SHOTS:
+        assert f"images/{name}" in guide and (ROOT / "docs" / "images" / name).is_file()
