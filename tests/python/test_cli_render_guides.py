@@ -96,3 +96,26 @@ def test_lpe_options_reach_the_guide_cache(cli_path, user_blend, tmp_path):
     assert bad.returncode != 0
     assert "Light path expression 1 'L(DE' is malformed" in bad.stderr and "position 4" in bad.stderr
     assert not (tmp_path / "bad").exists()
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--tensor-sigma", "1e9"], "tensor_sigma (structure tensor sigma (pixels)) must be from 0 to 1000"),
+    (["--lpe", "(" * 60000 + "L" + ")" * 60000], "at most 1000"),
+    (["--lpe", "L.*D.{30}E"], "too complex"),
+    (["--samples", "0"], "samples (Cycles samples) must be from 1"),
+])
+def test_bad_values_exit_2_before_rendering_and_leave_nothing(cli_path, user_blend, tmp_path, args, message):
+    """Issue 18: these crashed Blender (exit 139), hung it, or left temporary folders."""
+    import tempfile
+
+    before = set(Path(tempfile.gettempdir()).glob("tempera-guides-*"))
+    result = render_guides(cli_path, user_blend, "--frames", "1", "--out", tmp_path / "g", *args)
+    assert result.returncode == 2, result.stdout[-1500:] + result.stderr[-1500:]
+    assert message in result.stderr
+    assert not (tmp_path / "g").exists()
+    assert set(Path(tempfile.gettempdir()).glob("tempera-guides-*")) == before
+
+
+def test_frames_beyond_blenders_last_frame_exit_2(cli_path, user_blend, tmp_path):
+    result = render_guides(cli_path, user_blend, "--frames", "1-99999999999", "--out", tmp_path / "g")
+    assert result.returncode == 2 and "outside 0-1048574" in result.stderr, result.stderr[-1500:]

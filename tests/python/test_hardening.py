@@ -533,3 +533,21 @@ def test_user_guide_shows_the_screenshots_the_script_takes():
     guide = (ROOT / "docs" / "user_guide.md").read_text()
     for name, _ in shots.SHOTS:
         assert f"images/{name}" in guide and (ROOT / "docs" / "images" / name).is_file()
+
+
+def test_two_cli_runs_into_one_folder_are_safe(cli_path, caches):
+    """A second `tempera stylize` into the same folder is made safe by the
+    folder lock: both finish, every frame is whole and recorded once."""
+    make_cache(caches / "cache", frames=range(1, 7))
+    command = [str(cli_path), "stylize", "--guides", str(caches / "cache"), "--exemplar", str(caches / "paint.png"),
+               "--exemplar-guides", str(caches / "exemplar"), "--frames", "1-6", "--out", str(caches / "shared"),
+               "--quality", "preview", "--threads", "1", "--no-video"]
+    runs = [subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    outputs = [r.communicate(timeout=300) for r in runs]
+    assert [r.returncode for r in runs] == [0, 0], outputs
+    record = json.loads((caches / "shared" / "frames" / "tempera_stylize.json").read_text())
+    assert sorted(map(int, record["frames"])) == list(range(1, 7))
+    for f in range(1, 7):
+        assert tempera.read_image(str(caches / "shared" / "frames" / f"frame_{f:04d}.png")).shape == (H, W, 3)
+    again = subprocess.run(command, capture_output=True, text=True, timeout=300)
+    assert "0 frame(s) stylized, 6 skipped" in again.stdout, again.stdout
