@@ -59,6 +59,7 @@ const char* kStylizeHelp =
     "  --patch-size N          odd patch width (default 5)\n"
     "  --seed N                random seed (default 1)\n"
     "  --threads N             worker threads (default 0 = all cores)\n"
+    "  (any engine option of 'tempera synth --help', e.g. --em-iters 4 --window-sigma 3)\n"
     "  --format F              png (default) | exr (float, linear as painted)\n"
     "  --fps F                 frame rate of the video (default 24)\n"
     "  --no-video              do not encode OUT/stylized.mp4\n"
@@ -128,10 +129,6 @@ Options parse(const Args& args) {
     else if (flag == "--weights") parse_weights(r.value(flag), o.stylit);
     else if (flag == "--temporal") o.stylit.temporal_weight = r.number<float>(flag);
     else if (flag == "--quality") o.stylit.quality = parse_quality(r.value(flag));
-    else if (flag == "--usage") o.stylit.synthesis.usage = parse_patch_usage(r.value(flag));
-    else if (flag == "--patch-size") o.stylit.synthesis.patch_size = r.number<int>(flag);
-    else if (flag == "--seed") o.stylit.synthesis.seed = r.number<std::uint64_t>(flag);
-    else if (flag == "--threads") o.stylit.synthesis.threads = r.number<int>(flag);
     else if (flag == "--format") o.format = r.value(flag);
     else if (flag == "--fps") o.fps = r.number<double>(flag);
     else if (flag == "--no-video") o.video = false;
@@ -139,8 +136,10 @@ Options parse(const Args& args) {
     else if (flag == "--samples") o.samples = std::to_string(r.number<int>(flag));
     else if (flag == "--blender") o.blender.blender = r.value(flag);
     else if (flag == "--addon-path") o.blender.addon = r.value(flag);
-    else throw ValueError(concat("unknown option '", flag, "' (see tempera stylize --help)"));
+    else if (!set_from_flag(o.stylit.synthesis, synthesis_option_table(), flag.substr(2), r.value(flag)))
+      throw ValueError(concat("unknown option '", flag, "' (see tempera stylize --help)"));
   }
+  validate(o.stylit.synthesis);
   if (o.exemplar.empty()) throw ValueError("--exemplar is required (the painting)");
   if (o.frames.empty()) throw ValueError("--frames is required (e.g. --frames 1-24)");
   if (o.out.empty()) throw ValueError("--out is required (the output folder)");

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <set>
 
+#include "bind_options.hpp"
 #include "numpy_bridge.hpp"
 #include "tempera/contact_sheet.hpp"
 #include "tempera/process.hpp"
@@ -20,8 +21,14 @@ using py_bridge::FloatArray;
 
 namespace {
 
-const std::set<std::string> kStylitKeys = {"weights", "temporal_weight", "quality", "usage",
-                                           "patch_size", "seed", "threads"};
+// StyLit's own keys; every other key is an engine option (SynthesisOptions).
+const std::set<std::string> kStylitKeys = {"weights", "temporal_weight", "quality"};
+
+std::set<std::string> stylit_keys() {
+  std::set<std::string> keys = kStylitKeys;
+  for_each_field(synthesis_option_table(), [&](const auto& f) { keys.insert(f.name); });
+  return keys;
+}
 const std::set<std::string> kJobKeys = {"style", "exemplar_guides", "exemplar_frame", "guides", "frames",
                                         "out", "format", "prefix", "resume"};
 
@@ -54,16 +61,17 @@ StylitOptions parse_stylit(const py::dict& d) {
   if (d.contains("weights")) set_weights(opt, d["weights"].cast<py::dict>());
   if (d.contains("temporal_weight")) opt.temporal_weight = d["temporal_weight"].cast<float>();
   if (d.contains("quality")) opt.quality = parse_quality(d["quality"].cast<std::string>());
-  if (d.contains("usage")) opt.synthesis.usage = parse_patch_usage(d["usage"].cast<std::string>());
-  if (d.contains("patch_size")) opt.synthesis.patch_size = d["patch_size"].cast<int>();
-  if (d.contains("seed")) opt.synthesis.seed = d["seed"].cast<std::uint64_t>();
-  if (d.contains("threads")) opt.synthesis.threads = d["threads"].cast<int>();
+  py::dict engine;
+  for (const auto& [key, value] : d)
+    if (!kStylitKeys.count(py::str(key))) engine[key] = value;
+  py_bridge::set_from_dict(opt.synthesis, synthesis_option_table(), engine, "engine option");
+  validate(opt.synthesis);
   active_guides(opt);  // errors now, not in the middle of a run
   return opt;
 }
 
 StylizeJobConfig parse_job_config(const py::dict& d) {
-  reject_unknown(d, kJobKeys, kStylitKeys, "StylizeJob config");
+  reject_unknown(d, kJobKeys, stylit_keys(), "StylizeJob config");
   for (const char* key : {"style", "exemplar_guides", "guides", "frames", "out"})
     if (!d.contains(key)) throw ValueError(concat("StylizeJob config needs '", key, "'"));
   StylizeJobConfig c;
@@ -113,7 +121,7 @@ GuideFrame guide_frame(const py::dict& arrays, const char* what, std::vector<Flo
 
 py::tuple stylize_frame_py(const FloatArray& style, const py::dict& exemplar, const py::dict& target,
                            const py::dict& options, const py::object& temporal, const py::object& progress) {
-  reject_unknown(options, kStylitKeys, {}, "stylize_frame option");
+  reject_unknown(options, stylit_keys(), {}, "stylize_frame option");
   const StylitOptions opt = parse_stylit(options);
   std::vector<FloatArray> keep;
   const GuideFrame ex = guide_frame(exemplar, "exemplar", keep), tg = guide_frame(target, "target", keep);

@@ -1,0 +1,80 @@
+// Bénard et al. 2013, eq. 8: g_h = h_s max(0, H(M(p)) - h_tau), with H the
+// usage count of each exemplar pixel blurred by a small Gaussian. The paper
+// gives no values; here H is divided by the fair use omega (targets per valid
+// source patch) and the cost by the median patch distance d~, so h_s and
+// h_tau mean the same at every level and frame size (docs/engine.md).
+#include <algorithm>
+#include <cmath>
+
+#include "tempera/patch_usage.hpp"
+
+namespace tempera {
+namespace {
+
+// Separable Gaussian blur of a width x height grid, zero outside.
+std::vector<float> gaussian_blur(const std::vector<float>& in, int width, int height, float sigma) {
+  if (sigma <= 0) return in;
+  const int r = std::max(1, std::min(int(std::ceil(3 * sigma)), std::max(width, height)));
+  std::vector<float> k(2 * r + 1);
+  float sum = 0;
+  for (int i = -r; i <= r; ++i) sum += k[i + r] = std::exp(-0.5f * float(i * i) / (sigma * sigma));
+  for (auto& v : k) v /= sum;
+  std::vector<float> tmp(in.size(), 0.0f), out(in.size(), 0.0f);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      float acc = 0;
+      for (int i = std::max(-r, -x); i <= std::min(r, width - 1 - x); ++i) acc += k[i + r] * in[std::size_t(y) * width + x + i];
+      tmp[std::size_t(y) * width + x] = acc;
+    }
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      float acc = 0;
+      for (int i = std::max(-r, -y); i <= std::min(r, height - 1 - y); ++i)
+        acc += k[i + r] * tmp[std::size_t(y + i) * width + x];
+      out[std::size_t(y) * width + x] = acc;
+    }
+  return out;
+}
+
+class UsageHistogram final : public EnergyTerm {
+ public:
+  UsageHistogram(float weight, float threshold, float sigma) : weight_(weight), threshold_(threshold), sigma_(sigma) {}
+  const char* name() const override { return "histogram"; }
+  void add_source_costs(const LevelContext& c, const OffsetField& field, std::vector<float>& cost) const override {
+    const int sw = c.space->source->width, sh = c.space->source->height;
+    const std::vector<float> h = gaussian_blur(usage_counts(field, *c.constraints, sw), sw, sh, sigma_);
+    std::vector<float> dists;
+    for (std::size_t q = 0; q < c.constraints->target_active.size(); ++q)
+      if (c.constraints->target_active[q]) dists.push_back(field.dist[q]);
+    std::size_t valid = 0;
+    for (auto v : c.constraints->source_valid) valid += v;
+    if (dists.empty() || valid == 0) return;
+    std::nth_element(dists.begin(), dists.begin() + dists.size() / 2, dists.end());
+    const float typical = std::max(dists[dists.size() / 2], 1e-6f);
+    const float fair = float(dists.size()) / float(valid);
+    for (std::size_t p = 0; p < cost.size(); ++p)
+      cost[p] += weight_ * typical * std::max(0.0f, h[p] / fair - threshold_);
+  }
+
+ private:
+  float weight_, threshold_, sigma_;
+};
+
+}  // namespace
+
+std::shared_ptr<const EnergyTerm> make_usage_histogram(float weight, float threshold, float sigma) {
+  return std::make_shared<UsageHistogram>(weight, threshold, sigma);
+}
+
+std::shared_ptr<const EnergyTerm> make_usage_term(const SynthesisOptions& o) {
+  switch (o.usage) {
+    case PatchUsage::None: return nullptr;
+    case PatchUsage::Penalty: return make_occurrence_penalty(o.penalty_weight);
+    case PatchUsage::Uniform: return make_uniform_usage();
+    case PatchUsage::Budget: return make_error_budget(o.budget_coverage, o.budget_max_rounds);
+    case PatchUsage::Histogram: return make_usage_histogram(o.histogram_weight, o.histogram_threshold, o.histogram_sigma);
+  }
+  return nullptr;
+}
+
+}  // namespace tempera
