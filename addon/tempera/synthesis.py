@@ -121,7 +121,7 @@ def synthesize(
     for name, value in option_values.items():
         if not hasattr(opts, name):
             known = ", ".join(row["name"] for row in _native.SynthesisOptions.table())
-            raise ValueError(f"unknown synthesis option '{name}' (known: {known})")
+            raise TypeError(f"synthesize() got an unexpected keyword argument '{name}' (engine options: {known})")
         setattr(opts, name, value)
     opts.validate()
     style = _as_image(style, "style")

@@ -136,7 +136,7 @@ Options parse(const Args& args) {
     else if (flag == "--samples") o.samples = std::to_string(r.number<int>(flag));
     else if (flag == "--blender") o.blender.blender = r.value(flag);
     else if (flag == "--addon-path") o.blender.addon = r.value(flag);
-    else if (!set_from_flag(o.stylit.synthesis, synthesis_option_table(), flag.substr(2), r.value(flag)))
+    else if (!set_from_flag(o.stylit.synthesis, synthesis_option_table(), flag.substr(2), [&] { return r.value(flag); }))
       throw ValueError(concat("unknown option '", flag, "' (see tempera stylize --help)"));
   }
   validate(o.stylit.synthesis);

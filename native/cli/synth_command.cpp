@@ -103,7 +103,7 @@ int run_synth(const Args& args) {
     else if (flag == "--reference") reference_path = in.value(flag);
     else if (flag == "--stats") stats_path = in.value(flag);
     else if (flag == "--quiet") quiet = true;
-    else if (!set_from_flag(opt, synthesis_option_table(), flag.substr(2), in.value(flag)))
+    else if (!set_from_flag(opt, synthesis_option_table(), flag.substr(2), [&] { return in.value(flag); }))
       throw ValueError(concat("unknown option '", flag, "' (see tempera synth --help)"));
   }
   if (style_path.empty()) throw ValueError("--style is required");

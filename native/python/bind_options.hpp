@@ -25,7 +25,7 @@ template <class T>
 T from_python(const py::handle& value, const char* name) {
   try {
     if constexpr (std::is_enum_v<T>) {
-      return parse_enum<T>(py::cast<std::string>(value), name);
+      return parse_enum<T>(py::cast<std::string>(value), EnumNames<T>::what);
     } else if constexpr (std::is_same_v<T, bool>) {
       if (!py::isinstance<py::bool_>(value) && !py::isinstance<py::int_>(value))
         throw ValueError(concat(name, " expects True or False"));

@@ -62,8 +62,10 @@ StylitOptions parse_stylit(const py::dict& d) {
   if (d.contains("temporal_weight")) opt.temporal_weight = d["temporal_weight"].cast<float>();
   if (d.contains("quality")) opt.quality = parse_quality(d["quality"].cast<std::string>());
   py::dict engine;
+  std::set<std::string> engine_keys;
+  for_each_field(synthesis_option_table(), [&](const auto& f) { engine_keys.insert(f.name); });
   for (const auto& [key, value] : d)
-    if (!kStylitKeys.count(py::str(key))) engine[key] = value;
+    if (engine_keys.count(py::str(key))) engine[key] = value;
   py_bridge::set_from_dict(opt.synthesis, synthesis_option_table(), engine, "engine option");
   validate(opt.synthesis);
   active_guides(opt);  // errors now, not in the middle of a run

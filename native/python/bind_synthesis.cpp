@@ -90,10 +90,15 @@ Exemplar exemplar_from(const py::dict& d, std::size_t k, std::vector<FloatArray>
   return e;
 }
 
-py::tuple synthesize_py(const FloatArray& style, const py::list& guides, const SynthesisOptions& opt,
+py::tuple synthesize_py(const FloatArray& style, const py::list& guides, const py::object& options,
                         const py::dict& maps, std::optional<std::pair<int, int>> target_shape,
-                        const py::list& exemplars, const py::object& reference, const py::object& fixed,
+                        const py::object& exemplars, const py::object& reference, const py::object& fixed,
                         const std::function<bool(double)>& progress) {
+  SynthesisOptions opt;
+  if (py::isinstance<py::dict>(options))
+    py_bridge::set_from_dict(opt, synthesis_option_table(), options.cast<py::dict>(), "synthesis option");
+  else
+    opt = options.cast<SynthesisOptions>();
   std::vector<FloatArray> keep;
   SynthesisInput in;
   in.style = py_bridge::view_of(style, "style");
@@ -127,7 +132,8 @@ py::tuple synthesize_py(const FloatArray& style, const py::list& guides, const S
     in.target_width = target_shape->second;
   }
   std::size_t k = 1;
-  for (const auto& e : exemplars) in.exemplars.push_back(exemplar_from(e.cast<py::dict>(), k++, keep));
+  if (!exemplars.is_none())
+    for (const auto& e : exemplars.cast<py::list>()) in.exemplars.push_back(exemplar_from(e.cast<py::dict>(), k++, keep));
   in.reference = optional_view(reference, "reference", keep);
   if (!fixed.is_none()) {
     const py::dict f = fixed.cast<py::dict>();
@@ -200,7 +206,8 @@ void bind_synthesis(py::module_& m) {
       .def_readonly("field", &SynthesisStats::field, "(H, W, 2) float32 sub-pixel source positions");
   add_item_access(stats);
   m.def("synthesize", &synthesize_py, py::arg("style"), py::arg("guides"), py::arg("options"), py::arg("maps"),
-        py::arg("target_shape"), py::arg("exemplars"), py::arg("reference"), py::arg("fixed"), py::arg("progress"),
+        py::arg("target_shape"), py::arg("exemplars") = py::none(), py::arg("reference") = py::none(),
+        py::arg("fixed") = py::none(), py::arg("progress") = nullptr,
         "Low-level engine entry; use tempera.synthesize().");
   m.def("error_knee", [](std::vector<float> sorted_errors) {
     std::sort(sorted_errors.begin(), sorted_errors.end());

@@ -21,8 +21,9 @@
 
 namespace tempera {
 
-// Names of an enum's values, in declaration order; specialised next to each
-// enum used as an option: `static constexpr std::array<const char*, N> names`.
+// Names of an enum's values, in declaration order, and what the enum is
+// called in messages; specialised next to each enum used as an option:
+// `static constexpr const char* what` and `std::array<const char*, N> names`.
 template <class E>
 struct EnumNames;
 
@@ -118,7 +119,7 @@ T parse_value(std::string_view text, std::string_view what) {
     if (text == "false" || text == "0" || text == "off") return false;
     throw ValueError(concat(what, " expects true or false, got '", text, "'"));
   } else if constexpr (std::is_enum_v<T>) {
-    return parse_enum<T>(text, what);
+    return parse_enum<T>(text, EnumNames<T>::what);
   } else if constexpr (std::is_arithmetic_v<T>) {
     return parse_number<T>(text, what);
   } else {
@@ -135,12 +136,20 @@ T parse_value(std::string_view text, std::string_view what) {
 
 // ---- validation ----
 
+// "guide_variance" -> "guide variance", as messages name options.
+inline std::string spoken(const char* name) {
+  std::string out = name;
+  for (auto& c : out)
+    if (c == '_') c = ' ';
+  return out;
+}
+
 template <class T>
 void check_range(const T& v, const char* name, double min, double max) {
   if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>) {
     const double x = double(v);
     if (!std::isfinite(x) || x < min || x > max)
-      throw ValueError(concat(name, " must be in [", format_value(min), ", ", format_value(max), "], got ",
+      throw ValueError(concat(spoken(name), " must be in [", format_value(min), ", ", format_value(max), "], got ",
                               format_value(v)));
   } else if constexpr (!std::is_arithmetic_v<T> && !std::is_enum_v<T>) {
     for (const auto& x : v) check_range(x, name, min, max);
@@ -163,15 +172,16 @@ std::string settings_text(const S& options, const Tuple& table) {
   return out;
 }
 
-// Sets the field whose flag is `flag` (without dashes) from `text`; false if
-// the table has no such flag.
-template <class S, class Tuple>
-bool set_from_flag(S& options, const Tuple& table, std::string_view flag, std::string_view text) {
+// Sets the field whose flag is `flag` (without dashes) from the text that
+// `value()` returns (called only then, so it may consume an argument); false
+// if the table has no such flag.
+template <class S, class Tuple, class Value>
+bool set_from_flag(S& options, const Tuple& table, std::string_view flag, Value&& value) {
   bool found = false;
   for_each_field(table, [&](const auto& f) {
     using T = std::decay_t<decltype(options.*f.member)>;
     if (found || flag != f.flag || *f.flag == 0) return;
-    options.*f.member = parse_value<T>(text, concat("--", f.flag));
+    options.*f.member = parse_value<T>(value(), concat("--", f.flag));
     found = true;
   });
   return found;

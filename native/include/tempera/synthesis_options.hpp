@@ -15,6 +15,7 @@ namespace tempera {
 enum class PatchUsage { None, Penalty, Uniform, Budget, Histogram };
 template <>
 struct EnumNames<PatchUsage> {
+  static constexpr const char* what = "patch usage";
   static constexpr std::array<const char*, 5> names = {"none", "penalty", "uniform", "budget", "histogram"};
 };
 
@@ -23,6 +24,7 @@ struct EnumNames<PatchUsage> {
 enum class ColorSpace { Rgb, Lab };
 template <>
 struct EnumNames<ColorSpace> {
+  static constexpr const char* what = "colour space";
   static constexpr std::array<const char*, 2> names = {"rgb", "lab"};
 };
 
@@ -36,6 +38,7 @@ struct EnumNames<ColorSpace> {
 enum class OutputMode { Mean, Centre, Mode, Random };
 template <>
 struct EnumNames<OutputMode> {
+  static constexpr const char* what = "output mode";
   static constexpr std::array<const char*, 4> names = {"mean", "centre", "mode", "random"};
 };
 
