@@ -46,7 +46,8 @@ class OccurrencePenalty final : public EnergyTerm {
  public:
   explicit OccurrencePenalty(float weight) : weight_(weight) {}
   const char* name() const override { return "penalty"; }
-  void add_source_costs(const LevelContext& c, const OffsetField& field, std::vector<float>& cost) const override {
+  void add_source_costs(const LevelContext& c, const OffsetField& field, std::vector<float>& cost,
+                        TermState&) const override {
     const std::vector<float> pen = occurrence_penalty(field, *c.constraints, c.space->source->width, weight_);
     for (std::size_t i = 0; i < cost.size(); ++i) cost[i] += pen[i];
   }

@@ -139,6 +139,7 @@ void patchmatch(const PatchSpace& space, const SearchConstraints& cons, OffsetFi
   const SourceLayout* layout = cons.layout;
   const bool video = layout && std::any_of(layout->next_frame.begin(), layout->next_frame.end(),
                                            [](int s) { return s >= 0; });
+  const std::vector<std::uint8_t>& matched = cons.matched();
   for (int iter = 0; iter < params.iterations; ++iter) {
     const OffsetField snapshot = field;  // what other bands see of this band's neighbours
     const Matcher m(space, cons, params, &snapshot);
@@ -164,7 +165,7 @@ void patchmatch(const PatchSpace& space, const SearchConstraints& cons, OffsetFi
             const int nx = tx + d[0], ny = ty + d[1];
             if (nx < 0 || ny < 0 || nx >= tw || ny >= th) continue;
             const std::size_t ni = field.index(nx, ny);
-            if (!cons.target_active[ni]) continue;
+            if (!matched[ni]) continue;
             const bool inside = ny >= y0 && ny < y1;
             const OffsetField& src = inside ? field : snapshot;
             int cx, cy;

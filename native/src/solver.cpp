@@ -520,8 +520,10 @@ void Solver::build_level(int l, Level& level) const {
     for (std::size_t i = 0; i < level.fixed.size(); ++i)
       if (p.fixed_mask[l].data()[i] > 0.5f) level.fixed[i] = 1, cons.target_active[i] = 0;
     level.voters = cons.target_active;
-    if (!p.fixed_field.empty())
+    if (!p.fixed_field.empty()) {
       for (std::size_t i = 0; i < level.fixed.size(); ++i) level.voters[i] |= level.fixed[i];
+      cons.target_matched = level.voters;
+    }
   }
   if (!p.source_label.empty())
     for (std::size_t i = 0; i < std::size_t(sw) * sh; ++i)
@@ -679,13 +681,15 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
   pm.context = &context;
   for (const auto& t : terms_)
     if (t->reads_field()) pm.field_terms.push_back(t.get());
+  std::vector<TermState> states(terms_.size());
   for (int it = 0; it < em; ++it) {
     const std::uint64_t stream = std::uint64_t(l) * 1000 + std::uint64_t(it) + 1;
     t0 = Clock::now();
     set_target_style(level, bprime);
     refresh_distances(level.space, level.constraints, field, options_.threads);
     level.constraints.source_cost.assign(level.constraints.source_valid.size(), 0.0f);
-    for (const auto& t : terms_) t->add_source_costs(context, field, level.constraints.source_cost);
+    for (std::size_t k = 0; k < terms_.size(); ++k)
+      terms_[k]->add_source_costs(context, field, level.constraints.source_cost, states[k]);
     const bool source_costs = std::any_of(level.constraints.source_cost.begin(), level.constraints.source_cost.end(),
                                [](float c) { return c != 0.0f; });
     if (!source_costs) level.constraints.source_cost.clear();

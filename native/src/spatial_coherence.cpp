@@ -27,7 +27,7 @@ class SpatialCoherence final : public EnergyTerm {
         const int nx = tx + dx;
         if (nx < 0 || nx >= field.width || (dx == 0 && dy == 0)) continue;
         const std::size_t ni = field.index(nx, ny);
-        if (!c.constraints->target_active[ni]) continue;
+        if (!c.constraints->matched()[ni]) continue;
         float ox = float(dx), oy = float(dy);
         if (phi != 0.0f) rotate_offset(phi, float(dx), float(dy), ox, oy);
         const float ex = float(field.x[ni]) - (float(sx) + ox), ey = float(field.y[ni]) - (float(sy) + oy);

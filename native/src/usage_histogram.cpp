@@ -40,9 +40,19 @@ class UsageHistogram final : public EnergyTerm {
  public:
   UsageHistogram(float weight, float threshold, float sigma) : weight_(weight), threshold_(threshold), sigma_(sigma) {}
   const char* name() const override { return "histogram"; }
-  void add_source_costs(const LevelContext& c, const OffsetField& field, std::vector<float>& cost) const override {
+  void add_source_costs(const LevelContext& c, const OffsetField& field, std::vector<float>& cost,
+                        TermState& state) const override {
     const int sw = c.space->source->width, sh = c.space->source->height;
-    const std::vector<float> h = gaussian_blur(usage_counts(field, *c.constraints, sw), sw, sh, sigma_);
+    const std::vector<float> now = gaussian_blur(usage_counts(field, *c.constraints, sw), sw, sh, sigma_);
+    // The running mean of the histogram over this level's iterations: every
+    // target sees the same costs during a sweep, so a plain histogram makes
+    // the crowd of a hotspot move together to the same free patch and
+    // oscillate; the mean remembers where the crowd has been.
+    std::vector<float>& h = state.values;
+    if (h.size() != now.size()) h.assign(now.size(), 0.0f);
+    const float keep = float(state.updates) / float(state.updates + 1);
+    for (std::size_t p = 0; p < h.size(); ++p) h[p] = keep * h[p] + (1 - keep) * now[p];
+    ++state.updates;
     std::vector<float> dists;
     for (std::size_t q = 0; q < c.constraints->target_active.size(); ++q)
       if (c.constraints->target_active[q]) dists.push_back(field.dist[q]);
@@ -52,8 +62,13 @@ class UsageHistogram final : public EnergyTerm {
     std::nth_element(dists.begin(), dists.begin() + dists.size() / 2, dists.end());
     const float typical = std::max(dists[dists.size() / 2], 1e-6f);
     const float fair = float(dists.size()) / float(valid);
+    // Saturated one threshold above it: an overused patch costs at most h_s
+    // typical patch distances more, so targets leave it for nearby patches of
+    // similar fit instead of stampeding, all at once, to wherever no patch is
+    // used yet (the term is evaluated against the field before the sweep).
+    const float span = std::max(threshold_, 1.0f);
     for (std::size_t p = 0; p < cost.size(); ++p)
-      cost[p] += weight_ * typical * std::max(0.0f, h[p] / fair - threshold_);
+      cost[p] += weight_ * typical * std::clamp((h[p] / fair - threshold_) / span, 0.0f, 1.0f);
   }
 
  private:

@@ -38,12 +38,20 @@ struct UsageStats {
   double covered = 0.0;  // fraction of active targets placed by reversed retrieval
 };
 
+// What a term keeps across the EM iterations of one level solve (terms
+// themselves are immutable and shared).
+struct TermState {
+  std::vector<float> values;
+  int updates = 0;
+};
+
 class EnergyTerm {
  public:
   virtual ~EnergyTerm() = default;
   virtual const char* name() const = 0;
   // Adds this term's cost per source pixel into `cost` (atlas size).
-  virtual void add_source_costs(const LevelContext&, const OffsetField&, std::vector<float>& /*cost*/) const {}
+  virtual void add_source_costs(const LevelContext&, const OffsetField&, std::vector<float>& /*cost*/,
+                                TermState& /*state*/) const {}
   // Whether pair_cost() is used.
   virtual bool reads_field() const { return false; }
   // Extra cost of matching target (tx, ty) to source (sx, sy), given the

@@ -18,6 +18,10 @@ namespace tempera {
 struct SearchConstraints {
   std::vector<std::uint8_t> source_valid;   // per source pixel: may be a patch center
   std::vector<std::uint8_t> target_active;  // per target pixel: is synthesized
+  // Optional: target pixels whose matches neighbours may adopt (propagation,
+  // coherence): the active ones plus hard-constrained pixels with a fixed
+  // match. Empty = target_active.
+  std::vector<std::uint8_t> target_matched;
   // Optional segment labels: a target pixel only matches sources with its label.
   std::vector<std::int32_t> source_segment, target_segment;
   // Extra cost per source center (usage terms); empty = none.
@@ -33,6 +37,7 @@ struct SearchConstraints {
   bool allowed(std::size_t source_index, int segment) const {
     return source_valid[source_index] && segment_of_source(source_index) == segment;
   }
+  const std::vector<std::uint8_t>& matched() const { return target_matched.empty() ? target_active : target_matched; }
   float cost(std::size_t source_index) const { return source_cost.empty() ? 0.0f : source_cost[source_index]; }
 };
 
