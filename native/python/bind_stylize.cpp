@@ -47,11 +47,8 @@ void set_weights(StylitOptions& opt, const py::dict& weights) {
   for (const auto& [key, value] : weights) {
     const std::string name = py::str(key);
     auto it = std::find_if(opt.weights.begin(), opt.weights.end(), [&](auto& w) { return w.first == name; });
-    if (it == opt.weights.end()) {
-      std::string known;
-      for (const auto& g : light_path_guides()) known += (known.empty() ? "" : ", ") + g;
-      throw ValueError(concat("unknown guide '", name, "' in weights (StyLit guides: ", known, ")"));
-    }
+    if (it == opt.weights.end())
+      throw ValueError(concat("unknown guide '", name, "' in weights (StyLit guides: ", light_path_guide_names(), ")"));
     it->second = value.cast<float>();
   }
 }
@@ -205,6 +202,32 @@ void bind_stylize(py::module_& m) {
       py::arg("previous"), py::arg("current"), py::arg("velocity_backward"), py::arg("visible"),
       "Mean absolute colour change along valid motion; use tempera.temporal.flicker.");
   m.def(
+      "stylit_defaults",
+      [] {
+        const StylitOptions o;
+        py::dict d;
+        d["temporal_weight"] = o.temporal_weight;
+        d["quality"] = quality_name(o.quality);
+        return d;
+      },
+      "StyLit's own defaults (the engine's are SynthesisOptions.table()).");
+  m.def(
+      "light_path_guides",
+      [] {
+        py::list out;
+        for (const auto& g : light_path_guides()) {
+          py::dict d;
+          d["name"] = g.name;
+          d["expression"] = g.expression;
+          d["weight"] = g.weight;
+          d["label"] = g.label;
+          d["help"] = g.help;
+          out.append(d);
+        }
+        return out;
+      },
+      "StyLit's light-path guides: name, expression, default weight, label, help (the one table, stylit.hpp).");
+  m.def(
       "tonemap_guide",
       [](const FloatArray& linear) {
         const ImageView v = py_bridge::view_of(linear, "linear");
@@ -215,7 +238,7 @@ void bind_stylize(py::module_& m) {
         }
         return py_bridge::to_numpy(std::move(out));
       },
-      py::arg("linear"), "x/(1+x) then sRGB, as tempera.stylit_guides.tonemap.");
+      py::arg("linear"), "Linear radiance -> guide values in [0, 1): x/(1+x), then sRGB (use tempera.stylize.tonemap).");
   m.def(
       "contact_sheet",
       [](const std::vector<FloatArray>& images, int columns, int gap, int margin, std::vector<float> background) {
