@@ -437,11 +437,6 @@ int Solver::pm_iterations(int l) const {
 
 namespace {
 
-// Style channels of B' or A' as matched: in Lab if asked.
-Image matched_style(const ImageView& style, ColorSpace space) {
-  return space == ColorSpace::Lab ? srgb_to_lab(style) : Image::copy_of(style);
-}
-
 double mean_energy(const OffsetField& field, const SearchConstraints& cons) {
   double sum = 0;
   std::size_t n = 0;
@@ -469,7 +464,7 @@ PatchSpace Solver::geometry(int l, FeatureImage& source, FeatureImage& target) c
   return space;
 }
 
-void Solver::build_level(int l, Level& level) const {
+void Solver::build_level(int l, Level& level, const Image* fixed_mask) const {
   const Plan& p = *plan_;
   const Image& src = p.source[std::size_t(l)];
   const int total = src.channels();
@@ -479,12 +474,14 @@ void Solver::build_level(int l, Level& level) const {
   level.space.source = &level.source;
   level.space.target = &level.target;
   level.style = extract_channels(src.view(), 0, p.style_channels);
-  if (total > p.style_channels) {
-    const Image guides = extract_channels(src.view(), p.style_channels, total - p.style_channels);
-    level.source.set_channels(p.style_channels, guides.view(), 1.0f);
-    level.target.set_channels(p.style_channels, p.target[l].view(), 1.0f);
-  }
-  level.source.set_channels(0, matched_style(level.style.view(), options_.color_space).view(), p.style_scales);
+  // All channels as they are (the guides are weighted already), then the
+  // style's as matched: no full-size copy of the guides.
+  level.source.set_channels(0, src.view(), 1.0f);
+  if (total > p.style_channels) level.target.set_channels(p.style_channels, p.target[l].view(), 1.0f);
+  if (options_.color_space == ColorSpace::Lab)
+    level.source.set_channels(0, srgb_to_lab(level.style.view()).view(), p.style_scales);
+  else
+    level.source.set_channels(0, level.style.view(), p.style_scales);
   const int sw = level.source.width, sh = level.source.height, tw = level.target.width, th = level.target.height;
   const bool weighted = std::any_of(p.weight_maps.begin(), p.weight_maps.end(), [](auto& m) { return !m.empty(); });
   if (weighted) {
@@ -515,12 +512,15 @@ void Solver::build_level(int l, Level& level) const {
   if (!p.target_mask.empty())
     for (std::size_t i = 0; i < cons.target_active.size(); ++i)
       cons.target_active[i] = p.target_mask[l].data()[i] > 0.5f || (l > 0 && p.target_mask[l].data()[i] > 0.0f);
-  if (!p.fixed_mask.empty()) {
+  const Image* fixed = fixed_mask ? fixed_mask : (p.fixed_mask.empty() ? nullptr : &p.fixed_mask[std::size_t(l)]);
+  if (fixed) {
+    if (fixed->width() != tw || fixed->height() != th || fixed->channels() != 1)
+      throw ValueError(concat("the fixed-pixel mask of level ", l, " must be ", tw, "x", th, " with 1 channel"));
     level.fixed.assign(cons.target_active.size(), 0);
     for (std::size_t i = 0; i < level.fixed.size(); ++i)
-      if (p.fixed_mask[l].data()[i] > 0.5f) level.fixed[i] = 1, cons.target_active[i] = 0;
+      if (fixed->data()[i] > 0.5f) level.fixed[i] = 1, cons.target_active[i] = 0;
     level.voters = cons.target_active;
-    if (!p.fixed_field.empty()) {
+    if (!fixed_mask && !p.fixed_field.empty()) {
       for (std::size_t i = 0; i < level.fixed.size(); ++i) level.voters[i] |= level.fixed[i];
       cons.target_matched = level.voters;
     }
@@ -535,19 +535,26 @@ void Solver::build_level(int l, Level& level) const {
 }
 
 void Solver::set_target_style(Level& level, const Image& bprime) const {
-  level.target.set_channels(0, matched_style(bprime.view(), options_.color_space).view(), plan_->style_scales);
+  if (options_.color_space == ColorSpace::Lab)
+    level.target.set_channels(0, srgb_to_lab(bprime.view()).view(), plan_->style_scales);
+  else
+    level.target.set_channels(0, bprime.view(), plan_->style_scales);
 }
 
 // Fixed pixels: their match (when given) and their value.
-void Solver::fix_pixels(int l, const Level& level, OffsetField& field, Image& bprime) const {
+void Solver::fix_pixels(int l, const Level& level, const Image* given, OffsetField& field, Image& bprime) const {
   if (level.fixed.empty()) return;
   const Plan& p = *plan_;
-  const Image& values = p.fixed_values[std::size_t(l)];
+  if (!given && p.fixed_values.empty()) throw ValueError("fixed pixels of a level need their values");
+  const Image& values = given ? *given : p.fixed_values[std::size_t(l)];
+  if (values.width() != field.width || values.height() != field.height || values.channels() != p.style_channels)
+    throw ValueError(concat("fixed-pixel values of level ", l, " must be ", field.width, "x", field.height, " with ",
+                            p.style_channels, " channels"));
   if (bprime.empty()) bprime = Image(field.width, field.height, p.style_channels);
   for (std::size_t i = 0; i < level.fixed.size(); ++i) {
     if (!level.fixed[i]) continue;
     std::copy_n(values.data() + i * p.style_channels, p.style_channels, bprime.data() + i * p.style_channels);
-    if (p.fixed_field.empty()) continue;
+    if (given || p.fixed_field.empty()) continue;
     const OffsetField& f = p.fixed_field[std::size_t(l)];
     field.x[i] = f.x[i], field.y[i] = f.y[i], field.rx[i] = f.rx[i], field.ry[i] = f.ry[i];
   }
@@ -638,7 +645,7 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
   if (l < 0 || l >= levels()) throw ValueError(concat("level ", l, " does not exist (0 to ", coarsest(), ")"));
   const Plan& p = *plan_;
   Level level;
-  build_level(l, level);
+  build_level(l, level, start.fixed_mask);
   LevelResult out;
   LevelStats& stats = out.stats;
   stats.level = l;
@@ -666,7 +673,7 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
                               " channels"));
     bprime = *start.image;
   }
-  fix_pixels(l, level, field, bprime);
+  fix_pixels(l, level, start.fixed_values, field, bprime);
   stats.search_seconds += seconds_since(t0);
   const bool have_image = start.image || (!start.field && !p.reference.empty());  // else vote it from the field
   if (!have_image) {

@@ -26,6 +26,11 @@ struct LevelStart {
   const OffsetField* field = nullptr;  // null: cold start (guides-only match, or the reference)
   const Image* image = nullptr;        // B' to start from; null: voted from the field
   const CandidateList* candidates = nullptr;  // extra candidates (atlas positions at this level)
+  // Hard constraints of this level alone (level size), instead of the
+  // input's: pixels held at `fixed_values` (the style's channels), e.g. Color
+  // Me Noisy's pixels that join the synthesis only at a finer level.
+  const Image* fixed_mask = nullptr;
+  const Image* fixed_values = nullptr;
 };
 
 struct LevelResult {
@@ -72,11 +77,11 @@ class Solver {
  private:
   struct Plan;
   struct Level;
-  void build_level(int level, Level& out) const;
+  void build_level(int level, Level& out, const Image* fixed_mask = nullptr) const;
   // Patch space of `level` without features: for moving fields (angles, margins).
   PatchSpace geometry(int level, FeatureImage& source, FeatureImage& target) const;
   OffsetField cold_start(int level, Level& lv, Image& bprime) const;
-  void fix_pixels(int level, const Level& lv, OffsetField& field, Image& bprime) const;
+  void fix_pixels(int level, const Level& lv, const Image* values, OffsetField& field, Image& bprime) const;
   void set_target_style(Level& lv, const Image& bprime) const;
   std::unique_ptr<Plan> plan_;
   SynthesisOptions options_;
