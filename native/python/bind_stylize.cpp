@@ -12,6 +12,7 @@
 #include "numpy_bridge.hpp"
 #include "tempera/contact_sheet.hpp"
 #include "tempera/process.hpp"
+#include "tempera/pyramid.hpp"
 #include "tempera/stylit.hpp"
 #include "tempera/stylize_job.hpp"
 
@@ -227,6 +228,18 @@ void bind_stylize(py::module_& m) {
         return out;
       },
       "StyLit's light-path guides: name, expression, default weight, label, help (the one table, stylit.hpp).");
+  m.def(
+      "box_blur",
+      [](const FloatArray& image, float width) {
+        const ImageView v = py_bridge::view_of(image, "image");
+        Image out;
+        {
+          py::gil_scoped_release release;
+          out = box_blur(v, width);
+        }
+        return py_bridge::to_numpy(std::move(out));
+      },
+      py::arg("image"), py::arg("width"), "Box low-pass of `width` pixels (pyramid.hpp), clamped at the borders.");
   m.def(
       "tonemap_guide",
       [](const FloatArray& linear) {

@@ -19,7 +19,7 @@ SynthesisOptions noisy_defaults() {
   SynthesisOptions o;
   o.patch_size = 7;
   o.em_iterations = 4;   // "4 iterations of search and vote" per level (§4)
-  o.pm_iterations = 8;   // "8 PatchMatch iterations at each pyramid level", read as per search
+  o.pm_iterations = 2;   // "8 PatchMatch iterations at each pyramid level": 2 per search x 4 searches
   o.usage = PatchUsage::None;
   o.output = OutputMode::Mode;  // "the mode of colours" (§3.2)
   o.level_ratio = kRatio;
@@ -81,6 +81,9 @@ Image noisy_frame(const ImageView& style, const ImageView& reference, int frame,
   in.target_width = reference.width;
   in.target_height = reference.height;
   in.reference = reference;
+  // Eq. 2 as a guide pair: the low-passed exemplar against the low-passed R.
+  const Image low_s = box_blur(exemplar.view(), f), low_r = box_blur(reference, f);
+  if (o.consistency > 0) in.guides.add("low_frequencies", low_s.view(), low_r.view(), o.consistency);
   SynthesisOptions opt = o.synthesis;
   opt.level_ratio = kRatio;
   opt.levels = noisy_levels(f);
@@ -101,16 +104,30 @@ Image noisy_frame(const ImageView& style, const ImageView& reference, int frame,
       up = solver.resample(r.field, l + 1, l);
       start.field = &up;
     }
+    Image joining;
     if (!noise_map.empty()) {
       // f_p at this level's size (area-averaged).
       const Image fp = resize_area(noise_map, solver.target_width(l), solver.target_height(l));
+      const Image& held = reference_levels[std::size_t(l)];
       mask = Image(fp.width(), fp.height(), 1);
       for (std::size_t i = 0; i < fp.pixel_count(); ++i) {
         const float fpi = o.noise * fp.data()[i];
         mask.data()[i] = (fpi < 1.0f || widths[std::size_t(l)] > fpi + 1e-6f) ? 1.0f : 0.0f;
       }
       start.fixed_mask = &mask;
-      start.fixed_values = &reference_levels[std::size_t(l)];
+      start.fixed_values = &held;
+      // Pixels that join here start from R (their field is a placeholder);
+      // the others from the B' voted from the upsampled field.
+      if (l < solver.coarsest()) {
+        joining = Image(fp.width(), fp.height(), 1);
+        for (std::size_t i = 0; i < fp.pixel_count(); ++i) {
+          const float fpi = o.noise * fp.data()[i];
+          joining.data()[i] = fpi >= 1.0f && widths[std::size_t(l)] <= fpi + 1e-6f &&
+                              widths[std::size_t(l) + 1] > fpi + 1e-6f;
+        }
+        start.image = &held;
+        start.image_mask = &joining;
+      }
     }
     const double done = double(solver.coarsest() - l) / solver.levels();
     r = solver.solve_level(l, start, [&](double x) { return !progress || progress(done + x / solver.levels()); });

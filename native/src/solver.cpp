@@ -666,21 +666,26 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
   } else {
     field = cold_start(l, level, bprime);
   }
-  if (start.image) {
-    if (start.image->width() != stats.width || start.image->height() != stats.height ||
-        start.image->channels() != p.style_channels)
-      throw ValueError(concat("start image must be ", stats.width, "x", stats.height, " with ", p.style_channels,
-                              " channels"));
-    bprime = *start.image;
-  }
+  if (start.image && (start.image->width() != stats.width || start.image->height() != stats.height ||
+                      start.image->channels() != p.style_channels))
+    throw ValueError(concat("start image must be ", stats.width, "x", stats.height, " with ", p.style_channels,
+                            " channels"));
+  if (start.image_mask && (!start.image || start.image_mask->width() != stats.width ||
+                           start.image_mask->height() != stats.height || start.image_mask->channels() != 1))
+    throw ValueError(concat("a start image mask needs a start image and must be ", stats.width, "x", stats.height));
+  if (start.image && !start.image_mask) bprime = *start.image;
   fix_pixels(l, level, start.fixed_values, field, bprime);
   stats.search_seconds += seconds_since(t0);
-  const bool have_image = start.image || (!start.field && !p.reference.empty());  // else vote it from the field
-  if (!have_image) {
+  const bool have_image = (start.image && !start.image_mask) || (!start.field && !p.reference.empty());
+  if (!have_image) {  // vote it from the field
     t0 = Clock::now();
     bprime = vote(level.style.view(), level.space, level.constraints, field, bprime.view(), vote_params);
     stats.vote_seconds += seconds_since(t0);
   }
+  if (start.image_mask)
+    for (std::size_t i = 0; i < bprime.pixel_count(); ++i)
+      if (start.image_mask->data()[i] > 0.5f)
+        std::copy_n(start.image->data() + i * p.style_channels, p.style_channels, bprime.data() + i * p.style_channels);
   const LevelContext context{l, &level.space, &level.constraints, &p.layout[std::size_t(l)], options_.seed,
                              options_.threads};
   PatchMatchParams pm{pm_iters, options_.seed, options_.threads};

@@ -256,7 +256,10 @@ TEST(Solver, InjectedCandidatesAreTaken) {
       ribbons.begin.push_back(std::uint32_t(ribbons.x.size()));
     }
   auto correct = [&](const CandidateList* c) {
-    const LevelResult r = solver.solve_level(0, {&start, nullptr, c});
+    LevelStart from;
+    from.field = &start;
+    from.candidates = c;
+    const LevelResult r = solver.solve_level(0, from);
     int ok = 0;
     for (int y = 0; y < 40; ++y)
       for (int x = 0; x < 40; ++x) ok += r.field.x[r.field.index(x, y)] == x + 12 && r.field.y[r.field.index(x, y)] == y + 9;

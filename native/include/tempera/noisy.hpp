@@ -11,8 +11,12 @@
 //  - pyramid ratio 0.85 with M = 1 + ceil(ln f / ln(1 / 0.85)) levels and the
 //    box widths f_bar(l) = f^(l / (M - 1)) (l = 0 finest: 1; coarsest: f),
 //    for the exemplar and for R alike (eq. 4); the coarsest level starts
-//    from h_f * R (the engine's reference);
-//  - 4 EM iterations per level, 8 PatchMatch sweeps each, 7 x 7 patches,
+//    from h_f * R (the engine's reference), and the low-frequency term of
+//    eq. 2, |h_f * R - h_f * T|^2, is a guide pair (h_f * S against h_f * R)
+//    at every level: the paper only initializes from R, which let the large
+//    shapes drift from R's at every f in our measurements (docs/noisy.md);
+//  - 4 EM iterations per level with 2 PatchMatch sweeps each (the paper's "8
+//    PatchMatch iterations at each pyramid level"), 7 x 7 patches,
 //    weighted-mode voting, no usage control (§4);
 //  - a fresh random seed per frame, mix(seed, frame), so reruns repeat;
 //  - a local noise map f_p (§3.3): pixel p joins the synthesis at the first
@@ -31,7 +35,8 @@ struct NoisyOptions {
   float lattice_spacing = 50;  // MLS lattice at 1 Mpix (scaled with sqrt(pixels / 1 Mpix))
   float shift_min = 15, shift_max = 25;
   bool deform = true;          // the MLS pre-deformation (off only for the paper's ablation)
-  SynthesisOptions synthesis;  // patch 7, mode voting, 4 EM x 8 PM per level, usage none (noisy_defaults())
+  float consistency = 2.0f;    // weight of the low-frequency term (eq. 2) as a guide pair
+  SynthesisOptions synthesis;  // patch 7, mode voting, 4 EM x 2 PM per level, usage none (noisy_defaults())
 };
 
 // The engine options Color Me Noisy uses, before its pyramid is set per f.
@@ -45,7 +50,9 @@ inline const auto& noisy_option_table() {
             "MLS lattice spacing in pixels at 1 Mpix (scaled with the frame's size); 50 in the paper", 1, 10000),
       field(&N::shift_min, "shift_min", "shift-min", "least move of an MLS lattice node, px at 1 Mpix (15)", 0, 10000),
       field(&N::shift_max, "shift_max", "shift-max", "largest move of an MLS lattice node, px at 1 Mpix (25)", 0, 10000),
-      field(&N::deform, "deform", "deform", "pre-deform the exemplar every frame (off only for comparisons)"));
+      field(&N::deform, "deform", "deform", "pre-deform the exemplar every frame (off only for comparisons)"),
+      field(&N::consistency, "consistency", "consistency",
+            "weight of the low-frequency term |h_f*R - h_f*T|^2: how firmly the large shapes stay R's (2)", 0, 1e6));
   return table;
 }
 

@@ -25,6 +25,9 @@ namespace tempera {
 struct LevelStart {
   const OffsetField* field = nullptr;  // null: cold start (guides-only match, or the reference)
   const Image* image = nullptr;        // B' to start from; null: voted from the field
+  // With `image`: only where this mask (level size, 1 channel) is > 0.5 does
+  // `image` replace the B' voted from the field.
+  const Image* image_mask = nullptr;
   const CandidateList* candidates = nullptr;  // extra candidates (atlas positions at this level)
   // Hard constraints of this level alone (level size), instead of the
   // input's: pixels held at `fixed_values` (the style's channels), e.g. Color
