@@ -338,10 +338,14 @@ TEST(Solver, HistogramTermBreaksUpHotspotsAtLittleEnergy) {
       }
     return peak;
   };
-  double e_none = 0, e_hist = 0;
+  double e_none = 0, e_hist = 0, e_foot = 0;
   const float peak_none = run(PatchUsage::None, e_none), peak_hist = run(PatchUsage::Histogram, e_hist);
   EXPECT_LE(peak_hist * 2, peak_none);
   EXPECT_LE(e_hist, 1.1 * e_none);
+  // Fluidymation's footprint count spreads them too.
+  const float peak_foot = run(PatchUsage::Footprint, e_foot);
+  EXPECT_LT(peak_foot * 1.5, peak_none);
+  RecordProperty("peaks", std::to_string(peak_none) + " " + std::to_string(peak_hist) + " " + std::to_string(peak_foot));
 }
 
 TEST(Solver, SpatialCoherenceTermMakesTheFieldMoreCoherent) {

@@ -41,6 +41,8 @@ USAGE_ITEMS = (
     ("penalty", "Occurrence Penalty", "Overused patches cost more (Kaspar et al.); a softer uniformity"),
     ("histogram", "Usage Histogram", "Patches used far more than their share cost more (Bénard et al. 2013): "
      "breaks up repeated blotches while keeping the best fits"),
+    ("footprint", "Footprint", "Patches whose area of the exemplar is already covered cost more (Fluidymation): "
+     "even coverage for fluids and natural media"),
     ("none", "None", "Plain nearest neighbours: fastest, may wash out into few favourite patches"),
 )
 QUALITY_ITEMS = (

@@ -77,6 +77,9 @@ std::shared_ptr<const EnergyTerm> make_occurrence_penalty(float weight);
 // the fair use per source patch and d~ the median patch distance (so h_s is
 // unit-free).
 std::shared_ptr<const EnergyTerm> make_usage_histogram(float weight, float threshold, float sigma);
+// Fluidymation's Omega: weight * d~ * (coverage of the candidate's footprint
+// by the footprints in use) / fair coverage.
+std::shared_ptr<const EnergyTerm> make_footprint_usage(float weight);
 std::shared_ptr<const EnergyTerm> make_uniform_usage();
 std::shared_ptr<const EnergyTerm> make_error_budget(double coverage, int max_rounds);
 // Bénard et al. 2013, eq. 5: weight * sum over the patch window of

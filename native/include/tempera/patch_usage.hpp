@@ -5,6 +5,8 @@
 //    added to the matching cost;
 //  - histogram (usage_histogram.cpp): Bénard et al. 2013's blurred,
 //    thresholded usage histogram (eq. 8);
+//  - footprint (footprint_usage.cpp): Fluidymation's Omega, usage counted
+//    over patch footprints;
 //  - uniform (uniform_usage.cpp): strict uniform usage by reversed NNF
 //    retrieval with counters K and R per segment (LazyFluids, thesis
 //    §5.4.1-5.4.2);

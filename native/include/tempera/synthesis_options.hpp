@@ -12,11 +12,12 @@ namespace tempera {
 
 // How often each exemplar patch may be used (one implementation per file:
 // occurrence_penalty, usage_histogram, uniform_usage, error_budget).
-enum class PatchUsage { None, Penalty, Uniform, Budget, Histogram };
+enum class PatchUsage { None, Penalty, Uniform, Budget, Histogram, Footprint };
 template <>
 struct EnumNames<PatchUsage> {
   static constexpr const char* what = "patch usage";
-  static constexpr std::array<const char*, 5> names = {"none", "penalty", "uniform", "budget", "histogram"};
+  static constexpr std::array<const char*, 6> names = {"none", "penalty", "uniform", "budget", "histogram",
+                                                       "footprint"};
 };
 
 // Colour space the style channels are compared in (voting stays in the
@@ -56,7 +57,7 @@ struct SynthesisOptions {
   ColorSpace color_space = ColorSpace::Rgb;
   float window_sigma = 0.0f;
   OutputMode output = OutputMode::Mean;
-  float penalty_weight = 1.0f;
+  float penalty_weight = 1.0f;  // also the weight of the footprint term
   float histogram_weight = 1.0f;
   float histogram_threshold = 2.0f;
   float histogram_sigma = 1.5f;
@@ -87,8 +88,8 @@ inline const auto& synthesis_option_table() {
       field(&S::pm_schedule, "pm_schedule", "pm-schedule",
             "PatchMatch sweeps per level, coarsest first; levels past the list use pm_iterations", 0, 1000),
       field(&S::usage, "usage", "usage",
-            "patch usage: budget (StyLit, no wash-out), uniform (every patch equally), penalty and histogram "
-            "(overused patches cost more), none (fastest)"),
+            "patch usage: budget (StyLit, no wash-out), uniform (every patch equally), penalty, histogram and "
+            "footprint (overused patches cost more), none (fastest)"),
       field(&S::style_weight, "style_weight", "style-weight",
             "weight of the style term (A'/B') against the guides; 1 typical", 0, 1e6),
       field(&S::style_channel_weights, "style_channel_weights", "style-channel-weights",
@@ -101,7 +102,8 @@ inline const auto& synthesis_option_table() {
       field(&S::output, "output", "output-mode",
             "how B' is made: mean (blend of patches), centre (warp, no blending), mode or random (noisy)"),
       field(&S::penalty_weight, "penalty_weight", "penalty-weight",
-            "lambda of the occurrence penalty (usage penalty): 1 typical, higher spreads patches more", 0, 1e6),
+            "lambda of the occurrence penalty and of the footprint term: 1 typical, higher spreads patches more", 0,
+            1e6),
       field(&S::histogram_weight, "histogram_weight", "histogram-weight",
             "h_s of the histogram term (usage histogram): cost per use above the threshold, 1 typical", 0, 1e6),
       field(&S::histogram_threshold, "histogram_threshold", "histogram-threshold",
