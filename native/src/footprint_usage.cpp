@@ -38,18 +38,12 @@ class FootprintUsage final : public EnergyTerm {
     // a candidate centre's own footprint would land on.
     const std::vector<float> covered = box_sum(usage_counts(field, *c.constraints, sw), sw, sh, r);
     const std::vector<float> crowd = box_sum(covered, sw, sh, r);
-    std::vector<float> dists;
-    for (std::size_t q = 0; q < c.constraints->target_active.size(); ++q)
-      if (c.constraints->target_active[q]) dists.push_back(field.dist[q]);
-    std::size_t valid = 0;
-    for (auto v : c.constraints->source_valid) valid += v;
-    if (dists.empty() || valid == 0) return;
-    std::nth_element(dists.begin(), dists.begin() + dists.size() / 2, dists.end());
-    const float typical = std::max(dists[dists.size() / 2], 1e-6f);
+    const UsageScale scale = usage_scale(field, *c.constraints);
+    if (!scale.valid) return;
     const float area = float((2 * r + 1) * (2 * r + 1));
     // Fair coverage of a pixel is omega * area; a footprint sums area pixels.
-    const float fair = float(dists.size()) / float(valid) * area * area;
-    for (std::size_t p = 0; p < cost.size(); ++p) cost[p] += weight_ * typical * crowd[p] / fair;
+    const float fair = scale.fair * area * area;
+    for (std::size_t p = 0; p < cost.size(); ++p) cost[p] += weight_ * scale.typical * crowd[p] / fair;
   }
 
  private:

@@ -6,21 +6,27 @@
 
 namespace tempera {
 
-std::vector<float> occurrence_penalty(const OffsetField& nnf, const SearchConstraints& cons, int source_width, float weight) {
-  std::vector<float> uses(cons.source_valid.size(), 0.0f);
+UsageScale usage_scale(const OffsetField& field, const SearchConstraints& cons) {
   std::vector<float> dists;
-  for (std::size_t q = 0; q < cons.target_active.size(); ++q) {
-    if (!cons.target_active[q]) continue;
-    uses[std::size_t(nnf.y[q]) * source_width + nnf.x[q]] += 1.0f;
-    dists.push_back(nnf.dist[q]);
-  }
+  for (std::size_t q = 0; q < cons.target_active.size(); ++q)
+    if (cons.target_active[q]) dists.push_back(field.dist[q]);
   std::size_t valid = 0;
   for (auto v : cons.source_valid) valid += v;
-  if (dists.empty() || valid == 0) return uses;
+  UsageScale s;
+  if (dists.empty() || valid == 0) return s;
   std::nth_element(dists.begin(), dists.begin() + dists.size() / 2, dists.end());
-  const float typical = std::max(dists[dists.size() / 2], 1e-6f);
-  const float fair = float(dists.size()) / float(valid);  // omega: uses per source if uniform
-  for (auto& u : uses) u = weight * typical * u / fair;
+  s.typical = std::max(dists[dists.size() / 2], 1e-6f);
+  s.fair = float(dists.size()) / float(valid);  // omega: uses per source if uniform
+  s.valid = true;
+  return s;
+}
+
+std::vector<float> occurrence_penalty(const OffsetField& field, const SearchConstraints& cons, int source_width,
+                                      float weight) {
+  std::vector<float> uses = usage_counts(field, cons, source_width);
+  const UsageScale s = usage_scale(field, cons);
+  if (!s.valid) return uses;
+  for (auto& u : uses) u = weight * s.typical * u / s.fair;
   return uses;
 }
 

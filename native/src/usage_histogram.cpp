@@ -53,15 +53,9 @@ class UsageHistogram final : public EnergyTerm {
     const float keep = float(state.updates) / float(state.updates + 1);
     for (std::size_t p = 0; p < h.size(); ++p) h[p] = keep * h[p] + (1 - keep) * now[p];
     ++state.updates;
-    std::vector<float> dists;
-    for (std::size_t q = 0; q < c.constraints->target_active.size(); ++q)
-      if (c.constraints->target_active[q]) dists.push_back(field.dist[q]);
-    std::size_t valid = 0;
-    for (auto v : c.constraints->source_valid) valid += v;
-    if (dists.empty() || valid == 0) return;
-    std::nth_element(dists.begin(), dists.begin() + dists.size() / 2, dists.end());
-    const float typical = std::max(dists[dists.size() / 2], 1e-6f);
-    const float fair = float(dists.size()) / float(valid);
+    const UsageScale scale = usage_scale(field, *c.constraints);
+    if (!scale.valid) return;
+    const float typical = scale.typical, fair = scale.fair;
     // Saturated one threshold above it: an overused patch costs at most h_s
     // typical patch distances more, so targets leave it for nearby patches of
     // similar fit instead of stampeding, all at once, to wherever no patch is

@@ -42,6 +42,15 @@ std::size_t error_knee(const std::vector<float>& sorted_errors);
 std::vector<float> occurrence_penalty(const OffsetField& field, const SearchConstraints& constraints,
                                       int source_width, float weight);
 
+// The scales usage costs are measured in: the median patch distance d~ of the
+// active targets (at least 1e-6) and the fair use omega, active targets per
+// valid source centre. valid = false when there are none.
+struct UsageScale {
+  float typical = 1e-6f, fair = 1.0f;
+  bool valid = false;
+};
+UsageScale usage_scale(const OffsetField& field, const SearchConstraints& constraints);
+
 // Uses per source center by the active targets (atlas size).
 std::vector<float> usage_counts(const OffsetField& field, const SearchConstraints& constraints, int source_width);
 
