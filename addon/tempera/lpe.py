@@ -14,14 +14,8 @@ import numpy as np
 
 from . import _native
 
-# The guides of the StyLit paper (thesis fig. 8.4), by name.
-STYLIT_EXPRESSIONS = {
-    "FULL": "L.*E",
-    "LDE": "LDE",
-    "LSE": "LSE",
-    "LDDE": "L.*DDE",
-    "LD12E": "LD{1,2}E",
-}
+# The guides of the StyLit paper (thesis fig. 8.4), by name (native guide table).
+STYLIT_EXPRESSIONS = {g["name"]: g["expression"] for g in _native.light_path_guides()}
 
 _FLOAT_ARRAYS = ("vertices", "normals", "uvs")
 _INT_ARRAYS = ("triangles", "triangle_materials")

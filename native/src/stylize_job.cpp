@@ -19,7 +19,6 @@
 #include "tempera/error.hpp"
 #include "tempera/image_io.hpp"
 #include "tempera/paths.hpp"
-#include "tempera/limits.hpp"
 
 namespace fs = std::filesystem;
 
@@ -94,12 +93,8 @@ std::string settings_text(const StylizeJobConfig& c) {
   std::ostringstream s;
   s << "weights=";
   for (const auto& [name, weight] : active_guides(c.stylit)) s << name << ":" << weight << ",";
-  s << ";temporal=" << c.stylit.temporal_weight << ";quality=" << quality_name(c.stylit.quality)
-    << ";usage=" << patch_usage_name(o.usage) << ";patch_size=" << o.patch_size << ";levels=" << o.levels
-    << ";em=" << o.em_iterations << ";pm=" << o.pm_iterations << ";style_weight=" << o.style_weight
-    << ";penalty_weight=" << o.penalty_weight << ";guide_variance=" << o.guide_variance
-    << ";budget=" << o.budget_coverage << "/" << o.budget_max_rounds << ";seed=" << o.seed
-    << ";format=" << c.format;
+  s << ";temporal=" << c.stylit.temporal_weight << ";quality=" << quality_name(c.stylit.quality) << ";"
+    << settings_text(o, synthesis_option_table()) << "format=" << c.format;
   return s.str();
 }
 
@@ -187,8 +182,11 @@ std::map<int, ReportEntry> read_report(const std::string& path, std::vector<std:
   std::string line;
   bool ok = in && std::getline(in, line) && line == "{" && std::getline(in, line) &&
             line == concat("  \"format\": ", json_string(kReportFormat), ",");
+  bool closed = false;  // the final "}": a truncated record is damaged, not short
   try {
     while (ok && std::getline(in, line)) {
+      if (closed) ok = false;  // text after the end
+      if (line == "}") closed = true;
       if (line.find("{\"key\": ") == std::string::npos) {
         if (line.find("\"key\"") != std::string::npos) ok = false;
         continue;
@@ -218,7 +216,7 @@ std::map<int, ReportEntry> read_report(const std::string& path, std::vector<std:
   } catch (const std::exception&) {
     ok = false;
   }
-  if (ok) return entries;
+  if (ok && closed) return entries;
   const std::string aside = concat(path, ".corrupt-", temporary_name("", "").substr(5));
   fs::rename(path, aside, ec);
   warnings.push_back(concat("the resume record '", path, "' is damaged or from another Tempera version; ",
@@ -272,7 +270,6 @@ void validate_config(const StylizeJobConfig& c) {
   if (o.patch_size < 3 || o.patch_size % 2 == 0)
     throw ValueError(concat("patch size must be odd and >= 3, got ", o.patch_size));
   if (o.threads < 0) throw ValueError(concat("threads must be >= 0 (0 = all cores), got ", o.threads));
-  check_levels(o.levels);
   active_guides(c.stylit);
 }
 

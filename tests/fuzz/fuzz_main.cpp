@@ -35,7 +35,7 @@
 namespace fs = std::filesystem;
 using namespace tempera;
 using Bytes = std::string;
-using Rng = std::mt19937_64;
+using FuzzRng = std::mt19937_64;
 
 namespace {
 
@@ -52,11 +52,11 @@ void write_bytes(const fs::path& path, const Bytes& data) {
   out.write(data.data(), std::streamsize(data.size()));
 }
 
-std::size_t below(Rng& rng, std::size_t n) { return n ? std::size_t(rng() % n) : 0; }
+std::size_t below(FuzzRng& rng, std::size_t n) { return n ? std::size_t(rng() % n) : 0; }
 
 // The usual byte-level mutations: flips, random bytes, interesting values,
 // truncation, duplication, deletion and splicing of ranges.
-Bytes mutate(Rng& rng, Bytes data, const std::vector<Bytes>& corpus) {
+Bytes mutate(FuzzRng& rng, Bytes data, const std::vector<Bytes>& corpus) {
   const int rounds = 1 + int(below(rng, 8));
   for (int r = 0; r < rounds; ++r) {
     if (data.empty()) data.push_back(char(rng()));
@@ -133,7 +133,7 @@ Image test_image(int w, int h, int c) {
 
 // ---------------------------------------------------------------------------- targets
 
-void fuzz_images(Rng& rng, const std::function<bool()>& more) {
+void fuzz_images(FuzzRng& rng, const std::function<bool()>& more) {
   std::vector<Bytes> corpus;
   for (const char* ext : {"png", "jpg", "tif", "exr"}) {
     const fs::path seed = g_work / concat("seed.", ext);
@@ -167,7 +167,7 @@ std::vector<std::string> cache_channels() {
   return names;
 }
 
-void fuzz_cache(Rng& rng, const std::function<bool()>& more) {
+void fuzz_cache(FuzzRng& rng, const std::function<bool()>& more) {
   const auto names = cache_channels();
   const fs::path seed = g_work / "frame_0001.exr";
   write_image(seed.string(), test_image(8, 6, int(names.size())).view(), names);
@@ -185,7 +185,7 @@ void fuzz_cache(Rng& rng, const std::function<bool()>& more) {
   }
 }
 
-void fuzz_lpe(Rng& rng, const std::function<bool()>& more) {
+void fuzz_lpe(FuzzRng& rng, const std::function<bool()>& more) {
   const std::vector<Bytes> corpus = {"L.*E", "LDE", "L.*DDE", "LD{1,2}E", "LS+DE", "L[^D]*E", "L(D|S){0,3}E",
                                      "L[DS]?T*E", "LD{2,}E", "(L)(D)(E)"};
   const std::string alphabet = "LDSGTE.*+?{},0123456789[]^|()x ";
@@ -207,7 +207,7 @@ void fuzz_lpe(Rng& rng, const std::function<bool()>& more) {
   }
 }
 
-void fuzz_sidecar(Rng& rng, const std::function<bool()>& more) {
+void fuzz_sidecar(FuzzRng& rng, const std::function<bool()>& more) {
   // A one-frame job on tiny images; its record is then mutated before each run.
   const fs::path root = g_work / "job";
   fs::create_directories(root / "exemplar");
@@ -240,7 +240,7 @@ void fuzz_sidecar(Rng& rng, const std::function<bool()>& more) {
   }
 }
 
-void fuzz_options(Rng& rng, const std::function<bool()>& more) {
+void fuzz_options(FuzzRng& rng, const std::function<bool()>& more) {
   const std::vector<std::string> words = {
       "--frames", "1-24", "1-10,15", "--out", "--exemplar", "--guides", "--weights", "FULL=1,LDE=2", "LDE=",
       "=3", "--temporal", "0.5", "nan", "1e40", "--patch-size", "4", "--seed", "-1", "18446744073709551616",
@@ -295,13 +295,13 @@ int main(int argc, char** argv) {
   const bool own_work = g_work.empty();
   if (own_work) g_work = fs::temp_directory_path() / concat("tempera-fuzz-", getpid());
   fs::create_directories(g_work);
-  const std::vector<std::pair<const char*, void (*)(Rng&, const std::function<bool()>&)>> targets = {
+  const std::vector<std::pair<const char*, void (*)(FuzzRng&, const std::function<bool()>&)>> targets = {
       {"image", fuzz_images}, {"cache", fuzz_cache}, {"lpe", fuzz_lpe}, {"sidecar", fuzz_sidecar},
       {"options", fuzz_options}};
   const double each = only.empty() ? seconds / double(targets.size()) : seconds;
   for (const auto& [name, fn] : targets) {
     if (!only.empty() && only != name) continue;
-    Rng rng(seed);
+    FuzzRng rng(seed);
     long runs = 0;
     const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(each);
     fn(rng, [&] { return ++runs, std::chrono::steady_clock::now() < end; });

@@ -26,7 +26,7 @@ import numpy as np
 from .. import guide_cache, guides, read_image
 from ..frames import MAX_FRAME, check_frame
 from ..lpe import check_lpe, trace_lpe
-from ..stylit_guides import tonemap
+from ..stylize import tonemap
 from .scene_export import SceneExportError, evaluated_depsgraph, export_scene
 
 
