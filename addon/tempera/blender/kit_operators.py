@@ -88,7 +88,7 @@ class TEMPERA_OT_painting_template(Operator):
     def execute(self, context):
         from .. import guide_cache
         from ..painting_template import make_template, write_kit_json, write_pdf
-        from ..stylit_guides import tonemap
+        from ..stylize import tonemap
         from .stylize_operator import exemplar_paths
 
         settings = context.scene.tempera
