@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
@@ -46,6 +47,9 @@ const char* kRenderGuidesHelp =
     "  --blender PATH          Blender to run (default: $TEMPERA_BLENDER or 'blender')\n"
     "  --addon-path DIR        folder holding the tempera package\n"
     "                          (default: $TEMPERA_ADDON_PATH or this build's addon folder)\n";
+
+volatile std::sig_atomic_t g_interrupted = 0;
+void on_sigint(int) { g_interrupted = 1; }
 
 std::string env_or(const char* name, const std::string& fallback) {
   const char* value = std::getenv(name);
@@ -90,6 +94,7 @@ int render_guides_in_blender(const BlenderSetup& setup, const std::string& scene
       std::cerr << "tempera: cannot run '" << setup.blender << "' (install Blender or pass --blender PATH)\n";
       return 1;
     default:
+      if (g_interrupted) return 130;  // Ctrl-C: Blender's own exit status says nothing more
       std::cerr << "tempera: Blender ('" << setup.blender << "') exited with status " << status
                 << " while rendering the guides of '" << scene << "'"
                 << (status > 128 ? " (killed by a signal)" : "") << "\n";
@@ -122,7 +127,18 @@ int run_render_guides(const Args& args) {
   if (!fs::is_regular_file(scene, ec)) throw FileNotFoundError(concat("scene file not found: '", scene, "'"));
   if (!has_frames) throw ValueError("--frames is required (e.g. --frames 1-24)");
   if (!has_out) throw ValueError("--out is required (the guide cache folder)");
-  return render_guides_in_blender(setup, scene, forwarded);
+  // Ctrl-C reaches Blender too (same process group); this process waits for
+  // it to stop and says what is kept, instead of dying silently first.
+  struct sigaction action {};
+  action.sa_handler = on_sigint;
+  sigaction(SIGINT, &action, nullptr);
+  const int status = render_guides_in_blender(setup, scene, forwarded);
+  if (g_interrupted) {
+    std::cerr << "tempera render-guides: interrupted; the frames finished so far are in the cache "
+                 "(rerun the same command to render the rest)\n";
+    return 130;
+  }
+  return status;
 }
 
 std::vector<int> parse_frames(const std::string& text) {

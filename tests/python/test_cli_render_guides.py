@@ -119,3 +119,35 @@ def test_bad_values_exit_2_before_rendering_and_leave_nothing(cli_path, user_ble
 def test_frames_beyond_blenders_last_frame_exit_2(cli_path, user_blend, tmp_path):
     result = render_guides(cli_path, user_blend, "--frames", "1-99999999999", "--out", tmp_path / "g")
     assert result.returncode == 2 and "outside 0-1048574" in result.stderr, result.stderr[-1500:]
+
+
+def test_ctrl_c_keeps_the_finished_frames(cli_path, user_blend, tmp_path):
+    """Issue 18: Ctrl-C at frame 3 of 8 used to leave an empty cache (frames
+    waited in the system's temporary folder for the whole range)."""
+    import signal
+    import tempfile
+    import time
+
+    before = set(Path(tempfile.gettempdir()).glob("tempera-guides-*"))
+    out = tmp_path / "g"
+    process = subprocess.Popen([str(cli_path), "render-guides", str(user_blend), "--frames", "1-8", "--out", str(out),
+                                "--samples", "2", "--ld12e-samples", "2"], start_new_session=True,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               env=dict(os.environ, TEMPERA_BLENDER=BLENDER))
+    deadline = time.monotonic() + 240
+    while time.monotonic() < deadline and not (out / "frame_0002.exr").exists() and process.poll() is None:
+        time.sleep(0.05)
+    os.killpg(process.pid, signal.SIGINT)  # what a terminal's Ctrl-C does
+    _, err = process.communicate(timeout=240)
+    assert process.returncode == 130, err[-2000:]
+    assert "interrupted; the frames finished so far are in the cache" in err
+    manifest = guide_cache.read_manifest(out)
+    kept = sorted(int(f) for f in manifest["frames"])
+    assert kept and kept == list(range(1, len(kept) + 1)) and len(kept) < 8
+    for f in kept:
+        assert guide_cache.is_frame_current(out, manifest, f, manifest["frames"][str(f)]["key"])
+    assert set(Path(tempfile.gettempdir()).glob("tempera-guides-*")) == before
+    again = render_guides(cli_path, user_blend, "--frames", "1-8", "--out", out, "--samples", "2",
+                          "--ld12e-samples", "2")
+    assert again.returncode == 0 and f"{len(kept)} already current" in again.stdout, again.stdout[-1500:]
+    assert not list(out.glob(".tempera-render-*"))
