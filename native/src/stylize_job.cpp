@@ -253,6 +253,22 @@ void write_report(const std::string& path, const std::string& settings, const st
   }
 }
 
+// Temporary files (".<name>.tmp<pid>-<random>...") of writers killed with -9.
+// A live writer holds one for the seconds an image takes to write, so one
+// older than an hour is dead; it is never read, only removed here.
+void remove_stale_temporaries(const std::string& folder) {
+  std::error_code ec;
+  const auto now = fs::file_time_type::clock::now();
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() < 2 || name[0] != '.' || name.find(".tmp") == std::string::npos) continue;
+    std::error_code stat_ec;
+    const auto written = fs::last_write_time(it->path(), stat_ec);
+    if (!stat_ec && now - written > std::chrono::hours(1) && fs::is_regular_file(it->path(), stat_ec))
+      fs::remove(it->path(), stat_ec);
+  }
+}
+
 void validate_config(const StylizeJobConfig& c) {
   if (c.format != "png" && c.format != "exr")
     throw ValueError(concat("unknown output format '", c.format, "' (choose png or exr)"));
@@ -346,6 +362,7 @@ StylizeJob::StylizeJob(StylizeJobConfig config) : config_(std::move(config)) {
   fs::create_directories(config_.out, ec);
   if (!fs::is_directory(config_.out, ec))
     throw IoError(concat("cannot create the output folder '", config_.out, "'", ec ? ": " + ec.message() : ""));
+  remove_stale_temporaries(config_.out);
   settings_ = settings_text(config_);
   const std::string base = hash_hex(settings_ + "\n" + file_stamp(config_.style) + "\n" + file_stamp(exemplar_path_));
   // The predecessor's result is deliberately not part of a frame's key: frames

@@ -72,3 +72,20 @@ def test_sigkill_leaves_complete_frames_and_the_rerun_matches(cli_path, shot, tm
         np.testing.assert_array_equal(image, reference[f], err_msg=f"frame {f} after a kill {moment}")
     visible = [x.name for x in (tmp_path / "frames").iterdir() if not x.name.startswith(".")]
     assert sorted(visible) == sorted([f"frame_{f:04d}.png" for f in FRAMES] + ["tempera_stylize.json"])
+
+
+def test_temporaries_of_killed_writers_are_removed_once_stale(cli_path, shot, tmp_path):
+    """A kill -9 while a frame is written leaves its hidden temporary file;
+    the next run removes it once it is over an hour old (a live writer's is
+    seconds old)."""
+    p, reference, _ = shot
+    frames = tmp_path / "frames"
+    frames.mkdir()
+    stale, fresh = frames / ".frame_0003.tmp77-0123456789abcdef.png", frames / ".frame_0004.tmp78-fedcba9876543210.png"
+    for path in (stale, fresh):
+        path.write_bytes(b"half a png")
+    old = time.time() - 2 * 3600
+    os.utime(stale, (old, old))
+    done = subprocess.run(stylize(cli_path, p, tmp_path), capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert not stale.exists() and fresh.exists()
