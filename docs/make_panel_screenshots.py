@@ -22,7 +22,9 @@ ROOT = HERE.parent
 IMAGES = HERE / "images"
 # (file, width of the Properties area, what is set up first)
 SHOTS = (("panel_top.png", "top"), ("panel_custom_exemplar.png", "custom"), ("panel_guides.png", "guides"))
-WINDOW = (620, 1900)  # a Properties editor about as wide as Blender's default one
+# Blender's default layout on a tall screen: its Properties editor keeps the
+# default width (333 px, as at 1920x1080) and is tall enough for the panel.
+WINDOW = (1920, 2300)
 
 
 # --------------------------------------------------------------------------- outside Blender
@@ -120,8 +122,7 @@ def in_blender(argv):
 
     window = bpy.context.window_manager.windows[0]
     screen = window.screen
-    area = max(screen.areas, key=lambda a: a.width * a.height)
-    area.type = "PROPERTIES"  # its space exists once the window has drawn: the tab is set in the timer
+    area = next(a for a in screen.areas if a.type == "PROPERTIES")  # the default layout's, at its default width
 
     steps = list(SHOTS)
 
@@ -142,7 +143,7 @@ def in_blender(argv):
             bpy.ops.wm.quit_blender()
             return None
         if not getattr(shoot, "started", False):  # a click beside the splash screen closes it
-            subprocess.run(["xdotool", "mousemove", "5", str(WINDOW[1] - 5), "click", "1"], check=False)
+            subprocess.run(["xdotool", "mousemove", "300", str(WINDOW[1] - 5), "click", "1"], check=False)
             shoot.started = True
             return 1.0
         name, kind = steps[0]
@@ -158,10 +159,11 @@ def in_blender(argv):
                     bpy.ops.view2d.scroll_up(deltay=4000)
             area.tag_redraw()
             shoot.pending = name
-            return 1.5
+            return 1.5 if getattr(shoot, "shots", 0) else 6.0  # the first waits for the thumbnail to load
         with bpy.context.temp_override(window=window, area=area):
             bpy.ops.screen.screenshot_area(filepath=str(out / name))
         print(f"screenshot: {out / name}", flush=True)
+        shoot.shots = getattr(shoot, "shots", 0) + 1
         steps.pop(0)
         return 0.5
 

@@ -16,6 +16,30 @@ from .results import is_result_scene
 from .stylize_operator import TEMPERA_OT_stylize, exemplar_paths
 
 THUMBNAIL_SCALE = 6.0
+# Labels shortened in the panel to fit its default width (the tooltip keeps the full name).
+SHORT_LABELS = {"weight_ld12e": "Two Diffuse Bounces"}
+LABEL_FACTOR = 0.5  # share of a wide-label row given to its label
+STATUS_WIDTH = 38  # characters per status line at the default Properties width
+
+
+def wide_prop(layout, data, name, text=None):
+    """A two-column row whose label column is wider than property split's
+    40 %, for labels that would be cut at the default Properties width."""
+    row = layout.split(factor=LABEL_FACTOR, align=True)
+    label = row.column()
+    label.alignment = "RIGHT"
+    label.label(text=text if text is not None else data.bl_rna.properties[name].name)
+    row.prop(data, name, text="")
+
+
+def status_lines(layout, text, icon):
+    """A long status or error text on as many lines as it takes (a label
+    is cut at the editor's edge, not wrapped)."""
+    import textwrap
+
+    col = layout.column(align=True)
+    for i, line in enumerate(textwrap.wrap(text, STATUS_WIDTH) or [""]):
+        col.label(text=line, icon=icon if i == 0 else "BLANK1")
 
 
 class TEMPERA_PT_output(Panel):
@@ -102,7 +126,7 @@ def draw_light_paths(box, settings):
     box.label(text="Light Path Guides", icon="LIGHT")
     col = box.column(align=True)
     for prop in WEIGHT_PROPERTIES.values():
-        col.prop(settings, prop)
+        wide_prop(col, settings, prop, SHORT_LABELS.get(prop))
 
 
 def draw_synthesis(box, settings):
@@ -110,7 +134,7 @@ def draw_synthesis(box, settings):
     col = box.column()
     col.prop(settings, "quality")
     col.prop(settings, "usage")
-    col.prop(settings, "temporal_weight")
+    wide_prop(col, settings, "temporal_weight")
     col.prop(settings, "patch_size")
     col.prop(settings, "seed")
 
@@ -138,11 +162,11 @@ def draw_guides(box, scene, settings):
     col.prop(settings, "guide_line_d_max")
     col.prop(settings, "guide_masks")
     col.prop(settings, "guide_orientation_aov")
-    col.prop(settings, "guide_lpe")
+    wide_prop(col, settings, "guide_lpe")
     if settings.guide_lpe.strip():
         col.prop(settings, "guide_lpe_samples")
     try:
         text, icon = cache_status(scene)
     except Exception as exc:  # a status line must never break the panel
         text, icon = f"Guide cache status unavailable: {exc}", "ERROR"
-    box.label(text=text, icon=icon)
+    status_lines(box, text, icon)
