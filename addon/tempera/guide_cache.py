@@ -156,14 +156,16 @@ def _manifest_problem(manifest):
     return None
 
 
-def read_manifest(cache_dir, on_warning=None):
+def read_manifest(cache_dir, on_warning=None, set_aside=True):
     """The manifest dict, or None if the folder has none (or one of another
     format version, which a rerun then overwrites).
 
     A damaged manifest (not JSON, not UTF-8, the wrong structure) is renamed
     aside to manifest.json.corrupt-<random> and None is returned, so that the
     frames are rendered again instead of the run being blocked; the warning
-    naming both files goes to `on_warning(text)` (default: warnings.warn)."""
+    naming both files goes to `on_warning(text)` (default: warnings.warn).
+    set_aside=False only returns None (for readers such as a panel's status
+    line, which must not move files)."""
     path = Path(cache_dir) / MANIFEST_NAME
     try:
         with open(path, encoding="utf-8") as f:
@@ -175,6 +177,8 @@ def read_manifest(cache_dir, on_warning=None):
         problem = f"it is not valid JSON ({exc})"
     if problem is None:
         return manifest if manifest.get("format") == FORMAT_VERSION else None
+    if not set_aside:
+        return None
     aside = path.with_name(f"{MANIFEST_NAME}.corrupt-{secrets.token_hex(4)}")
     try:
         os.replace(path, aside)

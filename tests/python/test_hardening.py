@@ -551,3 +551,9 @@ def test_two_cli_runs_into_one_folder_are_safe(cli_path, caches):
         assert tempera.read_image(str(caches / "shared" / "frames" / f"frame_{f:04d}.png")).shape == (H, W, 3)
     again = subprocess.run(command, capture_output=True, text=True, timeout=300)
     assert "0 frame(s) stylized, 6 skipped" in again.stdout, again.stdout
+
+
+def test_a_status_reader_leaves_a_damaged_manifest_in_place(tmp_path):
+    (tmp_path / "manifest.json").write_text("{ broken")
+    assert guide_cache.read_manifest(tmp_path, set_aside=False) is None
+    assert (tmp_path / "manifest.json").read_text() == "{ broken"

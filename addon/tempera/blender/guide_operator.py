@@ -220,7 +220,7 @@ class GuideJob:
 
 @functools.lru_cache(maxsize=16)
 def _current_frames(folder, manifest_mtime_ns, params_json, fingerprint_json, frames):
-    manifest = guide_cache.read_manifest(folder)
+    manifest = guide_cache.read_manifest(folder, set_aside=False)  # draw() moves no files
     if not manifest:
         return 0
     params = json.loads(params_json)

@@ -182,7 +182,7 @@ class StylizeRun:
         """A rough duration of the whole run from scratch (guides and stylizing)."""
         r = scene.render
         mpix = r.resolution_x * r.resolution_y * (r.resolution_percentage / 100.0) ** 2 / 1e6
-        per_frame = mpix * STYLIZE_SECONDS_PER_MPIX[self.config["quality"]]
+        per_frame = mpix * STYLIZE_SECONDS_PER_MPIX.get(self.config["quality"], STYLIZE_SECONDS_PER_MPIX["final"])
         return estimate_guide_seconds(scene, self.guides.params, len(self.frames)) + per_frame * len(self.frames)
 
     def mean_flicker(self):
