@@ -44,21 +44,20 @@ def test_interrupted_render_keeps_each_finished_frame(scene, tmp_path):
 
     def progress(done, total, message):
         messages.append(message)
-        if message == f"guides of frame {FRAMES[1]} written":
-            raise KeyboardInterrupt  # Ctrl-C after the second frame of three
+        if message == f"rendering frame {FRAMES[2]}":
+            raise KeyboardInterrupt  # Ctrl-C as the third frame of three starts rendering
 
     with pytest.raises(KeyboardInterrupt):
         render_guides(scene, FRAMES, cache, params(), progress)
     manifest = guide_cache.read_manifest(cache)
-    assert sorted(manifest["frames"]) == [str(f) for f in FRAMES[:2]]
-    for f in FRAMES[:2]:
-        assert guide_cache.is_frame_current(cache, manifest, f, manifest["frames"][str(f)]["key"])
-    assert not guide_cache.frame_path(cache, FRAMES[2]).exists()
-    assert sorted(p.name for p in cache.iterdir()) == ["frame_0002.exr", "frame_0003.exr", "manifest.json"]
+    # The first frame was finished (its successor rendered) before the interruption: it is in the cache.
+    assert sorted(manifest["frames"]) == [str(FRAMES[0])]
+    assert guide_cache.is_frame_current(cache, manifest, FRAMES[0], manifest["frames"][str(FRAMES[0])]["key"])
+    assert sorted(p.name for p in cache.iterdir()) == ["frame_0002.exr", "manifest.json"]
     assert temp_leftovers() == before
-    # The rerun renders only the last frame, and the same guides as an uninterrupted run.
+    # The rerun renders only the others, and the same guides as an uninterrupted run.
     report = render_guides(scene, FRAMES, cache, params())
-    assert report["rendered"] == [FRAMES[2]] and report["skipped"] == list(FRAMES[:2])
+    assert report["rendered"] == list(FRAMES[1:]) and report["skipped"] == [FRAMES[0]]
     whole = render_guides(scene, FRAMES, tmp_path / "whole", params())
     assert whole["rendered"] == list(FRAMES)
     import numpy as np
