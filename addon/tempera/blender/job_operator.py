@@ -153,6 +153,7 @@ class JobOperator:
         return {"RUNNING_MODAL"}
 
     def _begin(self, context, job):
+        self._over = False
         self._job_state = job
         self._worker, self._future, self._fraction, self._stop = None, None, 0.0, False
         wm = context.window_manager
@@ -163,6 +164,10 @@ class JobOperator:
         self._show(context, job)
 
     def modal(self, context, event):
+        if getattr(self, "_over", False):
+            # A copy of this handler (Blender copies a window's handlers into
+            # a window opened meanwhile) must not step a finished job again.
+            return {"FINISHED"}
         job = self._job_state
         if event.type == "ESC" and event.value == "PRESS":
             self._stop = True
@@ -236,6 +241,7 @@ class JobOperator:
         _redraw_properties(context)
 
     def _finish(self, context):
+        self._over = True
         wm = context.window_manager
         if getattr(self, "_timer", None) is not None:
             wm.event_timer_remove(self._timer)

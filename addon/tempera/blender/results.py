@@ -120,8 +120,11 @@ def show(context, loaded, how, interactive=None):
                 area.tag_redraw()
                 return f"'{loaded.name}' shown in the Image Editor"
         if interactive and isinstance(context.window, bpy.types.Window):
-            if _open_image_window(context, loaded):
-                return f"'{loaded.name}' shown in a new Image Editor window"
+            # Opened once the operator has returned: a window opened from a
+            # modal handler would get a copy of that handler.
+            window, name = context.window, loaded.name
+            bpy.app.timers.register(lambda: _open_image_window(window, name), first_interval=0.05)
+            return f"'{loaded.name}' shown in a new Image Editor window"
         return f"the result is the image '{loaded.name}' (open it in an Image Editor)"
     if how == "SEQUENCER":
         windows = _windows(context)
@@ -138,17 +141,23 @@ def show(context, loaded, how, interactive=None):
     return ""
 
 
-def _open_image_window(context, image):
-    """A new window whose only area is an Image Editor showing `image`."""
-    before = set(context.window_manager.windows[:])
+def _open_image_window(window, image_name):
+    """A new window (a copy of `window`) whose largest area becomes an Image
+    Editor showing the image; run from a timer. Returns None (timer done)."""
+    wm = bpy.context.window_manager
+    image = bpy.data.images.get(image_name)
+    if image is None or window not in wm.windows[:]:
+        return None
+    before = set(wm.windows[:])
     try:
-        bpy.ops.wm.window_new()
-    except RuntimeError:
-        return False
-    new = [w for w in context.window_manager.windows if w not in before]
-    if not new:
-        return False
-    area = new[0].screen.areas[0]
-    area.type = "IMAGE_EDITOR"
-    area.spaces.active.image = image
-    return True
+        area = max(window.screen.areas, key=lambda a: a.width * a.height)
+        with bpy.context.temp_override(window=window, area=area):
+            bpy.ops.wm.window_new()
+    except (RuntimeError, TypeError):
+        return None
+    new = [w for w in wm.windows if w not in before]
+    if new:
+        target = max(new[0].screen.areas, key=lambda a: a.width * a.height)
+        target.type = "IMAGE_EDITOR"
+        target.spaces.active.image = image
+    return None
