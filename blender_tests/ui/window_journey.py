@@ -5,7 +5,8 @@ them (modal, a worker thread, timers), not through execute().
 Stylize Frame, then Stylize Animation, then a long Stylize Animation that
 must ask first. Checked: the frame is shown in an Image Editor window, the
 animation switches the window to the result scene (Standard view), no job
-steps after it finished, the long run waits for its confirmation. Prints
+steps after it finished, the long run waits for its confirmation, starts on
+OK (Return) and stops on Esc. Prints
 "WINDOW_JOURNEY OK" or "WINDOW_JOURNEY FAIL: ..." and quits."""
 import sys
 import time
@@ -107,6 +108,24 @@ def tick():
             return 0.25
         if running_job():
             return fail("the 80-frame run started without confirmation")
+        import subprocess
+
+        subprocess.run(["xdotool", "mousemove", "300", "1050", "sleep", "0.3", "click", "1"], check=False)  # OK
+        state["phase"], state["wait"] = "confirmed", time.monotonic() + 20
+    elif phase == "confirmed":
+        if not running_job():
+            if time.monotonic() < state["wait"]:
+                return 0.25
+            bpy.ops.screen.screenshot(filepath=str(out / "no_start.png"))
+            return fail("OK did not start the long run")
+        import subprocess
+
+        subprocess.run(["xdotool", "mousemove", "900", "500", "search", "--name", "Blender", "windowfocus", "--sync", "%1",
+                        "key", "--window", "%1", "Escape"], check=False)
+        state["phase"], state["wait"] = "stopped", time.monotonic() + 60
+    elif phase == "stopped":
+        if running_job():
+            return 0.25 if time.monotonic() < state["wait"] else fail("Esc did not stop the long run")
         if steps_after_finish:
             return fail(f"finished jobs were stepped again: {steps_after_finish}")
         print("WINDOW_JOURNEY OK", flush=True)
