@@ -35,7 +35,7 @@ def check_repaired(wheel):
     """Names of the vendored libraries; exits if one expected is missing."""
     with zipfile.ZipFile(wheel) as zf:
         names = zf.namelist()
-    libs = sorted(Path(n).name for n in names if n.startswith("tempera_native.libs/"))
+    libs = sorted(Path(n).name for n in names if n.startswith("tempera_native.libs/") and not n.endswith("/"))
     missing = [v for v in VENDORED if not any(lib.startswith(v + "-") for lib in libs)]
     if missing:
         sys.exit(f"build_wheel: {wheel.name} does not vendor {missing} (has {libs})")
