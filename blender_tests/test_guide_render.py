@@ -19,7 +19,8 @@ def rna_dump(struct, prefix, out, depth=0):
     nested structs too (IDs by name); collections and the depsgraph are skipped."""
     for prop in struct.bl_rna.properties:
         name = prop.identifier
-        if name in ("rna_type", "depsgraph") or prop.type == "COLLECTION":
+        # dimensions: derived from the evaluated geometry, which 4.x/5.0 evaluate lazily.
+        if name in ("rna_type", "depsgraph", "dimensions") or prop.type == "COLLECTION":
             continue
         value = getattr(struct, name, None)
         key = f"{prefix}.{name}"
@@ -52,7 +53,6 @@ def rendered(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("guide_render")
     scene = _build_scene()
     scene.frame_set(1)
-    scene.view_layers[0].update()  # 5.0 evaluates lazily: object dimensions come from the evaluated mesh
     before = scene_dump(scene)
     window_scene = bpy.context.window.scene.name
     blend = tmp / "scene.blend"

@@ -28,6 +28,13 @@ SIZE = (96, 72)
 SAMPLES = 64  # Cycles and tracer alike
 MEAN_TOLERANCE = 0.05
 BLOCK_TOLERANCE = 0.15
+# Cycles 4.0 changed its lights (point and spot lights became spheres, spot
+# lights lost the cosine weighting to their axis, area lights are sampled and
+# normalised anew); the tracer follows Cycles 3.x. Measured in 4.5 and 5.0:
+# metal scene LDE mean error 0.21, AREA floor 0.061, SPOT within tolerance.
+CYCLES_4_LIGHTS = bpy.app.version >= (4, 0, 0)
+_CYCLES_4_XFAIL = pytest.mark.xfail(CYCLES_4_LIGHTS, strict=True,
+                                    reason="the tracer models Cycles 3.x lights, not 4.0's (docs/lpe_guides.md)")
 COMPARED = {"LDE": "LDE", "LSE": "LSE", "LDDE": "L.*DDE"}  # Cycles guide -> tracer expression
 NOTHING = "L[^LDST]E"  # a well-formed expression no path can match
 
@@ -98,7 +105,7 @@ def traced(guides, expression):
 
 # --------------------------------------------------------------------------- tracer against Cycles
 
-@pytest.mark.parametrize("guide", ["LDE", "LSE"])
+@pytest.mark.parametrize("guide", [pytest.param("LDE", marks=_CYCLES_4_XFAIL), "LSE"])
 def test_direct_light_matches_cycles(metal, guide):
     guides = metal["guides"]
     mean_error, block_error = compare(traced(guides, COMPARED[guide]), guides[guide], guides["alpha"])
@@ -156,9 +163,10 @@ def test_alpha_matches_cycles_for_other_cameras(kind, size, fit, shift, tmp_path
     assert 0.1 < cycles.mean() < 0.95 and iou >= 0.99
 
 
-@pytest.mark.parametrize("light", ["POINT", "SUN", "AREA",
+@pytest.mark.parametrize("light", ["POINT", "SUN", pytest.param("AREA", marks=_CYCLES_4_XFAIL),
                                    pytest.param("SPOT", marks=pytest.mark.xfail(
-                                       strict=True, reason="Cycles 3.4 also weights spot lights by the cosine "
+                                       not CYCLES_4_LIGHTS, strict=True,
+                                       reason="Cycles 3.x also weights spot lights by the cosine "
                                        "to their axis; the tracer does not (docs/lpe_guides.md)"))])
 def test_light_power_matches_cycles(light, tmp_path):
     """A diffuse floor under each light type: the unit conversions of scene_units."""
@@ -280,6 +288,9 @@ def test_render_guides_writes_the_lpe_channels(metal):
     assert metal["report"]["warnings"] == []  # everything in this scene is modelled
 
 
+@pytest.mark.xfail(bpy.app.version >= (5, 0, 0), strict=True,
+                   reason="5.0 renders every material through its nodes (a default, partly glossy Principled "
+                   "BSDF for the scene's plain materials): block error 0.041 against the 0.03 of this test")
 def test_animated_frames_are_traced_at_their_frame(tmp_path):
     """The moving cube of guide_scene.py: each frame's L.*E against Cycles'
     FULL of the same frame (no glossy surfaces, so they hold the same paths)."""

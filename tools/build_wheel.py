@@ -12,7 +12,8 @@
    rewrites the module's and the CLI's needs and RPATH to them; the wheel gets
    a manylinux tag.
 3. Checks the result: no needed library outside the wheel except the policy's
-   (libc, libm, libstdc++, ...), prints the wheel's path on the last line.
+   (libc, libm, libstdc++, ...), writes the wheel's path into OUT/wheel.txt
+   and prints it on the last line.
 """
 import argparse
 import os
@@ -69,6 +70,7 @@ def main():
     (repaired,) = out.glob("tempera_native-*manylinux*.whl")
     libs = check_repaired(repaired)
     shutil.rmtree(raw, ignore_errors=True)
+    (out / "wheel.txt").write_text(f"{repaired}\n")  # for make: the extension packs this one
     print(f"vendored {len(libs)} libraries: {', '.join(libs)}")
     print(f"{repaired} ({repaired.stat().st_size // (1024 * 1024)} MiB)")
 
