@@ -202,15 +202,41 @@ def default_tempera():
     return [found] if found else [sys.executable, "-m", "tempera"]
 
 
-# Options of `tempera stylize` that the farm plans with; all others go to every
-# stylize command as they are (and --samples/--blender/--addon-path to render-guides).
-GUIDE_OPTIONS = ("--samples", "--blender", "--addon-path")
+# Options of the farm itself (with a value, and flags); every other option goes
+# to the tasks as it is: --samples, --blender and --addon-path to render-guides,
+# the rest to stylize (all take a value except the flags in PASS_FLAGS).
+FARM_OPTIONS = {"--exemplar", "--exemplar-guides", "--exemplar-scene", "--exemplar-frame", "--guides", "--frames",
+                "--out", "--temporal", "--chunk-size", "--scheduler", "--workers", "--retries", "--tempera"}
+FARM_FLAGS = {"--no-video", "--dry-run", "-h", "--help"}
+GUIDE_OPTIONS = {"--samples", "--blender", "--addon-path"}
+PASS_FLAGS = {"--no-resume"}
+
+
+def _split_argv(argv):
+    """(the farm's own arguments, render-guides options, stylize options)."""
+    own, guide_args, stylize_args = [], [], []
+    i = 0
+    while i < len(argv):
+        word = argv[i]
+        key = word.split("=", 1)[0]
+        takes_value = "=" not in word and key not in FARM_FLAGS and key not in PASS_FLAGS and i + 1 < len(argv)
+        group = own if (key in FARM_OPTIONS or key in FARM_FLAGS or not word.startswith("-")) else (
+            guide_args if key in GUIDE_OPTIONS else stylize_args)
+        if word.startswith("-") and takes_value:
+            group.extend(argv[i:i + 2])
+            i += 2
+        else:
+            group.append(word)
+            i += 1
+    return own, guide_args, stylize_args
 
 
 def parse_args(argv):
+    own, guide_args, stylize_args = _split_argv(list(argv))
     parser = argparse.ArgumentParser(
         prog="tempera farm", description="Stylize a shot on a Dask cluster (see tempera.farm). Options "
-        "not listed here are passed to every `tempera stylize` task.")
+        "not listed here are passed to the tasks: --samples, --blender and --addon-path to render-guides, "
+        "all others to stylize.")
     parser.add_argument("scene", nargs="?", help="the shot's .blend (its guides are rendered); "
                         "or give --guides")
     parser.add_argument("--exemplar", required=True)
@@ -228,16 +254,7 @@ def parse_args(argv):
     parser.add_argument("--retries", type=int, default=2, help="reruns of a task whose worker died")
     parser.add_argument("--tempera", help="the command workers run (default: tempera on PATH)")
     parser.add_argument("--dry-run", action="store_true", help="print the tasks, run nothing")
-    args, rest = parser.parse_known_args(argv)
-    guide_args, stylize_args = [], []
-    i = 0
-    while i < len(rest):
-        option = rest[i]
-        key = option.split("=", 1)[0]
-        value = [] if "=" in option or i + 1 >= len(rest) or rest[i + 1].startswith("--") else [rest[i + 1]]
-        (guide_args if key in GUIDE_OPTIONS else stylize_args).extend([option, *value])
-        i += 1 + len(value)
-    return args, guide_args, stylize_args
+    return parser.parse_args(own), guide_args, stylize_args
 
 
 def main(argv=None):
