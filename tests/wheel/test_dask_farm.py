@@ -1,10 +1,12 @@
 """tempera farm on Dask (tempera.farm), through the pip-installed `tempera`
-command: a local-cluster run equals a single-process run frame for frame, and
-killing a worker mid-shot loses no finished frame; a rerun completes the shot."""
+command: a local-cluster run equals a single-process run frame for frame,
+killing a worker mid-shot loses no finished frame and a rerun completes the
+shot, and the scene form renders its guides in chunks with Blender."""
 import os
-import signal
+import shutil
 import subprocess
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -111,3 +113,40 @@ def test_killing_a_worker_mid_shot_loses_no_finished_frame(installed, tmp_path):
     assert single.returncode == 0, single.stderr
     for name, image in frames_of(tmp_path / "single").items():
         np.testing.assert_array_equal(done[name], image, err_msg=name)
+
+
+@pytest.mark.skipif(shutil.which("blender") is None, reason="Blender not installed")
+def test_farm_renders_guides_from_a_blend_in_chunks(installed, tmp_path):
+    """The scene form: exemplar and guide chunks rendered by background Blender
+    through the wheel's CLI, then the stylize chunks; the frames equal a
+    single-process stylize of the same guide caches."""
+    import tempera
+
+    root = Path(__file__).resolve().parents[2]
+    blend = tmp_path / "shot.blend"
+    code = (f"import sys, bpy; sys.path.insert(0, {str(root / 'scenes')!r}); import demo_scene; "
+            "scene = bpy.context.scene; demo_scene.build_scene(scene); "
+            "scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = 64, 48, 50; "
+            f"bpy.ops.wm.save_as_mainfile(filepath={str(blend)!r})")
+    made = subprocess.run(["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python-expr", code],
+                          capture_output=True, text=True, timeout=120)
+    assert made.returncode == 0, made.stderr[-2000:]
+    painting = tmp_path / "paint.png"
+    tempera.write_image(str(painting), np.random.default_rng(1).random((24, 32, 3), dtype=np.float32))
+    out = tmp_path / "farm"
+    farmed = tempera_cmd(installed, "farm", blend, "--exemplar", painting, "--exemplar-scene", blend,
+                         "--frames", "1-4", "--chunk-size", "2", "--out", out, "--samples", "2", "--no-video",
+                         "--threads", "1", "--tempera", installed / "bin" / "tempera")
+    assert farmed.returncode == 0, farmed.stdout[-2000:] + farmed.stderr[-2000:]
+    done = [line.split(" done")[0] for line in farmed.stdout.splitlines() if line.endswith(" s)")]
+    assert sorted(done) == sorted(["farm: exemplar-guides", "farm: guides 1-2", "farm: guides 3-4",
+                                   "farm: stylize 1-2", "farm: stylize 3-4", "farm: finish"]), farmed.stdout
+    assert sorted(p.name for p in (out / "guides").glob("frame_*.exr")) == [f"frame_{f:04d}.exr" for f in range(1, 5)]
+    single = tempera_cmd(installed, "stylize", "--guides", out / "guides", "--exemplar", painting,
+                         "--exemplar-guides", out / "exemplar_guides", "--frames", "1-4", "--out", tmp_path / "one",
+                         "--no-video", "--threads", "1")
+    assert single.returncode == 0, single.stderr
+    ours, theirs = frames_of(tmp_path / "one"), frames_of(out)
+    assert sorted(theirs) == [f"frame_{f:04d}.png" for f in range(1, 5)] == sorted(ours)
+    for name in ours:
+        np.testing.assert_array_equal(theirs[name], ours[name], err_msg=name)
