@@ -59,6 +59,7 @@ def main():
             os.environ["TEMPERA_TEST_INSTALL"] = "legacy"
         else:
             installed = blender_env.install_extension(args.extension_zip)
+            os.environ["TEMPERA_TEST_EXTENSION_ZIP"] = str(Path(args.extension_zip).resolve())
             os.environ["TEMPERA_TEST_ADDON_MODULE"] = blender_env.extension_module()
             os.environ["TEMPERA_TEST_INSTALL"] = "extension"
         # The tests check that they see this copy of the add-on.

@@ -1,6 +1,7 @@
-"""The README's demo through the installed extension (Blender 4.2+): the
-demo scene of scenes/demo_scene.py, the bundled kit, Stylize Animation; a
-shorter shot than `make demo` (3 frames, fewer samples) to keep CI lean."""
+"""The extension in Blender 4.2+: Blender's validator accepts the zip, and
+the README's demo runs through it (the demo scene of scenes/demo_scene.py,
+the bundled kit, Stylize Animation; a shorter shot than `make demo`: 3
+frames, fewer samples, preview quality, to keep CI lean)."""
 import os
 import sys
 from pathlib import Path
@@ -71,3 +72,14 @@ def test_the_kit_comes_from_the_extension_folder():
     style, guides = kit.kit_exemplar()
     installed = Path(os.environ["TEMPERA_TEST_SCRIPTS_DIR"])
     assert installed in style.parents and (guides / "manifest.json").is_file()
+
+
+def test_blenders_own_validator_accepts_the_zip():
+    """bl_pkg's `blender_ext.py validate`, what `blender --command extension validate` runs."""
+    import subprocess
+
+    tool = Path(bpy.utils.system_resource("SCRIPTS")) / "addons_core" / "bl_pkg" / "cli" / "blender_ext.py"
+    assert tool.is_file(), tool
+    result = subprocess.run([sys.executable, str(tool), "validate", os.environ["TEMPERA_TEST_EXTENSION_ZIP"]],
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0 and "Success" in result.stdout, result.stdout + result.stderr
