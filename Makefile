@@ -1,6 +1,6 @@
 # Tempera: one entry point for humans and CI.
 #   make demo    install deps, build, stylize the bundled demo scene in background Blender
-#   make test    install deps, build, run C++, Python, in-Blender (3.4, 4.5, 5.0), wheel/farm
+#   make test    install deps, build, run C++, Python, in-Blender (3.4, 4.2, 4.5, 5.0), wheel/farm
 #                and Flamenco tests
 # Other targets: deps, build, kit, addon-zip, wheel, extension, bench, bench-tracer, sanitize, clean.
 
@@ -13,6 +13,7 @@ ADDON_ZIP := dist/tempera-addon-$(VERSION).zip
 EXTENSION_ZIP := dist/tempera-$(VERSION)-linux-x64.zip
 # PyPI environments made by tools/setup_venvs.sh (part of `make deps`).
 VENVS    ?= $(HOME)/.cache/tempera
+BPY42    ?= $(VENVS)/venv-bpy42/bin/python
 BPY45    ?= $(VENVS)/venv-bpy45/bin/python
 BPY50    ?= $(VENVS)/venv-bpy50/bin/python
 TOOLS_PY ?= $(VENVS)/venv-tools/bin/python
@@ -65,7 +66,7 @@ extension: build $(EXTENSION_ZIP)
 test: build addon-zip extension
 	$(PYTHON) tools/run_tests.py --build $(BUILD) --addon-zip $(ADDON_ZIP) --blender $(BLENDER) \
 	    --extension-zip $(EXTENSION_ZIP) --wheel "$$(cat $(WHEEL_LIST))" \
-	    --bpy45 $(BPY45) --bpy50 $(BPY50) --tools-python $(TOOLS_PY)
+	    --bpy42 $(BPY42) --bpy45 $(BPY45) --bpy50 $(BPY50) --tools-python $(TOOLS_PY)
 
 demo: build addon-zip
 	$(PYTHON) tools/run_demo.py --addon-zip $(ADDON_ZIP) --blender $(BLENDER) --out $(DEMO_OUT)

@@ -25,7 +25,7 @@ PACKAGES=(
   ffmpeg                # mp4 previews of stylized sequences
   python3-venv          # virtual environments for PyPI's bpy and the wheel/farm tools
   libx11-6 libxi6 libxxf86vm1 libxfixes3 libxrender1 libxkbcommon0 libsm6 \
-  libgl1 libegl1        # X11/GL libraries blender.org's bpy (4.5, 5.0) loads, even headless
+  libgl1 libegl1        # X11/GL libraries blender.org's bpy (4.2, 4.5, 5.0) loads, even headless
   nodejs                # tests of the Flamenco job type (farm/flamenco/tempera.js)
 )
 

