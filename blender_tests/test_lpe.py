@@ -30,7 +30,7 @@ MEAN_TOLERANCE = 0.05
 BLOCK_TOLERANCE = 0.15
 # Cycles 4.0 changed its lights (point and spot lights became spheres, spot
 # lights lost the cosine weighting to their axis, area lights are sampled and
-# normalised anew); the tracer follows Cycles 3.x. Measured in 4.5 and 5.0:
+# normalised anew); the tracer follows Cycles 3.x. Measured in 4.2, 4.5 and 5.0:
 # metal scene LDE mean error 0.21, AREA floor 0.061, SPOT within tolerance.
 CYCLES_4_LIGHTS = bpy.app.version >= (4, 0, 0)
 _CYCLES_4_XFAIL = pytest.mark.xfail(CYCLES_4_LIGHTS, strict=True,

@@ -280,7 +280,7 @@ def _principled(node, owner, out, warnings):
 def _ignored_socket_used(node, name, neutral):
     try:
         socket = compat.principled_socket(node, name)
-    except KeyError:  # not in this Blender's Principled BSDF (4.0 dropped Anisotropic's old form)
+    except KeyError:  # a socket this Blender's Principled BSDF does not have
         return False
     return socket.is_linked or abs(float(socket.default_value) - neutral) > 1e-6
 
