@@ -1,9 +1,12 @@
 #include "tempera/stylize_job.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -193,6 +196,30 @@ std::map<int, ReportEntry> read_report(const std::string& path) {
   }
   return entries;
 }
+
+// Holds an exclusive lock on "<report>.lock" while a process merges its frame
+// into the report, so that jobs sharing an output folder (a render farm's
+// chunks finishing at the same moment) never drop each other's entries.
+class ReportLock {
+ public:
+  explicit ReportLock(const std::string& report) {
+    const std::string path = report + ".lock";
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw IoError(concat("cannot open the job report lock '", path, "'"));
+    while (::flock(fd_, LOCK_EX) != 0) {
+      if (errno != EINTR) {
+        ::close(fd_);
+        throw IoError(concat("cannot lock the job report lock '", path, "'"));
+      }
+    }
+  }
+  ~ReportLock() { ::close(fd_); }  // closing releases the lock
+  ReportLock(const ReportLock&) = delete;
+  ReportLock& operator=(const ReportLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
 
 void write_report(const std::string& path, const std::string& settings, const std::map<int, ReportEntry>& entries) {
   const fs::path target(path);
@@ -384,6 +411,7 @@ FrameResult StylizeJob::run_frame(std::size_t index, const ProgressCallback& pro
                        : flicker(previous.view(), synth.image.view(), temporal.velocity_backward,
                                  temporal.occlusion_backward);
   // Merge into what is on disk: other machines may share this folder.
+  const ReportLock lock(report_path());
   auto entries = read_report(report_path());
   entries[result.frame] = {keys_[index], fs::path(result.path).filename().string(), result.flicker,
                            result.source_coverage};

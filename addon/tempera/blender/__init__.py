@@ -23,7 +23,11 @@ CLASSES = (
 )
 
 
-def register():
+def register(addon_id="tempera"):
+    """`addon_id`: the module name Blender knows the add-on by ('tempera', or
+    'bl_ext.<repository>.tempera' for the extension); the preferences are
+    registered under it."""
+    TemperaPreferences.bl_idname = addon_id
     for operator in (TEMPERA_OT_render_guides, TEMPERA_OT_stylize):
         operator._running = False  # a run cut short by disabling the add-on is over
     registered = []

@@ -3,6 +3,8 @@ import os
 
 import bpy
 
+from . import compat
+
 RESULT_SCENE_SUFFIX = " Tempera"
 
 
@@ -50,7 +52,7 @@ def load_sequencer_scene(scene, paths, frames):
     result.render.resolution_percentage = 100
     bpy.data.images.remove(first)
     editor = result.sequence_editor_create()
-    strip = editor.sequences.new_image("Tempera", paths[0], channel=1, frame_start=frames[0])
+    strip = compat.sequencer_strips(editor).new_image("Tempera", paths[0], channel=1, frame_start=frames[0])
     for path in paths[1:]:
         strip.elements.append(os.path.basename(path))
     return result
