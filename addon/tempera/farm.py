@@ -90,7 +90,7 @@ def chunk_frames(frames, size):
 
 
 def plan(frames, out, exemplar, *, scene=None, guides=None, exemplar_guides=None, exemplar_scene=None,
-         exemplar_frame=1, chunk_size=DEFAULT_CHUNK_SIZE, temporal=0.0, tempera=("tempera",),
+         exemplar_frame=1, chunk_size=DEFAULT_CHUNK_SIZE, temporal=None, tempera=("tempera",),
          guide_args=(), stylize_args=(), video=True):
     """The tasks of a shot, in an order that respects their dependencies."""
     frames = parse_frames(frames) if isinstance(frames, str) else sorted(set(frames))
@@ -120,10 +120,11 @@ def plan(frames, out, exemplar, *, scene=None, guides=None, exemplar_guides=None
                               tempera + ["render-guides", str(scene), "--frames", format_frames(chunk),
                                          "--out", guides, *guide_args], frames=chunk))
             guide_tasks.append((set(chunk), name))
+    if temporal is None:
+        from .settings import DEFAULT_TEMPORAL_WEIGHT as temporal
+    # Always stated: the chunks must agree with a single run whatever the CLI's default.
     common = ["--guides", guides, "--exemplar", str(exemplar), "--exemplar-guides", str(exemplar_guides),
-              "--out", out]
-    if temporal:
-        common += ["--temporal", repr(float(temporal))]
+              "--out", out, "--temporal", repr(float(temporal))]
     common += list(stylize_args)
     # A temporal chain is one task (one segment per shot until keyframes exist).
     pieces = [frames] if temporal else chunk_frames(frames, chunk_size)
@@ -246,7 +247,8 @@ def parse_args(argv):
     parser.add_argument("--guides")
     parser.add_argument("--frames", required=True)
     parser.add_argument("--out", required=True)
-    parser.add_argument("--temporal", type=float, default=0.0)
+    parser.add_argument("--temporal", type=float, default=None,
+                        help="weight of the temporal guide (default: tempera stylize's)")
     parser.add_argument("--no-video", action="store_true")
     parser.add_argument("--chunk-size", type=int, default=DEFAULT_CHUNK_SIZE, help="frames per task (default 8)")
     parser.add_argument("--scheduler", help="Dask scheduler address (default: start a local cluster)")

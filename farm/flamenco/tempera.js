@@ -36,7 +36,8 @@ const JOB_TYPE = {
           description: "The exemplar's .blend, rendered into OUT/exemplar_guides" },
         { key: "exemplar_frame", type: "int32", default: 1, description: "Frame of the exemplar scene" },
         { key: "out", type: "string", subtype: "dir_path", required: true, description: "Output folder" },
-        { key: "temporal", type: "float", default: 0.0, description: "Weight of the temporal guide" },
+        // The default is tempera's own (StylitOptions in stylit.hpp); tests/python/test_farm.py checks it.
+        { key: "temporal", type: "float", default: 0.0, description: "Weight of the temporal guide (0 = frames independent)" },
         { key: "video", type: "bool", default: true, description: "Write stylized.mp4" },
         { key: "guide_args", type: "string", default: "", description: "Extra render-guides options" },
         { key: "stylize_args", type: "string", default: "", description: "Extra stylize options" },
@@ -135,9 +136,9 @@ function compileJob(job) {
         }
     }
 
+    // Always stated: the chunks must agree with a single run whatever the CLI's default.
     let common = ["--guides", guides, "--exemplar", s.exemplar, "--exemplar-guides", exemplarGuides,
-                  "--out", s.out];
-    if (s.temporal) common = common.concat(["--temporal", pyFloat(s.temporal)]);
+                  "--out", s.out, "--temporal", pyFloat(s.temporal)];
     common = common.concat(splitArgs(s.stylize_args));
     // A temporal chain must not be cut: one task per segment (the whole shot for now).
     const pieces = s.temporal ? [frames] : chunkFrames(frames, chunkSize);

@@ -94,3 +94,12 @@ def test_flamenco_job_type_makes_the_same_tasks(temporal):
     assert [t["name"] for t in flamenco] == [t.name for t in ours]
     assert [t["argv"] for t in flamenco] == [t.command for t in ours]
     assert [t["depends"] for t in flamenco] == [t.depends for t in ours]
+
+
+def test_flamenco_default_temporal_weight_is_temperas():
+    from pathlib import Path
+
+    from tempera.settings import DEFAULT_TEMPORAL_WEIGHT
+
+    js = (Path(__file__).resolve().parents[2] / "farm" / "flamenco" / "tempera.js").read_text()
+    assert f'key: "temporal", type: "float", default: {DEFAULT_TEMPORAL_WEIGHT:.1f}' in js
