@@ -29,7 +29,7 @@ test("a 48-frame shot becomes exemplar, 6 guide, 6 stylize chunks and a finish",
     const stylize = tasks.find((t) => t.name === "stylize 17-24");
     assert.deepEqual(stylize.argv, ["tempera", "stylize", "--frames", "17-24", "--guides", "/shared/out/guides",
                                     "--exemplar", "/shared/style.png", "--exemplar-guides",
-                                    "/shared/out/exemplar_guides", "--out", "/shared/out", "--quality", "preview",
+                                    "/shared/out/exemplar_guides", "--out", "/shared/out", "--temporal", "0.0", "--quality", "preview",
                                     "--no-video"]);
     assert.deepEqual(stylize.depends, ["exemplar-guides", "guides 17-24"]);
     const finish = tasks[tasks.length - 1];
