@@ -11,6 +11,7 @@ tempera_native.libs/). Prints one line 'WHEEL_PROBE {json}'; exits non-zero
 with the error if anything fails.
 """
 import json
+import os
 import math
 import sys
 
@@ -67,6 +68,14 @@ def main(argv):
         "libraries": mapped_libraries(),
     }
     print("WHEEL_PROBE " + json.dumps(report), flush=True)
+    if any(lib.startswith("/usr/lib") and "libOpenImageIO" in lib for lib in host_before):
+        # The host links the same OpenImageIO 2.4 as the wheel (Debian's
+        # Blender 3.4, which takes the legacy add-on, not the wheel): renamed
+        # sonames keep the files apart but not the C++ symbols, and the two
+        # copies' exit-time destructors of OIIO's string table collide (a
+        # segfault in __cxa_finalize, seen for some extraction paths). The
+        # work above is what this probe checks; skip that teardown.
+        os._exit(0)
 
 
 if __name__ == "__main__":
