@@ -1,7 +1,8 @@
 # Tempera: one entry point for humans and CI.
 #   make demo    install deps, build, stylize the bundled demo scene in background Blender
-#   make test    install deps, build, run C++, Python and in-Blender tests
-# Other targets: deps, build, kit, addon-zip, wheel, bench, bench-tracer, sanitize, clean.
+#   make test    install deps, build, run C++, Python, in-Blender (3.4, 4.2, 4.5, 5.0), wheel/farm
+#                and Flamenco tests
+# Other targets: deps, build, kit, addon-zip, wheel, extension, bench, bench-tracer, sanitize, clean.
 
 PYTHON   := /usr/bin/python3
 BLENDER  ?= blender
@@ -9,13 +10,25 @@ BUILD    ?= build
 JOBS     ?= $(shell nproc)
 VERSION  := $(shell sed -n 's/^project.tempera VERSION \([0-9.]*\).*/\1/p' CMakeLists.txt)
 ADDON_ZIP := dist/tempera-addon-$(VERSION).zip
+EXTENSION_ZIP := dist/tempera-$(VERSION)-linux-x64.zip
+# PyPI environments made by tools/setup_venvs.sh (part of `make deps`).
+VENVS    ?= $(HOME)/.cache/tempera
+BPY42    ?= $(VENVS)/venv-bpy42/bin/python
+BPY45    ?= $(VENVS)/venv-bpy45/bin/python
+BPY50    ?= $(VENVS)/venv-bpy50/bin/python
+TOOLS_PY ?= $(VENVS)/venv-tools/bin/python
+# tools/build_wheel.py writes the repaired wheel's path here.
+WHEEL_LIST := dist/wheel.txt
+WHEEL_SOURCES := CMakeLists.txt pyproject.toml README.md native/python/tempera_native/__init__.py \
+                 $(shell find native addon/tempera -name '*.cpp' -o -name '*.hpp' -o -name '*.py' \
+                         -o -name CMakeLists.txt 2>/dev/null)
 # The exemplar kit bundled in the add-on zip (scenes/exemplar_kit.py renders and paints it).
 KIT      := $(BUILD)/kit/sphere_on_table
 KIT_SOURCES := scenes/exemplar_kit.py scenes/scene_kit.py addon/tempera/exemplar_paint.py \
                addon/tempera/blender/guide_render.py addon/tempera/guide_cache.py
 DEMO_OUT ?= out/demo
 
-.PHONY: all deps build kit addon-zip wheel test demo bench bench-tracer sanitize fuzz clean
+.PHONY: all deps build kit addon-zip wheel extension test demo bench bench-tracer sanitize fuzz clean
 
 all: build
 
@@ -37,11 +50,23 @@ kit: build $(KIT)/kit.json
 addon-zip: build $(KIT)/kit.json
 	$(PYTHON) tools/make_addon_zip.py --out $(ADDON_ZIP) --kit $(KIT)
 
-wheel: deps
-	$(PYTHON) -m pip wheel --no-build-isolation --no-deps -w dist .
+# The self-contained wheel: scikit-build-core, then auditwheel repair (tools/build_wheel.py).
+$(WHEEL_LIST): $(WHEEL_SOURCES) | deps
+	$(TOOLS_PY) tools/build_wheel.py --python $(TOOLS_PY) --out dist --jobs $(JOBS)
 
-test: build addon-zip
-	$(PYTHON) tools/run_tests.py --build $(BUILD) --addon-zip $(ADDON_ZIP) --blender $(BLENDER)
+wheel: deps $(WHEEL_LIST)
+
+# The Blender 4.2+ extension: manifest, shim, kit and the wheel.
+$(EXTENSION_ZIP): $(WHEEL_LIST) $(KIT)/kit.json addon/extension/__init__.py addon/tempera/blender_manifest.toml \
+                  tools/make_extension.py tools/make_addon_zip.py
+	$(PYTHON) tools/make_extension.py --wheel "$$(cat $(WHEEL_LIST))" --kit $(KIT) --out $@
+
+extension: build $(EXTENSION_ZIP)
+
+test: build addon-zip extension
+	$(PYTHON) tools/run_tests.py --build $(BUILD) --addon-zip $(ADDON_ZIP) --blender $(BLENDER) \
+	    --extension-zip $(EXTENSION_ZIP) --wheel "$$(cat $(WHEEL_LIST))" \
+	    --bpy42 $(BPY42) --bpy45 $(BPY45) --bpy50 $(BPY50) --tools-python $(TOOLS_PY)
 
 demo: build addon-zip
 	$(PYTHON) tools/run_demo.py --addon-zip $(ADDON_ZIP) --blender $(BLENDER) --out $(DEMO_OUT)

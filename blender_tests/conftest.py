@@ -1,9 +1,16 @@
 """Shared helpers for tests that run inside Blender (see run.py)."""
+import os
+
 import addon_utils
 import bpy
 import pytest
 
-ADDON = "tempera"
+# The module name Blender knows the add-on by (run.py sets it): 'tempera' for
+# the legacy add-on, 'bl_ext.user_default.tempera' for the extension, whose
+# code is the package `tempera` from its wheel.
+ADDON = os.environ.get("TEMPERA_TEST_ADDON_MODULE", "tempera")
+INSTALL = os.environ.get("TEMPERA_TEST_INSTALL", "legacy")
+PACKAGE = "tempera"
 
 
 def _raise(exc):
@@ -42,7 +49,7 @@ def registered_tempera_classes():
     names = {n for n in dir(bpy.types) if n.lower().startswith("tempera")}
     for base in _REGISTERABLE:
         names.update(c.__name__ for c in _subclasses(base)
-                     if c.__module__.split(".")[0] == ADDON and c.is_registered)
+                     if c.__module__.split(".")[0] == PACKAGE and c.is_registered)
     return sorted(names)
 
 

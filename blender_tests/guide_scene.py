@@ -5,6 +5,7 @@ import math
 
 import bpy
 from mathutils import Vector
+from tempera.blender import compat
 
 # 131 x 97 at 50 %: an odd effective width, 65 x 48 pixels.
 RESOLUTION, PERCENT, SIZE = (131, 97), 50, (65, 48)
@@ -15,7 +16,7 @@ PARAMS = {"samples": 8, "ld12e_samples": 8}
 
 def build_scene(name="Guide render test"):
     scene = bpy.data.scenes.new(name)
-    scene.render.engine = "BLENDER_EEVEE"  # saved with EEVEE: guides still come from Cycles
+    scene.render.engine = compat.eevee_engine()  # saved with EEVEE: guides still come from Cycles
     scene.render.resolution_x, scene.render.resolution_y = RESOLUTION
     scene.render.resolution_percentage = PERCENT
     scene.frame_start, scene.frame_end = 1, 5
@@ -42,7 +43,7 @@ def build_scene(name="Guide render test"):
     for frame, location in ((1, CUBE_START), (5, CUBE_START + 4 * CUBE_STEP)):
         cube.location = location
         cube.keyframe_insert("location", frame=frame)
-    for fcurve in cube.animation_data.action.fcurves:
+    for fcurve in compat.action_fcurves(cube):
         for key in fcurve.keyframe_points:
             key.interpolation = "LINEAR"
     cube.location = CUBE_START  # where frame 1 has it

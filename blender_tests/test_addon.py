@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import tempera
-from conftest import ADDON, disable, enable, is_enabled, registered_tempera_classes
+from conftest import ADDON, INSTALL, disable, enable, is_enabled, registered_tempera_classes
 
 EXPECTED_CLASSES = ["TEMPERA_OT_choose_painting", "TEMPERA_OT_painting_template", "TEMPERA_OT_register_painting",
                     "TEMPERA_OT_render_guides", "TEMPERA_OT_stylize", "TEMPERA_PT_output", "TemperaPreferences",
@@ -18,13 +18,22 @@ EXPECTED_CLASSES = ["TEMPERA_OT_choose_painting", "TEMPERA_OT_painting_template"
 
 def test_addon_is_enabled_from_the_installed_zip():
     assert is_enabled()
-    scripts_dir = Path(os.environ["TEMPERA_TEST_SCRIPTS_DIR"])
+    installed = Path(os.environ["TEMPERA_TEST_SCRIPTS_DIR"])
     module_file = Path(tempera.__file__).resolve()
-    assert module_file == scripts_dir / "addons" / "tempera" / "__init__.py"
     # The zipped copy, not the source tree (which the Python tests use).
     repo_addon = Path(__file__).resolve().parent.parent / "addon"
     assert repo_addon not in module_file.parents
-    assert list(module_file.parent.glob("_native*.so")), "the zip carries no compiled module"
+    if INSTALL == "legacy":
+        assert module_file == installed / "addons" / "tempera" / "__init__.py"
+        assert list(module_file.parent.glob("_native*.so")), "the zip carries no compiled module"
+    else:
+        # The extension folder holds the manifest, the shim and the wheel; the
+        # package comes from the wheel, unpacked into Blender's extension site-packages.
+        assert (installed / "blender_manifest.toml").is_file()
+        assert list((installed / "wheels").glob("tempera_native-*.whl"))
+        assert module_file.parent.parent.name == "site-packages"
+        native = Path(tempera._native.__file__).resolve()
+        assert native.parent.name == "tempera_native" and native.parent.parent == module_file.parent.parent
 
 
 def test_native_module_reads_and_writes_exr(tmp_path):

@@ -11,6 +11,7 @@ import bpy
 import numpy as np
 import pytest
 from fake_ui import modal_run
+from tempera.blender import compat
 from guide_scene import FRAMES, PARAMS, SIZE, build_scene, remove_scene
 
 SCENE = "Stylize test"
@@ -100,7 +101,7 @@ def test_stylize_animation_end_to_end(scene, tmp_path, exemplar):
                            capture_output=True, text=True, check=True).stdout.strip()
     assert int(count) == len(FRAMES)
     result = bpy.data.scenes[SCENE + " Tempera"]
-    strip = result.sequence_editor.sequences[0]
+    strip = compat.sequencer_strips(result.sequence_editor)[0]
     assert [e.filename for e in strip.elements] == [f"frame_{f:04d}.png" for f in FRAMES]
     assert (result.frame_start, result.frame_end) == (FRAMES[0], FRAMES[-1])
 

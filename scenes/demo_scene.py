@@ -50,7 +50,9 @@ FRAMES_PER_ROW = 6  # on the comparison sheet
 # --------------------------------------------------------------------------- scene
 
 def _linear_keys(obj):
-    for fcurve in obj.animation_data.action.fcurves:
+    from tempera.blender import compat
+
+    for fcurve in compat.action_fcurves(obj):
         for key in fcurve.keyframe_points:
             key.interpolation = "LINEAR"
 

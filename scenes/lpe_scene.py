@@ -43,8 +43,10 @@ def _material(name, color, diffuse_only, **principled):
         return mat
     node = tree.nodes["Principled BSDF"]
     node.inputs["Base Color"].default_value = (*color, 1)
+    from tempera.blender import compat
+
     for key, value in principled.items():
-        node.inputs[key].default_value = value
+        compat.principled_socket(node, key).default_value = value
     return mat
 
 
@@ -99,6 +101,9 @@ def build_scene(name="LPE", size=(96, 72), sphere="metal", light="POINT", diffus
     data.energy = power
     for key, value in extra.items():
         setattr(data, key, value)
+    from tempera.blender import compat
+
+    compat.hard_light_falloff(data)  # what the tracer models
     lamp = bpy.data.objects.new(f"{name} light", data)
     lamp.location = location
     lamp.rotation_euler = _aim(location, target)  # lights shine down their local -Z

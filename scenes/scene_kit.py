@@ -160,7 +160,9 @@ def configure_render(scene, resolution, samples, passes, frames=None):
         setattr(view_layer, render_pass.view_layer_property, render_pass.name in passes)
 
     settings = scene.render.image_settings
-    settings.file_format = "OPEN_EXR_MULTILAYER"
+    from tempera.blender import compat  # the add-on is installed (or addon/ on sys.path) wherever this runs
+
+    compat.set_file_format(settings, "OPEN_EXR_MULTILAYER")
     settings.color_depth = "32"
     settings.exr_codec = "ZIP"
     scene.render.use_file_extension = False

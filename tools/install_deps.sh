@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# Installs Tempera's build and test dependencies from Debian's archive only.
+# Installs Tempera's build and test dependencies from Debian's archive, then
+# (tools/setup_venvs.sh) the Python environments from PyPI: blender.org's
+# Blender 4.5 and 5.0 as the bpy module, and the wheel/farm tools.
 # Idempotent and fast when everything is present: apt-get runs only for
-# packages that are missing.
+# packages that are missing, pip only for environments that are.
 set -euo pipefail
 
 # package                 why it is needed
@@ -21,8 +23,14 @@ PACKAGES=(
   python3-setuptools python3-pip  # offline pyproject build (--no-build-isolation)
   libgtest-dev          # C++ unit tests
   ffmpeg                # mp4 previews of stylized sequences
+  python3-venv          # virtual environments for PyPI's bpy and the wheel/farm tools
+  libx11-6 libxi6 libxxf86vm1 libxfixes3 libxrender1 libxkbcommon0 libsm6 \
+  libgl1 libegl1        # X11/GL libraries blender.org's bpy (4.2, 4.5, 5.0) loads, even headless
+  nodejs                # tests of the Flamenco job type (farm/flamenco/tempera.js)
   xvfb xdotool imagemagick  # docs/make_panel_screenshots.py: the real panel in a window on a virtual display
 )
+
+HERE="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 
 missing=()
 for pkg in "${PACKAGES[@]}"; do
@@ -30,11 +38,12 @@ for pkg in "${PACKAGES[@]}"; do
 done
 if [ ${#missing[@]} -eq 0 ]; then
   echo "deps: all ${#PACKAGES[@]} packages present"
-  exit 0
+else
+  echo "deps: installing ${missing[*]}"
+  SUDO=""
+  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
-echo "deps: installing ${missing[*]}"
-SUDO=""
-[ "$(id -u)" -eq 0 ] || SUDO="sudo"
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+"$HERE/setup_venvs.sh"

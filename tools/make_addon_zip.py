@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
-"""Packs addon/tempera (with the compiled _native module) into an installable
-add-on zip for Blender 3.4 (legacy add-on) and 4.2+ (extension manifest).
+"""Packs addon/tempera (with the compiled _native module) into the legacy
+add-on zip for Blender 3.x (Debian's 3.4: the module links Debian's shared
+libraries). Blender 4.2+ gets the extension zip (tools/make_extension.py);
+the manifest stays out of this zip, so 4.2+ does not take it for one.
 
 With --kit DIR (a folder written by scenes/exemplar_kit.py), the kit's
 painting, render and guide cache go into the zip as tempera/kit/<variant>/,
@@ -38,7 +40,8 @@ def main():
     tmp = out.with_suffix(".zip.tmp")
     with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as zf:
         for path in sorted(PACKAGE.rglob("*")):
-            if path.is_dir() or "__pycache__" in path.parts or path.suffix == ".pyc":
+            if path.is_dir() or "__pycache__" in path.parts or path.suffix == ".pyc" \
+                    or path.name == "blender_manifest.toml":
                 continue
             zf.write(path, Path("tempera") / path.relative_to(PACKAGE))
         for kit in map(Path, args.kit):

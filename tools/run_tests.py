@@ -1,9 +1,14 @@
 #!/usr/bin/env python3
-"""Runs Tempera's three test levels and prints one summed closing line.
+"""Runs Tempera's test levels and prints one summed closing line.
 
-1. C++ unit tests (GoogleTest under ctest),
-2. Python tests (pytest under /usr/bin/python3, importing `tempera` from addon/),
-3. blender_tests (pytest inside `blender -b --factory-startup`, add-on enabled).
+    cpp        C++ unit tests (GoogleTest under ctest)
+    python     Python tests (pytest under /usr/bin/python3, importing `tempera` from addon/)
+    blender    blender_tests in Debian's Blender 3.4 (`blender -b`), legacy add-on zip
+    blender42  blender_tests in blender.org 4.2 LTS (PyPI bpy), the extension's minimum version
+    blender45  blender_tests in blender.org 4.5 LTS (PyPI bpy), extension zip installed as a user does
+    blender50  blender_tests in blender.org 5.0 (PyPI bpy), extension zip
+    wheel      tests/wheel: pip install of the repaired wheel, ldd, the Dask farm (venv-tools)
+    flamenco   farm/flamenco tests under Node (node --test)
 
 Counts come from JUnit XML that every level writes, so they do not depend on
 parsing console text. Exits non-zero if anything failed or a level did not run.
@@ -13,6 +18,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import time
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -24,7 +30,13 @@ def junit_counts(path):
     if not path.exists() or path.stat().st_size == 0:
         return None
     root = ET.parse(path).getroot()
-    suites = [root] if root.tag == "testsuite" else root.iter("testsuite")
+    suites = [root] if root.tag == "testsuite" else list(root.iter("testsuite"))
+    if not any(suite.get("tests") is not None for suite in suites):
+        # Node's reporter: bare test cases, outcome in child elements.
+        cases = list(root.iter("testcase"))
+        failed = sum(1 for c in cases if c.find("failure") is not None or c.find("error") is not None)
+        skipped = sum(1 for c in cases if c.find("skipped") is not None)
+        return len(cases) - failed - skipped, failed, skipped
     tests = failed = skipped = 0
     for suite in suites:
         tests += int(suite.get("tests", 0))
@@ -48,16 +60,40 @@ def run_level(name, cmd, junit, env=None, cwd=ROOT):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__)
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--build", default="build")
-    parser.add_argument("--addon-zip", required=True)
+    parser.add_argument("--addon-zip", help="legacy add-on zip (level blender)")
+    parser.add_argument("--extension-zip", help="extension zip (levels blender45, blender50)")
+    parser.add_argument("--wheel", help="repaired wheel (levels blender*, wheel)")
     parser.add_argument("--blender", default="blender")
-    parser.add_argument("--levels", default="cpp,python,blender")
+    parser.add_argument("--bpy42", help="Python with PyPI bpy 4.2 (tools/setup_venvs.sh)")
+    parser.add_argument("--bpy45", help="Python with PyPI bpy 4.5")
+    parser.add_argument("--bpy50", help="Python with PyPI bpy 5.0")
+    parser.add_argument("--tools-python", help="Python with dask and pytest (venv-tools)")
+    parser.add_argument("--levels", default="cpp,python,blender,blender42,blender45,blender50,wheel,flamenco")
     args = parser.parse_args()
     build = (ROOT / args.build).resolve()
     reports = Path(tempfile.mkdtemp(prefix="tempera-tests-"))
     env = dict(os.environ, PYTHONPATH=str(ROOT / "addon"), TEMPERA_CLI=str(build / "bin" / "tempera"),
                TEMPERA_BLENDER=args.blender)
+    if args.wheel:
+        env["TEMPERA_TEST_WHEEL"] = str(Path(args.wheel).resolve())
+
+    def needs(*names):
+        missing = [n for n in names if not getattr(args, n.replace("-", "_"))]
+        if missing:
+            print(f"=== missing {', '.join('--' + n for n in missing)}", flush=True)
+        return not missing
+
+    def blender_level(name, python, version):
+        if not needs("extension-zip", version):
+            return None
+        return run_level(
+            f"Blender tests ({name}, extension)",
+            [python, ROOT / "blender_tests" / "run.py", "--extension-zip", Path(args.extension_zip).resolve(),
+             "--junit", reports / f"{version}.xml"],
+            reports / f"{version}.xml", env=env)
+
     levels = {
         "cpp": lambda: run_level(
             "C++ unit tests",
@@ -68,17 +104,35 @@ def main():
             ["/usr/bin/python3", "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests/python",
              f"--junitxml={reports / 'python.xml'}"],
             reports / "python.xml", env=env),
-        "blender": lambda: run_level(
-            "Blender tests",
+        "blender": lambda: needs("addon-zip") and run_level(
+            "Blender tests (Debian 3.4, legacy add-on)",
             [args.blender, "-b", "--factory-startup", "--python-exit-code", "1",
              "--python", ROOT / "blender_tests" / "run.py", "--",
              "--addon-zip", Path(args.addon_zip).resolve(), "--junit", reports / "blender.xml"],
-            reports / "blender.xml", env=env),
+            reports / "blender.xml", env=env) or None,
+        "blender42": lambda: blender_level("blender.org 4.2", args.bpy42, "bpy42"),
+        "blender45": lambda: blender_level("blender.org 4.5", args.bpy45, "bpy45"),
+        "blender50": lambda: blender_level("blender.org 5.0", args.bpy50, "bpy50"),
+        "wheel": lambda: needs("wheel", "tools-python") and run_level(
+            "Wheel and Dask farm tests",
+            [args.tools_python, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests/wheel",
+             f"--junitxml={reports / 'wheel.xml'}"],
+            reports / "wheel.xml", env=dict(env, PYTHONPATH="")) or None,
+        "flamenco": lambda: run_level(
+            "Flamenco job type tests (Node)",
+            ["node", "--test", "--test-reporter=spec", "--test-reporter-destination=stdout",
+             "--test-reporter=junit", f"--test-reporter-destination={reports / 'flamenco.xml'}",
+             ROOT / "farm" / "flamenco" / "tempera.test.js"],
+            reports / "flamenco.xml"),
     }
     total_passed = total_failed = total_skipped = 0
     missing = []
     for name in args.levels.split(","):
+        if name not in levels:
+            parser.error(f"unknown level {name!r}; levels: {', '.join(levels)}")
+        started = time.monotonic()
         result = levels[name]()
+        print(f"=== {name}: {time.monotonic() - started:.0f} s", flush=True)
         if result is None:
             missing.append(name)
             continue

@@ -21,14 +21,34 @@ bl_info = {
 
 __version__ = "0.1.0"  # keep equal to project(tempera VERSION ...) in CMakeLists.txt
 
-try:
-    from ._native import Cancelled, image_info, max_image_pixels, read_image, set_max_image_pixels, write_image
-except ImportError as exc:  # not built, or built for another Python
+def _load_native():
+    """The compiled engine: tempera._native next to this file (source tree,
+    legacy add-on zip), else the one of the self-contained wheel
+    (tempera_native._native, with its own OpenImageIO, Embree and TBB),
+    which is then also importable as tempera._native."""
+    import importlib
+    import sys
+
+    errors = []
+    for name in (__name__ + "._native", "tempera_native._native"):
+        try:
+            module = importlib.import_module(name)
+        except ImportError as exc:
+            errors.append(f"{name}: {exc}")
+            continue
+        sys.modules[__name__ + "._native"] = module
+        return module
     raise ImportError(
-        f"tempera: the compiled module tempera._native cannot be loaded ({exc}). "
+        "tempera: the compiled module tempera._native cannot be loaded (" + "; ".join(errors) + "). "
         "Build it with 'make build' in the Tempera source tree "
-        "(or install the add-on zip / wheel made by 'make addon-zip' / 'make wheel')."
-    ) from exc
+        "(or install the add-on zip / extension / wheel made by 'make addon-zip' / 'make extension' / 'make wheel')."
+    )
+
+
+_native = _load_native()
+Cancelled, image_info, read_image, write_image = (
+    _native.Cancelled, _native.image_info, _native.read_image, _native.write_image)
+max_image_pixels, set_max_image_pixels = _native.max_image_pixels, _native.set_max_image_pixels
 
 # Python API on top of the native module; public entry points are listed in __all__.
 from .contact_sheet import contact_sheet
@@ -52,10 +72,13 @@ __all__ = [
 ]
 
 
-def register():
+def register(addon_id=None):
+    """Blender's entry point. `addon_id` is the module name Blender knows the
+    add-on by: 'tempera' for the legacy add-on (the default), or the
+    extension's 'bl_ext.<repository>.tempera' when the extension shim calls it."""
     from . import blender  # imports bpy; only ever reached inside Blender
 
-    blender.register()
+    blender.register(addon_id or __name__)
 
 
 def unregister():

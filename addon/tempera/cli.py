@@ -2,7 +2,8 @@
 
 The CLI runs Tempera's solvers on files on disk without Blender, so a render
 farm can split a shot by frames. The add-on preferences may name it
-explicitly; otherwise it is looked up on PATH.
+explicitly; otherwise it is looked up on PATH, and then in the installed
+wheel (tempera_native/bin/tempera, which the extension brings along).
 """
 import os
 import shutil
@@ -14,9 +15,20 @@ class CliError(RuntimeError):
     """The `tempera` CLI is missing, not executable or answered unexpectedly."""
 
 
+def bundled_cli():
+    """The wheel's CLI (tempera_native/bin/tempera) if that is installed, else None."""
+    try:
+        import tempera_native
+    except ImportError:
+        return None
+    path = Path(tempera_native.CLI)
+    return path if path.is_file() and os.access(path, os.X_OK) else None
+
+
 def find_cli(path=""):
     """Absolute path of the CLI: `path` if given (a file or a folder holding
-    `tempera`, '~' expanded), else `tempera` on PATH. Raises CliError."""
+    `tempera`, '~' expanded), else `tempera` on PATH, else the one of the
+    installed wheel. Raises CliError."""
     if path:
         candidate = Path(os.path.expanduser(path))
         if candidate.is_dir():
@@ -26,7 +38,7 @@ def find_cli(path=""):
         if not os.access(candidate, os.X_OK):
             raise CliError(f"tempera CLI at '{candidate}' is not executable")
         return candidate.resolve()
-    found = shutil.which("tempera")
+    found = shutil.which("tempera") or bundled_cli()
     if not found:
         raise CliError("tempera CLI not found on PATH; set its path in the add-on preferences")
     return Path(found).resolve()

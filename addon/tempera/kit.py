@@ -12,15 +12,19 @@ so that an artist can stylize a scene before painting an exemplar of their own.
 """
 from pathlib import Path
 
+# The legacy add-on zip carries the kit inside the package; the extension
+# carries it beside its own __init__.py, which points KIT_DIR there.
 KIT_DIR = Path(__file__).resolve().parent / "kit"
 DEFAULT_VARIANT = "sphere_on_table"
 STYLE_NAME = "style.png"
 GUIDES_NAME = "guides"
 
 
-def kit_exemplar(variant=DEFAULT_VARIANT, kit_dir=KIT_DIR):
-    """(painting path, guide cache folder) of a bundled kit variant; raises
-    FileNotFoundError naming what is missing and how to get it."""
+def kit_exemplar(variant=DEFAULT_VARIANT, kit_dir=None):
+    """(painting path, guide cache folder) of a bundled kit variant (in
+    `kit_dir`, default KIT_DIR); raises FileNotFoundError naming what is
+    missing and how to get it."""
+    kit_dir = KIT_DIR if kit_dir is None else kit_dir
     folder = Path(kit_dir) / variant
     style, guides = folder / STYLE_NAME, folder / GUIDES_NAME
     if not (style.is_file() and (guides / "manifest.json").is_file()):

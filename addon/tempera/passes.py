@@ -1,14 +1,16 @@
 """Blender render passes as stored in multilayer EXR files.
 
 Blender (Cycles, 3.x/4.x) names multilayer EXR channels
-"<view layer>.<pass>.<component>", e.g. "ViewLayer.DiffDir.R". This module
+"<view layer>.<pass>.<component>", e.g. "ViewLayer.DiffDir.R"; Blender 5.0
+writes the passes' UI names instead ("ViewLayer.Diffuse Direct.R"), and
+readers here accept both (LONG_NAMES, stored_pass_name). This module
 knows the passes Tempera uses as guides: their channel components and the
 ViewLayer property that enables each, so that code building a render setup
 and code reading its output agree on one table.
 """
 from dataclasses import dataclass
 
-from ._native import read_image
+from ._native import image_info, read_image
 
 
 @dataclass(frozen=True)
@@ -35,6 +37,27 @@ PASSES = {
 }
 
 
+# Render passes in multilayer EXR files: the short names of 3.x/4.x -> 5.0's.
+LONG_NAMES = {
+    "DiffDir": "Diffuse Direct", "DiffInd": "Diffuse Indirect", "DiffCol": "Diffuse Color",
+    "GlossDir": "Glossy Direct", "GlossInd": "Glossy Indirect", "GlossCol": "Glossy Color",
+    "TransDir": "Transmission Direct", "TransInd": "Transmission Indirect", "TransCol": "Transmission Color",
+    "IndexOB": "Object Index", "IndexMA": "Material Index", "Emit": "Emission", "Env": "Environment",
+    "AO": "Ambient Occlusion",
+}
+
+
+def stored_pass_name(channels, view_layer, pass_name):
+    """The name under which the pass `pass_name` (short form, e.g. 'DiffDir')
+    is stored in an EXR with `channels`: the short name or 5.0's long one,
+    whichever the file has (the short one if neither, so that the error
+    names what was asked for)."""
+    for candidate in (pass_name, LONG_NAMES.get(pass_name)):
+        if candidate and any(c.startswith(f"{view_layer}.{candidate}.") for c in channels):
+            return candidate
+    return pass_name
+
+
 def channel_names(pass_name, view_layer="ViewLayer"):
     """EXR channel names of one pass, e.g. ['ViewLayer.DiffDir.R', ...G, ...B]."""
     try:
@@ -50,4 +73,8 @@ def read_pass(path, pass_name, view_layer="ViewLayer"):
     Raises FileNotFoundError / OSError naming the file, or ValueError naming
     the missing channel and listing the channels the file has.
     """
-    return read_image(str(path), channel_names(pass_name, view_layer))
+    names = channel_names(pass_name, view_layer)
+    stored = stored_pass_name(image_info(str(path))["channels"], view_layer, pass_name)
+    if stored != pass_name:
+        names = [f"{view_layer}.{stored}.{n.rsplit('.', 1)[1]}" for n in names]
+    return read_image(str(path), names)

@@ -47,6 +47,7 @@ class ArgReader {
 int run_synth(const Args& args);
 int run_render_guides(const Args& args);
 int run_stylize(const Args& args);
+int run_noisy(const Args& args);
 
 // Which Blender renders guides, and where it finds the tempera package.
 struct BlenderSetup {

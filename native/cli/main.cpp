@@ -25,6 +25,7 @@ const std::map<std::string, Command>& commands() {
       {"render-guides",
        {"render a .blend scene's guide cache with background Blender", tempera::cli::run_render_guides}},
       {"stylize", {"stylize an animation from a painted exemplar (StyLit, resumable)", tempera::cli::run_stylize}},
+      {"noisy", {"add temporal noise to a coherent sequence (Color Me Noisy, resumable)", tempera::cli::run_noisy}},
   };
   return table;
 }

@@ -82,6 +82,7 @@ void bind_guides(py::module_& m);     // bind_guides.cpp
 void bind_stylize(py::module_& m);    // bind_stylize.cpp
 void bind_tracer(py::module_& m);     // bind_tracer.cpp
 void bind_noisy(py::module_& m);      // bind_noisy.cpp
+void bind_tcia(py::module_& m);       // bind_tcia.cpp
 
 PYBIND11_MODULE(_native, m) {
   m.doc() = "Tempera native engine";
@@ -93,4 +94,5 @@ PYBIND11_MODULE(_native, m) {
   bind_stylize(m);
   bind_tracer(m);
   bind_noisy(m);
+  bind_tcia(m);
 }

@@ -258,6 +258,7 @@ struct Solver::Plan {
   double ratio = 0.5;
   int style_channels = 0;
   std::vector<int> guide_channels;  // per guide layer (one merged layer after PCA)
+  std::vector<float> guide_weights;  // per guide layer of the input
   double kept_variance = 1.0;
   std::vector<SourceLayout> layout;   // per level
   std::vector<Image> source, target;  // source: style + guides (atlas); target: guides
@@ -312,6 +313,7 @@ Solver::Solver(const SynthesisInput& in, const SynthesisOptions& opt) : plan_(ne
     for (const auto& layer : layers) {
       weighted.push_back(scaled(layer.target, std::sqrt(layer.weight)));
       p.guide_channels.push_back(layer.source.channels);
+      p.guide_weights.push_back(layer.weight);
     }
     tgt_guides = stack_channels(views(weighted));
     const bool has_maps = std::any_of(in.target_weight_maps.begin(), in.target_weight_maps.end(),
@@ -464,7 +466,8 @@ PatchSpace Solver::geometry(int l, FeatureImage& source, FeatureImage& target) c
   return space;
 }
 
-void Solver::build_level(int l, Level& level, const Image* fixed_mask) const {
+void Solver::build_level(int l, Level& level, const LevelStart* start) const {
+  const Image* fixed_mask = start ? start->fixed_mask : nullptr;
   const Plan& p = *plan_;
   const Image& src = p.source[std::size_t(l)];
   const int total = src.channels();
@@ -478,6 +481,7 @@ void Solver::build_level(int l, Level& level, const Image* fixed_mask) const {
   // style's as matched: no full-size copy of the guides.
   level.source.set_channels(0, src.view(), 1.0f);
   if (total > p.style_channels) level.target.set_channels(p.style_channels, p.target[l].view(), 1.0f);
+  if (start) replace_guide_targets(l, *start, level.target);
   if (options_.color_space == ColorSpace::Lab)
     level.source.set_channels(0, srgb_to_lab(level.style.view()).view(), p.style_scales);
   else
@@ -534,6 +538,23 @@ void Solver::build_level(int l, Level& level, const Image* fixed_mask) const {
   cons.finalize();
 }
 
+void Solver::replace_guide_targets(int l, const LevelStart& start, FeatureImage& target) const {
+  const Plan& p = *plan_;
+  for (const auto& [layer, image] : start.guide_targets) {
+    if (p.guide_channels.size() != p.guide_weights.size())
+      throw ValueError("per-level guide targets need uncompressed guides (guide_variance 1)");
+    if (layer < 0 || layer >= int(p.guide_weights.size()))
+      throw ValueError(concat("guide layer ", layer, " does not exist (there are ", p.guide_weights.size(), ")"));
+    if (image->width() != target.width || image->height() != target.height ||
+        image->channels() != p.guide_channels[std::size_t(layer)])
+      throw ValueError(concat("guide target of layer ", layer, " at level ", l, " must be ", target.width, "x",
+                              target.height, " with ", p.guide_channels[std::size_t(layer)], " channels"));
+    int first = p.style_channels;
+    for (int k = 0; k < layer; ++k) first += p.guide_channels[std::size_t(k)];
+    target.set_channels(first, image->view(), std::sqrt(p.guide_weights[std::size_t(layer)]));
+  }
+}
+
 void Solver::set_target_style(Level& level, const Image& bprime) const {
   if (options_.color_space == ColorSpace::Lab)
     level.target.set_channels(0, srgb_to_lab(bprime.view()).view(), plan_->style_scales);
@@ -579,10 +600,9 @@ OffsetField Solver::cold_start(int l, Level& level, Image& bprime) const {
     return field;
   }
   FeatureImage source = level.source, target = level.target;
-  std::fill(target.data.begin(), target.data.end(), 0.0f);
-  target.set_channels(p.style_channels, p.target[std::size_t(l)].view(), 1.0f);
-  for (std::size_t i = 0; i < source.data.size(); i += std::size_t(source.stride))
-    std::fill_n(source.data.begin() + std::ptrdiff_t(i), p.style_channels, 0.0f);
+  for (FeatureImage* f : {&source, &target})  // the guide channels alone
+    for (std::size_t i = 0; i < f->data.size(); i += std::size_t(f->stride))
+      std::fill_n(f->data.begin() + std::ptrdiff_t(i), p.style_channels, 0.0f);
   PatchSpace guide_space = level.space;
   guide_space.source = &source;
   guide_space.target = &target;
@@ -645,7 +665,7 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
   if (l < 0 || l >= levels()) throw ValueError(concat("level ", l, " does not exist (0 to ", coarsest(), ")"));
   const Plan& p = *plan_;
   Level level;
-  build_level(l, level, start.fixed_mask);
+  build_level(l, level, &start);
   LevelResult out;
   LevelStats& stats = out.stats;
   stats.level = l;

@@ -1,10 +1,13 @@
 #include "tempera/stylize_job.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -224,6 +227,7 @@ std::map<int, ReportEntry> read_report(const std::string& path, std::vector<std:
                             " and its frames are stylized again"));
   return {};
 }
+
 
 void write_report(const std::string& path, const std::string& settings, const std::map<int, ReportEntry>& entries) {
   const fs::path target(path);

@@ -1,6 +1,7 @@
 """The `tempera` batch command line, and tempera.cli which locates it."""
 import os
 import subprocess
+import sys
 
 import pytest
 
@@ -47,6 +48,18 @@ def test_find_cli_on_path(cli_path, monkeypatch):
     monkeypatch.setenv("PATH", str(cli_path.parent))
     assert cli.find_cli() == cli_path.resolve()
     monkeypatch.setenv("PATH", "")
+    with pytest.raises(cli.CliError, match="not found on PATH"):
+        cli.find_cli()
+
+
+def test_find_cli_falls_back_to_the_wheels_cli(cli_path, tmp_path, monkeypatch):
+    """Not on PATH, but installed with the wheel (tempera_native/bin/tempera): the extension's case."""
+    import types
+
+    monkeypatch.setenv("PATH", str(tmp_path))
+    monkeypatch.setitem(sys.modules, "tempera_native", types.SimpleNamespace(CLI=cli_path))
+    assert cli.find_cli() == cli_path.resolve()
+    monkeypatch.setitem(sys.modules, "tempera_native", types.SimpleNamespace(CLI=tmp_path / "missing"))
     with pytest.raises(cli.CliError, match="not found on PATH"):
         cli.find_cli()
 

@@ -71,7 +71,57 @@ def test_missing_native_module_says_how_to_build_it(tmp_path):
     assert "make build" in last and "tempera._native" in last
 
 
-def test_setup_py_version_comes_from_cmake():
-    result = subprocess.run([sys.executable, "setup.py", "--version"], cwd=ROOT, capture_output=True, text=True)
-    assert result.returncode == 0, result.stderr
-    assert result.stdout.strip().splitlines()[-1] == cmake_project_version()
+def test_wheel_version_comes_from_cmake():
+    """pyproject.toml takes the wheel's version from CMakeLists.txt with a
+    regex (scikit-build-core's regex provider): it must match the project line."""
+    import re
+
+    pyproject = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    provider = pyproject["tool"]["scikit-build"]["metadata"]["version"]
+    assert provider["provider"] == "scikit_build_core.metadata.regex" and provider["input"] == "CMakeLists.txt"
+    match = re.search(provider["regex"], (ROOT / "CMakeLists.txt").read_text(), re.MULTILINE)
+    assert match and match.group("value") == cmake_project_version() == tempera.__version__
+    assert pyproject["project"]["dynamic"] == ["version"] and "version" not in pyproject["project"]
+    assert pyproject["project"]["name"] == "tempera_native"  # not "tempera": Blender's shared wheel folder
+    assert pyproject["project"]["scripts"] == {"tempera": "tempera.__main__:main"}
+    assert not (ROOT / "setup.py").exists()
+
+
+def test_extension_manifest_permissions_and_packer(tmp_path):
+    """The packer adds the wheel to the manifest and refuses a wheel of another version."""
+    import subprocess as sp
+
+    manifest = tomllib.loads((ROOT / "addon" / "tempera" / "blender_manifest.toml").read_text())
+    assert set(manifest["permissions"]) == {"files"} and len(manifest["permissions"]["files"]) <= 64
+    assert "wheels" not in manifest
+    sys.path.insert(0, str(ROOT / "tools"))
+    try:
+        import make_extension
+    finally:
+        sys.path.pop(0)
+    name = f"tempera_native-{tempera.__version__}-cp311-cp311-manylinux_2_35_x86_64.whl"
+    text = make_extension.manifest_text(name, tempera.__version__)
+    assert tomllib.loads(text)["wheels"] == [f"./wheels/{name}"]
+    wrong = tmp_path / "tempera_native-9.9.9-cp311-cp311-manylinux_2_35_x86_64.whl"
+    wrong.write_bytes(b"")
+    result = sp.run([sys.executable, str(ROOT / "tools" / "make_extension.py"), "--wheel", str(wrong),
+                     "--out", str(tmp_path / "x.zip")], capture_output=True, text=True)
+    assert result.returncode != 0 and "version 9.9.9" in result.stderr
+    unrepaired = tmp_path / f"tempera_native-{tempera.__version__}-cp311-cp311-linux_x86_64.whl"
+    unrepaired.write_bytes(b"")
+    result = sp.run([sys.executable, str(ROOT / "tools" / "make_extension.py"), "--wheel", str(unrepaired),
+                     "--out", str(tmp_path / "x.zip")], capture_output=True, text=True)
+    assert result.returncode != 0 and "not a repaired cp311 manylinux" in result.stderr
+
+
+def test_legacy_zip_leaves_the_manifest_out(tmp_path):
+    """Blender 4.2+ would take a zip with a manifest for an (incomplete) extension."""
+    import subprocess as sp
+    import zipfile
+
+    out = tmp_path / "legacy.zip"
+    sp.run([sys.executable, str(ROOT / "tools" / "make_addon_zip.py"), "--out", str(out)], check=True,
+           capture_output=True)
+    names = zipfile.ZipFile(out).namelist()
+    assert "tempera/__init__.py" in names and any(n.startswith("tempera/_native") for n in names)
+    assert not [n for n in names if n.endswith("blender_manifest.toml")]

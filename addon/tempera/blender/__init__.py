@@ -25,7 +25,11 @@ CLASSES = (
 )
 
 
-def register():
+def register(addon_id="tempera"):
+    """`addon_id`: the module name Blender knows the add-on by ('tempera', or
+    'bl_ext.<repository>.tempera' for the extension); the preferences are
+    registered under it."""
+    TemperaPreferences.bl_idname = addon_id
     job_operator._set_running(None, False)  # a run cut short by disabling the add-on is over
     registered = []
     try:

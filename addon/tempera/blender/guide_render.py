@@ -23,7 +23,8 @@ from pathlib import Path
 import bpy
 import numpy as np
 
-from .. import guide_cache, guides, read_image
+from .. import guide_cache, guides, image_info, read_image
+from . import compat
 from ..frames import MAX_FRAME, check_frame
 from ..lpe import check_lpe, trace_lpe
 from ..stylize import tonemap
@@ -35,10 +36,10 @@ class GuideRenderError(RuntimeError):
 
 
 # Settings changed while rendering guides, restored in this order afterwards
-# (file_format before color_depth: the depths on offer depend on the format).
+# (image settings: see compat.IMAGE_FORMAT_SETTINGS).
 RENDER_SETTINGS = ("engine", "film_transparent", "filepath", "use_file_extension", "use_compositing",
                    "use_sequencer", "use_border")
-IMAGE_SETTINGS = ("file_format", "color_depth", "exr_codec", "color_mode", "use_preview")
+IMAGE_SETTINGS = compat.IMAGE_FORMAT_SETTINGS
 CYCLES_SETTINGS = ("device", "samples", "use_adaptive_sampling", "use_denoising", "sample_clamp_direct",
                    "sample_clamp_indirect", "seed", "use_animated_seed", "max_bounces", "diffuse_bounces",
                    "glossy_bounces", "transmission_bounces", "volume_bounces", "transparent_max_bounces",
@@ -238,7 +239,7 @@ def _configure(scene, layer, samples, passes, seed):
     render.use_sequencer = False
     render.use_border = False  # guides cover the whole frame
     settings = render.image_settings
-    settings.file_format = "OPEN_EXR_MULTILAYER"
+    compat.set_file_format(settings, "OPEN_EXR_MULTILAYER")
     settings.color_depth = "32"
     settings.exr_codec = "ZIP"
     cycles.device = "CPU"
@@ -271,7 +272,9 @@ def _render(scene, path, frame):
 
 
 def _read_passes(path, layer_name, passes):
-    return {name: read_image(str(path), [f"{layer_name}.{name}.{c}" for c in comps])
+    channels = image_info(str(path))["channels"]
+    return {name: read_image(str(path), [f"{layer_name}.{compat.exr_pass_name(channels, layer_name, name)}.{c}"
+                                         for c in comps])
             for name, comps in passes.items()}
 
 
@@ -372,7 +375,7 @@ def _animation(id_block):
         return None
     return [[fc.data_path, fc.array_index, fc.extrapolation,
              [[*k.co, *k.handle_left, *k.handle_right, k.interpolation] for k in fc.keyframe_points]]
-            for fc in anim.action.fcurves]
+            for fc in compat.action_fcurves(id_block)]
 
 
 def _camera_fingerprint(camera):

@@ -6,7 +6,9 @@ from bpy.types import AddonPreferences
 
 from .. import __version__, cli
 
-ADDON_ID = __package__.rpartition(".")[0]  # "tempera": the add-on's module name
+# The legacy add-on's module name; the extension registers the preferences under
+# its own ("bl_ext.<repository>.tempera", see tempera.blender.register).
+ADDON_ID = __package__.rpartition(".")[0]
 
 
 @functools.lru_cache(maxsize=8)

@@ -3,6 +3,8 @@ import os
 
 import bpy
 
+from . import compat
+
 RESULT_SCENE_SUFFIX = " Tempera"
 RESULT_MARK = "tempera_result"  # custom property of a result scene (the panel hides there)
 
@@ -70,7 +72,7 @@ def load_sequencer_scene(scene, paths, frames):
     result.display_settings.display_device = "sRGB"
     result.sequencer_colorspace_settings.name = "sRGB"
     editor = result.sequence_editor_create()
-    strip = editor.sequences.new_image("Tempera", paths[0], channel=1, frame_start=frames[0])
+    strip = compat.sequencer_strips(editor).new_image("Tempera", paths[0], channel=1, frame_start=frames[0])
     for path in paths[1:]:
         strip.elements.append(os.path.basename(path))
     return result

@@ -15,6 +15,7 @@ scene's unit scale is ignored by Cycles too).
 import numpy as np
 
 from .. import scene_units
+from . import compat
 
 GEOMETRY_TYPES = {"MESH", "CURVE", "SURFACE", "META", "FONT"}
 FALLBACK_GREY = (0.8, 0.8, 0.8)
@@ -174,13 +175,12 @@ def _triangles(obj, materials, warnings):
         if mesh is None or not mesh.polygons:
             return None
         mesh.calc_loop_triangles()
-        mesh.calc_normals_split()  # per-corner normals: smooth, flat and auto-smooth faces as Cycles shades them
         count = len(mesh.loop_triangles)
         verts = _get(mesh.vertices, "co", (len(mesh.vertices), 3), np.float64)
         tris = _get(mesh.loop_triangles, "vertices", (count, 3), np.int32)
         loops = _get(mesh.loop_triangles, "loops", (count, 3), np.int32)
         slots = _get(mesh.loop_triangles, "material_index", (count,), np.int32)
-        loop_normals = _get(mesh.loops, "normal", (len(mesh.loops), 3), np.float64)
+        loop_normals = compat.corner_normals(mesh)  # smooth, flat and auto-smooth faces as Cycles shades them
         uv_layer = next((layer for layer in mesh.uv_layers if layer.active_render), None)
         if uv_layer is not None:
             uvs = _get(uv_layer.data, "uv", (len(mesh.loops), 2), np.float32)[loops]
@@ -264,17 +264,25 @@ def _principled(node, owner, out, warnings):
     inputs = node.inputs
     _base_color(inputs["Base Color"], owner, warnings, out)
     for socket, key in PRINCIPLED_INPUTS.items():
-        out[key] = float(_unlinked(inputs[socket], owner, warnings))
-    emission = _unlinked(inputs["Emission"], owner, warnings)[:3] * float(
+        out[key] = float(_unlinked(compat.principled_socket(node, socket), owner, warnings))
+    emission = _unlinked(compat.principled_socket(node, "Emission"), owner, warnings)[:3] * float(
         _unlinked(inputs["Emission Strength"], owner, warnings))
     out["emission"] = np.asarray(emission, np.float32)
     ignored = [s for s, neutral in PRINCIPLED_IGNORED.items()
-               if inputs[s].is_linked or abs(float(inputs[s].default_value) - neutral) > 1e-6]
+               if _ignored_socket_used(node, s, neutral)]
     if ignored:
         warnings.append(f"{owner}: Principled {', '.join(ignored)} not modelled by the light-path "
                         "tracer (ignored).")
     if inputs["Normal"].is_linked:
         warnings.append(f"{owner}: the normal map is ignored by the light-path tracer.")
+
+
+def _ignored_socket_used(node, name, neutral):
+    try:
+        socket = compat.principled_socket(node, name)
+    except KeyError:  # a socket this Blender's Principled BSDF does not have
+        return False
+    return socket.is_linked or abs(float(socket.default_value) - neutral) > 1e-6
 
 
 def _linked_node(socket):

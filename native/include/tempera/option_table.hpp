@@ -93,7 +93,7 @@ std::string format_value(const T& v) {
     return enum_name(v);
   } else if constexpr (std::is_arithmetic_v<T>) {
     std::ostringstream s;
-    s.precision(9);
+    s.precision(std::is_same_v<T, float> ? 7 : 12);  // "2.2", not the float's 2.20000005
     s << v;
     return s.str();
   } else {  // std::vector of numbers

@@ -34,6 +34,11 @@ struct LevelStart {
   // Me Noisy's pixels that join the synthesis only at a finer level.
   const Image* fixed_mask = nullptr;
   const Image* fixed_values = nullptr;
+  // Target images of guide layers at this level (layer index, level-size
+  // image with the layer's channels), replacing the input's: guides that a
+  // method recomputes per level and sweep, such as Bénard's temporal term on
+  // the previous frame's result. Needs uncompressed guides (guide_variance 1).
+  std::vector<std::pair<int, const Image*>> guide_targets;
 };
 
 struct LevelResult {
@@ -80,12 +85,13 @@ class Solver {
  private:
   struct Plan;
   struct Level;
-  void build_level(int level, Level& out, const Image* fixed_mask = nullptr) const;
+  void build_level(int level, Level& out, const LevelStart* start = nullptr) const;
   // Patch space of `level` without features: for moving fields (angles, margins).
   PatchSpace geometry(int level, FeatureImage& source, FeatureImage& target) const;
   OffsetField cold_start(int level, Level& lv, Image& bprime) const;
   void fix_pixels(int level, const Level& lv, const Image* values, OffsetField& field, Image& bprime) const;
   void set_target_style(Level& lv, const Image& bprime) const;
+  void replace_guide_targets(int level, const LevelStart& start, FeatureImage& target) const;
   std::unique_ptr<Plan> plan_;
   SynthesisOptions options_;
   EnergyTerms terms_;

@@ -1,0 +1,53 @@
+"""The `tempera` command of the pip-installed wheel (console script), also
+`python -m tempera`.
+
+`tempera farm ...` and `tempera stylize --scheduler ADDRESS ...` run a shot on
+a Dask cluster (tempera.farm); every other command is the native batch CLI
+(tempera_native/bin/tempera: synth, stylize, render-guides), run with this
+package as the add-on that `render-guides` hands to Blender.
+"""
+import os
+import sys
+from pathlib import Path
+
+PACKAGE_PARENT = Path(__file__).resolve().parent.parent
+
+
+def native_cli():
+    """Path of the native CLI: $TEMPERA_CLI, else the wheel's bin/tempera.
+    Raises FileNotFoundError naming where it looked."""
+    override = os.environ.get("TEMPERA_CLI")
+    if override:
+        path = Path(override)
+    else:
+        try:
+            import tempera_native
+        except ImportError as exc:
+            raise FileNotFoundError(
+                "the tempera CLI is not installed with this package (no tempera_native: "
+                f"{exc}); set TEMPERA_CLI to build/bin/tempera") from exc
+        path = tempera_native.CLI
+    if not (path.is_file() and os.access(path, os.X_OK)):
+        raise FileNotFoundError(f"the tempera CLI '{path}' is missing or not executable")
+    return path
+
+
+def main(argv=None):
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv[:1] == ["farm"] or (argv[:1] == ["stylize"] and any(
+            a == "--scheduler" or a.startswith("--scheduler=") for a in argv)):
+        from .farm import main as farm_main
+
+        return farm_main(argv[1:])
+    try:
+        cli = native_cli()
+    except FileNotFoundError as exc:
+        print(f"tempera: {exc}", file=sys.stderr)
+        return 1
+    env = dict(os.environ)
+    env.setdefault("TEMPERA_ADDON_PATH", str(PACKAGE_PARENT))
+    os.execve(str(cli), [str(cli), *argv], env)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,177 @@
+"""Differences between the Blender versions Tempera runs in, in one place.
+
+Tested: Debian's Blender 3.4, blender.org 4.2 LTS, 4.5 LTS and 5.0 (PyPI
+bpy). Every function here works in all of them; the rest of the add-on, the scene scripts
+(scenes/) and the in-Blender tests call these instead of testing versions
+themselves. Each helper asks Blender for the feature (hasattr, enum items),
+not for a version number, so a point release that back-ports a change is
+handled too.
+
+The breaks handled:
+
+* 4.2: EEVEE's engine id became BLENDER_EEVEE_NEXT (and BLENDER_EEVEE again
+  in 5.0): `eevee_engine()`.
+* 4.0: Principled BSDF sockets renamed (Emission -> Emission Color,
+  Specular -> Specular IOR Level, Transmission -> Transmission Weight, ...):
+  `principled_socket()`.
+* 4.4/5.0: layered actions; Action.fcurves is gone in 5.0 (the F-curves live
+  in the channel bag of the ID's action slot): `action_fcurves()`.
+* 5.0: ImageFormatSettings.media_type must be chosen before file_format
+  (multilayer EXR is its own media type): `set_file_format()` and
+  `IMAGE_FORMAT_SETTINGS` for saving and restoring.
+* 5.0: Scene.node_tree is gone; the compositor is a node group in
+  Scene.compositing_node_group: `compositor_node_tree()` (guide renders
+  switch compositing off, so only scene scripts and tests need it).
+* 5.0: multilayer EXR files name the render passes as the UI does
+  ("Diffuse Direct", "Object Index"), where 3.x/4.x wrote "DiffDir",
+  "IndexOB": `exr_pass_name()` picks the one a file holds.
+* 4.1: Mesh.calc_normals_split() is gone, corner normals are always there
+  (Mesh.corner_normals): `corner_normals()`.
+* 4.0: lights have a soft falloff, on by default: `hard_light_falloff()`.
+* 4.x: the AOV Output node names its AOV in .aov_name: `set_aov_output_name()`.
+* 5.0: the sequencer's Scene.sequence_editor.sequences became .strips
+  (available since 4.4): `sequencer_strips()`.
+
+Two breaks of the list in issue 16 need no helper: Tempera reads its
+settings as RNA properties only (never `scene["tempera"]`, which 5.0 no
+longer maps to bpy.props properties), and it passes no context dictionary to
+operators (4.0 removed that; Context.temp_override exists since 3.2).
+"""
+import bpy
+import numpy as np
+
+from .. import passes
+
+# Principled BSDF sockets: the name Tempera uses (Blender 3.x) -> the 4.0+ name.
+PRINCIPLED_RENAMES = {
+    "Emission": "Emission Color",
+    "Specular": "Specular IOR Level",
+    "Transmission": "Transmission Weight",
+    "Subsurface": "Subsurface Weight",
+    "Sheen": "Sheen Weight",
+    "Clearcoat": "Coat Weight",
+    "Clearcoat Roughness": "Coat Roughness",
+}
+
+
+def _enum_ids(struct, prop):
+    return {item.identifier for item in struct.bl_rna.properties[prop].enum_items}
+
+
+def eevee_engine():
+    """The render engine id of EEVEE in this Blender."""
+    engines = _enum_ids(bpy.context.scene.render, "engine")
+    return "BLENDER_EEVEE_NEXT" if "BLENDER_EEVEE_NEXT" in engines else "BLENDER_EEVEE"
+
+
+def principled_socket(node, name):
+    """The input socket `name` (3.x name) of a Principled BSDF node, under its
+    name in this Blender. KeyError names both if neither exists."""
+    inputs = node.inputs
+    if name in inputs:
+        return inputs[name]
+    renamed = PRINCIPLED_RENAMES.get(name)
+    if renamed is not None and renamed in inputs:
+        return inputs[renamed]
+    raise KeyError(f"{node.bl_idname} '{node.name}' has no input '{name}'"
+                   + (f" nor '{renamed}'" if renamed else ""))
+
+
+def action_fcurves(id_block):
+    """The F-curves animating `id_block` (an object, camera, light, ...):
+    Action.fcurves before 5.0, the channel bag of the ID's action slot in
+    layered actions. An empty list if it is not animated."""
+    anim = getattr(id_block, "animation_data", None)
+    action = anim.action if anim is not None else None
+    if action is None:
+        return []
+    if hasattr(action, "fcurves") and not hasattr(action, "layers"):
+        return list(action.fcurves)
+    slot = getattr(anim, "action_slot", None)
+    if slot is None:
+        return list(action.fcurves)
+    from bpy_extras import anim_utils
+
+    channelbag = anim_utils.action_get_channelbag_for_slot(action, slot)
+    return list(channelbag.fcurves) if channelbag is not None else []
+
+
+def _media_type(file_format):
+    return "MULTI_LAYER_IMAGE" if file_format == "OPEN_EXR_MULTILAYER" else (
+        "VIDEO" if file_format == "FFMPEG" else "IMAGE")
+
+
+def has_media_type(image_settings):
+    return "media_type" in image_settings.bl_rna.properties
+
+
+def set_file_format(image_settings, file_format):
+    """image_settings.file_format = file_format, choosing the media type
+    first where Blender has one (5.0: the formats on offer depend on it)."""
+    if has_media_type(image_settings):
+        image_settings.media_type = _media_type(file_format)
+    image_settings.file_format = file_format
+
+
+# ImageFormatSettings that render code changes, in the order to restore them:
+# media_type (5.0 only; callers skip the names a struct lacks) before
+# file_format before color_depth (what is on offer depends on the one before).
+IMAGE_FORMAT_SETTINGS = ("media_type", "file_format", "color_depth", "exr_codec", "color_mode", "use_preview")
+
+
+def compositor_node_tree(scene, create=False):
+    """The scene's compositor node tree (None if it has none): Scene.node_tree
+    with use_nodes before 5.0, Scene.compositing_node_group in 5.0. With
+    `create`, makes one."""
+    if hasattr(scene, "compositing_node_group"):
+        tree = scene.compositing_node_group
+        if tree is None and create:
+            tree = bpy.data.node_groups.new(f"{scene.name} Compositing", "CompositorNodeTree")
+            scene.compositing_node_group = tree
+        return tree
+    if create and not scene.use_nodes:
+        scene.use_nodes = True
+    return scene.node_tree
+
+
+def exr_pass_name(channels, layer, name):
+    """The name the render pass `name` (short form, 'DiffDir') has in an EXR
+    file with `channels`: see tempera.passes.stored_pass_name (no bpy there,
+    so the guide readers outside Blender share it)."""
+    return passes.stored_pass_name(channels, layer, name)
+
+
+def corner_normals(mesh):
+    """Per-corner (loop) normals of `mesh` as a float64 (loops, 3) array, as
+    Cycles shades them: Mesh.corner_normals (4.1+), or calc_normals_split()
+    and MeshLoop.normal before."""
+    if hasattr(mesh, "corner_normals"):
+        flat = np.empty(len(mesh.corner_normals) * 3, np.float64)
+        mesh.corner_normals.foreach_get("vector", flat)
+    else:
+        mesh.calc_normals_split()
+        flat = np.empty(len(mesh.loops) * 3, np.float64)
+        mesh.loops.foreach_get("normal", flat)
+    return flat.reshape(-1, 3)
+
+
+def hard_light_falloff(light):
+    """Turns off the soft falloff Cycles 4.0+ gives point, spot and area lights
+    by default (no such option, and no soft falloff, before): Tempera's
+    light-path tracer models the hard inverse-square falloff."""
+    if "use_soft_falloff" in light.bl_rna.properties:
+        light.use_soft_falloff = False
+
+
+def set_aov_output_name(node, name):
+    """Makes an AOV Output shader node write the AOV `name` (ShaderNodeOutputAOV.aov_name
+    where it exists, the node's name in 3.x)."""
+    if "aov_name" in node.bl_rna.properties:
+        node.aov_name = name
+    else:
+        node.name = name
+
+
+def sequencer_strips(editor):
+    """The top-level strips of a sequence editor (.strips since 4.4, .sequences before)."""
+    return editor.strips if hasattr(editor, "strips") else editor.sequences

@@ -1,0 +1,170 @@
+// Flamenco 3 job type "tempera": stylize a shot by example with Tempera's CLI.
+//
+// Install: copy this file into the Flamenco Manager's scripts/ folder (next to
+// the flamenco-manager executable) and restart the manager; "Tempera Stylize"
+// then appears among the job types. Every worker needs the `tempera` command
+// (pip install tempera_native-*.whl, or build/bin/tempera) and, for jobs that
+// render guides from a .blend, Blender (the manager's {blender} variable is not
+// used: render-guides runs $TEMPERA_BLENDER or `blender`).
+//
+// The job becomes the same tasks as tempera.farm.plan() (addon/tempera/farm.py,
+// which the tests compare against this file):
+//   exemplar-guides   tempera render-guides EXEMPLAR.blend --frames N     (with an exemplar scene)
+//   guides A-B        tempera render-guides SCENE.blend --frames A-B      (per chunk, with a scene)
+//   stylize A-B       tempera stylize --guides ... --frames A-B --no-video (per chunk; with a temporal
+//                     weight one task per segment, i.e. the whole shot until keyframes exist)
+//   finish            tempera stylize over all frames: sheet and video (every frame is current)
+// Each command resumes, so a task requeued after a worker died redoes only unfinished frames.
+
+const JOB_TYPE = {
+    label: "Tempera Stylize",
+    description: "Stylize a shot by example: guide renders, StyLit synthesis, contact sheet and video",
+    settings: [
+        { key: "frames", type: "string", required: true, description: "Frames, e.g. 1-48 or 1-10,15",
+          eval: "f'{C.scene.frame_start}-{C.scene.frame_end}'", evalInfo: { showLinkButton: true } },
+        { key: "chunk_size", type: "int32", default: 8, description: "Frames per task" },
+        { key: "scene", type: "string", subtype: "file_path", required: false,
+          description: "The shot's .blend; its guides are rendered (empty: use 'guides')",
+          eval: "bpy.data.filepath" },
+        { key: "guides", type: "string", subtype: "dir_path", required: false,
+          description: "The shot's guide cache (default: OUT/guides)" },
+        { key: "exemplar", type: "string", subtype: "file_path", required: true,
+          description: "The painted exemplar (style image)" },
+        { key: "exemplar_guides", type: "string", subtype: "dir_path", required: false,
+          description: "The exemplar's guide cache (or give 'exemplar_scene')" },
+        { key: "exemplar_scene", type: "string", subtype: "file_path", required: false,
+          description: "The exemplar's .blend, rendered into OUT/exemplar_guides" },
+        { key: "exemplar_frame", type: "int32", default: 1, description: "Frame of the exemplar scene" },
+        { key: "out", type: "string", subtype: "dir_path", required: true, description: "Output folder" },
+        // The default is tempera's own (StylitOptions in stylit.hpp); tests/python/test_farm.py checks it.
+        { key: "temporal", type: "float", default: 0.0, description: "Weight of the temporal guide (0 = frames independent)" },
+        { key: "video", type: "bool", default: true, description: "Write stylized.mp4" },
+        { key: "guide_args", type: "string", default: "", description: "Extra render-guides options" },
+        { key: "stylize_args", type: "string", default: "", description: "Extra stylize options" },
+        { key: "tempera", type: "string", default: "tempera", description: "The tempera command on the workers" },
+    ],
+};
+
+function parseFrames(text) {
+    const frames = new Set();
+    for (const raw of String(text).split(",")) {
+        const part = raw.trim();
+        const range = /^(-?\d+)-(-?\d+)$/.exec(part);
+        if (range) {
+            const first = parseInt(range[1], 10), last = parseInt(range[2], 10);
+            if (last < first) throw `bad frame range '${text}': expected e.g. '1-48' or '1-10,15'`;
+            for (let f = first; f <= last; f++) frames.add(f);
+        } else if (/^-?\d+$/.test(part)) {
+            frames.add(parseInt(part, 10));
+        } else {
+            throw `bad frame range '${text}': expected e.g. '1-48' or '1-10,15'`;
+        }
+    }
+    return Array.from(frames).sort((a, b) => a - b);
+}
+
+function formatFrames(frames) {
+    const runs = [];
+    let start = null;
+    frames.forEach((f, i) => {
+        if (start === null) start = f;
+        if (i + 1 === frames.length || frames[i + 1] !== f + 1) {
+            runs.push(start === f ? `${start}` : `${start}-${f}`);
+            start = null;
+        }
+    });
+    return runs.join(",");
+}
+
+function chunkFrames(frames, size) {
+    if (!(size >= 1)) throw `chunk size must be at least 1, not ${size}`;
+    const chunks = [];
+    for (let i = 0; i < frames.length; i += size) chunks.push(frames.slice(i, i + size));
+    return chunks;
+}
+
+function splitArgs(text) {
+    return String(text || "").split(" ").filter((a) => a.length > 0);
+}
+
+// Python's repr() of a float, as tempera.farm writes the temporal weight.
+function pyFloat(x) {
+    return Number.isInteger(x) ? `${x}.0` : `${x}`;
+}
+
+function joinPath(dir, name) {
+    return dir.endsWith("/") ? dir + name : `${dir}/${name}`;
+}
+
+function execCommand(tempera, args) {
+    const words = splitArgs(tempera);
+    return author.Command("exec", { exe: words[0], args: words.slice(1).concat(args) });
+}
+
+function compileJob(job) {
+    const s = job.settings;
+    const frames = parseFrames(s.frames);
+    const chunkSize = s.chunk_size === undefined ? 8 : s.chunk_size;
+    const tempera = s.tempera || "tempera";
+    if (!s.exemplar_guides === !s.exemplar_scene)
+        throw "give the exemplar's guides as exactly one of exemplar_guides and exemplar_scene";
+    if (!s.scene && !s.guides) throw "give the shot as a scene (.blend) or as a guide cache folder";
+    const guides = s.guides || joinPath(s.out, "guides");
+    const guideArgs = splitArgs(s.guide_args);
+
+    let exemplarGuides = s.exemplar_guides;
+    const exemplarTasks = [];
+    if (s.exemplar_scene) {
+        exemplarGuides = joinPath(s.out, "exemplar_guides");
+        const frame = s.exemplar_frame === undefined ? 1 : s.exemplar_frame;
+        const task = author.Task("exemplar-guides", "blender");
+        task.addCommand(execCommand(tempera, ["render-guides", s.exemplar_scene, "--frames", `${frame}`,
+                                              "--out", exemplarGuides].concat(guideArgs)));
+        job.addTask(task);
+        exemplarTasks.push(task);
+    }
+
+    const guideTasks = [];
+    if (s.scene) {
+        for (const chunk of chunkFrames(frames, chunkSize)) {
+            const range = formatFrames(chunk);
+            const task = author.Task(`guides ${range}`, "blender");
+            task.addCommand(execCommand(tempera, ["render-guides", s.scene, "--frames", range,
+                                                  "--out", guides].concat(guideArgs)));
+            job.addTask(task);
+            guideTasks.push({ frames: new Set(chunk), task: task });
+        }
+    }
+
+    // Always stated: the chunks must agree with a single run whatever the CLI's default.
+    let common = ["--guides", guides, "--exemplar", s.exemplar, "--exemplar-guides", exemplarGuides,
+                  "--out", s.out, "--temporal", pyFloat(s.temporal)];
+    common = common.concat(splitArgs(s.stylize_args));
+    // A temporal chain must not be cut: one task per segment (the whole shot for now).
+    const pieces = s.temporal ? [frames] : chunkFrames(frames, chunkSize);
+    const stylizeTasks = [];
+    for (const piece of pieces) {
+        const range = formatFrames(piece);
+        const task = author.Task(`stylize ${range}`, "misc");
+        task.addCommand(execCommand(tempera, ["stylize", "--frames", range].concat(common, ["--no-video"])));
+        for (const t of exemplarTasks) task.addDependency(t);
+        for (const g of guideTasks) {
+            if (piece.some((f) => g.frames.has(f))) task.addDependency(g.task);
+        }
+        job.addTask(task);
+        stylizeTasks.push(task);
+    }
+
+    const finish = author.Task("finish", "misc");
+    const video = s.video === undefined ? true : s.video;
+    finish.addCommand(execCommand(tempera, ["stylize", "--frames", formatFrames(frames)].concat(
+        common, video ? [] : ["--no-video"])));
+    for (const t of stylizeTasks) finish.addDependency(t);
+    job.addTask(finish);
+}
+
+// Flamenco's manager runs this file as a script (JOB_TYPE and compileJob are
+// what it reads); under Node, the tests load it as a module.
+if (typeof module !== "undefined") {
+    module.exports = { JOB_TYPE, compileJob, parseFrames, formatFrames, chunkFrames };
+}

