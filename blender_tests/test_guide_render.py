@@ -237,7 +237,9 @@ def test_settings_come_back_when_rendering_fails(rendered, tmp_path):
     scene = rendered["scene"]
     scene.frame_set(1)
     before = scene_dump(scene)
-    temp_dirs = set(Path(tempfile.gettempdir()).glob("tempera-guides-*"))
+    private_tmp = tmp_path / "systmp"  # this test's own system temporary folder (others share /tmp)
+    private_tmp.mkdir()
+    saved_tempdir, tempfile.tempdir = tempfile.tempdir, str(private_tmp)
 
     class Cancel(Exception):
         pass
@@ -246,12 +248,15 @@ def test_settings_come_back_when_rendering_fails(rendered, tmp_path):
         if done == 1:
             raise Cancel()
 
-    with pytest.raises(Cancel):
-        render_guides(scene, (2, 3), tmp_path / "cache", {"samples": 2, "ld12e_samples": 2}, progress=cancel)
+    try:
+        with pytest.raises(Cancel):
+            render_guides(scene, (2, 3), tmp_path / "cache", {"samples": 2, "ld12e_samples": 2}, progress=cancel)
+    finally:
+        tempfile.tempdir = saved_tempdir
     after = scene_dump(scene)
     assert [k for k in before if before[k] != after.get(k)] == []
     assert bpy.context.window.scene.name == rendered["window_scene"]
-    assert set(Path(tempfile.gettempdir()).glob("tempera-guides-*")) == temp_dirs
+    assert list(private_tmp.iterdir()) == []
     assert sorted(p.name for p in (tmp_path / "cache").iterdir()) == ["frame_0002.exr", "manifest.json"]
 
 

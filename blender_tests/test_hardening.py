@@ -28,18 +28,23 @@ def params(**extra):
     return {**guide_cache.DEFAULT_PARAMS, **PARAMS, **extra}
 
 
-def temp_leftovers():
-    return sorted(p.name for p in Path(tempfile.gettempdir()).glob("tempera-guides-*"))
+@pytest.fixture
+def private_tmp(tmp_path):
+    """The system temporary folder of this test alone (other processes share /tmp)."""
+    folder = tmp_path / "systmp"
+    folder.mkdir()
+    saved, tempfile.tempdir = tempfile.tempdir, str(folder)
+    yield folder
+    tempfile.tempdir = saved
 
 
-def test_interrupted_render_keeps_each_finished_frame(scene, tmp_path):
+def test_interrupted_render_keeps_each_finished_frame(scene, tmp_path, private_tmp):
     from tempera import guide_cache
     from tempera.blender.guide_render import WORK_PREFIX, render_guides
 
     cache = tmp_path / "guides"
     (cache / f"{WORK_PREFIX}1-deadbeef").mkdir(parents=True)  # left by a run killed with -9
     (cache / f"{WORK_PREFIX}1-deadbeef" / "main_7.exr").write_bytes(b"x")
-    before = temp_leftovers()
     messages = []
 
     def progress(done, total, message):
@@ -54,7 +59,7 @@ def test_interrupted_render_keeps_each_finished_frame(scene, tmp_path):
     assert sorted(manifest["frames"]) == [str(FRAMES[0])]
     assert guide_cache.is_frame_current(cache, manifest, FRAMES[0], manifest["frames"][str(FRAMES[0])]["key"])
     assert sorted(p.name for p in cache.iterdir()) == ["frame_0002.exr", "manifest.json"]
-    assert temp_leftovers() == before
+    assert list(private_tmp.iterdir()) == []
     # The rerun renders only the others, and the same guides as an uninterrupted run.
     report = render_guides(scene, FRAMES, cache, params())
     assert report["rendered"] == list(FRAMES[1:]) and report["skipped"] == [FRAMES[0]]

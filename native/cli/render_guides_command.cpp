@@ -81,7 +81,7 @@ int render_guides_in_blender(const BlenderSetup& setup, const std::string& scene
   std::vector<std::string> argv = {setup.blender, "-b", "--factory-startup", scene, "--python-exit-code", "1",
                                    "--python-expr", bootstrap, "--", setup.addon};
   argv.insert(argv.end(), options.begin(), options.end());
-  const int status = run_process(argv);
+  const int status = run_process(argv, false, &g_interrupted);
   // The renderer (render_guides_main.py) prints its own error line and exits
   // 2 (bad values), 3 (files) or 130 (interrupted); anything else means
   // Blender failed before or around it (or is not Blender) and said nothing.

@@ -1,6 +1,7 @@
 #include "tempera/process.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -30,7 +31,7 @@ std::string find_on_path(const std::string& program) {
   return "";
 }
 
-int run_process(const std::vector<std::string>& argv, bool quiet) {
+int run_process(const std::vector<std::string>& argv, bool quiet, const volatile std::sig_atomic_t* interrupted) {
   std::vector<char*> raw;
   for (const auto& a : argv) raw.push_back(const_cast<char*>(a.c_str()));
   raw.push_back(nullptr);
@@ -46,7 +47,14 @@ int run_process(const std::vector<std::string>& argv, bool quiet) {
     _exit(127);
   }
   int status = 0;
+  bool terminated = false;
   while (waitpid(pid, &status, 0) < 0) {
+    // Interrupted by a signal (EINTR): after Ctrl-C, make sure the child
+    // stops too (Blender ignores a Ctrl-C that comes between two renders).
+    if (interrupted && *interrupted && !terminated) {
+      kill(pid, SIGTERM);
+      terminated = true;
+    }
   }
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }

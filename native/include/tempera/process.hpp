@@ -1,6 +1,7 @@
 #pragma once
 // Child processes without a shell (argument lists, never command strings):
 // Blender for guide renders, ffmpeg for videos.
+#include <csignal>
 #include <string>
 #include <vector>
 
@@ -19,7 +20,10 @@ bool encode_video(const std::string& pattern, int first_frame, double fps, const
 // Runs argv (no shell; argv[0] looked up on PATH), waits, returns the exit
 // status (128 + signal if killed, 127 if it could not be started). With
 // `quiet`, stdin is /dev/null and stdout is discarded.
-int run_process(const std::vector<std::string>& argv, bool quiet = false);
+// `interrupted`: a flag set by the caller's SIGINT handler; once set, the
+// child gets SIGTERM (it got the terminal's SIGINT too, which it may ignore).
+int run_process(const std::vector<std::string>& argv, bool quiet = false,
+                const volatile std::sig_atomic_t* interrupted = nullptr);
 
 // Full path of `program` found on PATH, or "" when absent.
 std::string find_on_path(const std::string& program);
