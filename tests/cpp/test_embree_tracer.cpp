@@ -311,7 +311,8 @@ TEST(Tracer, SpotLightIsAPointLightInsideItsCone) {
   s.camera = top_camera(5, 4, 16);  // pixels 0.25 m wide
   const TraceResult r = trace_lpe(s, {"LDE"}, options(16));
   EXPECT_EQ(r.images[0].at(0, 0, 0), 0.0f);  // outside the cone
-  // The pixel at (0.125, 0.125) m is well inside; compare with the point light law.
+  // The pixel at (0.125, 0.125) m is well inside; compare with the point light
+  // law times Cycles' cosine to the spot's axis (1 / sqrt(d2) here).
   const double d2 = 2 * 0.125 * 0.125 + 1;
-  EXPECT_NEAR(r.images[0].at(8, 7, 0), 0.5 / kPi * 10 / std::pow(d2, 1.5), 0.03);
+  EXPECT_NEAR(r.images[0].at(8, 7, 0), 0.5 / kPi * 10 / std::pow(d2, 2.0), 0.03);
 }

@@ -20,6 +20,13 @@ struct TraceOptions {
   // Indirect bounces as Cycles counts them: 0 gives direct light only (one
   // scattering event per path), 8 allows paths of up to nine.
   int max_bounces = 8;
+  // Cycles' per-kind limits (Light Paths > Max Bounces), counted the same
+  // way; a path ends once any count exceeds its limit. Transparent surfaces
+  // are passed without a bounce, up to transparent_bounces of them.
+  int diffuse_bounces = 1024, glossy_bounces = 1024, transmission_bounces = 1024, transparent_bounces = 1024;
+  // Cycles' caustics options: false drops glossy (reflective) or refractive
+  // lobes at a vertex reached by a diffuse bounce, so those paths do not exist.
+  bool caustics_reflective = true, caustics_refractive = true;
 };
 
 struct TraceResult {
