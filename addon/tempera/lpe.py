@@ -47,6 +47,10 @@ def _prepare_scene(scene: dict) -> dict:
             out[key] = _int_array(out[key], key)
     if isinstance(out.get("materials"), (list, tuple)):
         out["materials"] = [_prepare_material(m) for m in out["materials"]]
+    if isinstance(out.get("textures"), (list, tuple)):
+        out["textures"] = [np.ascontiguousarray(t, dtype=np.float32) for t in out["textures"]]
+    if "triangle_visibility" in out:
+        out["triangle_visibility"] = _int_array(out["triangle_visibility"], "triangle_visibility")
     return out
 
 
@@ -77,6 +81,12 @@ def trace_lpe(
     threads: int = 0,
     max_bounces: int = 8,
     progress: Optional[Callable[[float], Optional[bool]]] = None,
+    diffuse_bounces: int = 1024,
+    glossy_bounces: int = 1024,
+    transmission_bounces: int = 1024,
+    transparent_bounces: int = 1024,
+    caustics_reflective: bool = True,
+    caustics_refractive: bool = True,
 ):
     """Render one linear radiance image per light path expression.
 
@@ -84,7 +94,10 @@ def trace_lpe(
     surfaces, world), ``D`` diffuse, ``S`` (or ``G``) glossy/specular
     reflection, ``T`` transmission, ``E`` eye; operators ``. * + ? {m} {m,}
     {m,n} [..] [^..] | ( )``. The result depends only on ``seed``, not on
-    ``threads``. ``max_bounces`` counts indirect bounces as Cycles does.
+    ``threads``. ``max_bounces`` counts indirect bounces as Cycles does, and
+    so do the per-kind limits (``diffuse_bounces`` ...; transparent surfaces
+    count separately). ``caustics_reflective``/``caustics_refractive`` False
+    drop glossy/refractive lobes after a diffuse bounce, as Cycles' options do.
     ``progress(fraction)`` returning False cancels (raises ``tempera.Cancelled``).
 
     Returns ``(images, alpha)``: a list of float32 (H, W, 3) arrays in the
@@ -99,4 +112,9 @@ def trace_lpe(
         return True if progress is None else progress(fraction) is not False
 
     return _native.trace_lpe(_prepare_scene(scene), expressions, samples=int(samples), seed=int(seed),
-                             threads=int(threads), max_bounces=int(max_bounces), progress=report)
+                             threads=int(threads), max_bounces=int(max_bounces), progress=report,
+                             diffuse_bounces=int(diffuse_bounces), glossy_bounces=int(glossy_bounces),
+                             transmission_bounces=int(transmission_bounces),
+                             transparent_bounces=int(transparent_bounces),
+                             caustics_reflective=bool(caustics_reflective),
+                             caustics_refractive=bool(caustics_refractive))

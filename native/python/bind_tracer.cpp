@@ -97,10 +97,89 @@ py::array_t<std::int64_t> integer_array(DictReader& r, const char* key) {
   return a.cast<py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>>();
 }
 
+TextureRef parse_texture_ref(const py::handle& object, const std::string& what) {
+  DictReader r(object, what);
+  TextureRef t;
+  t.image = r.integer("image");
+  if (t.image < 0) throw ValueError(what + ": image must be >= 0");
+  if (r.has("uv")) {
+    const FloatArray uv = shaped(r, "uv", {2, 3});
+    std::copy(uv.data(), uv.data() + 6, t.uv.begin());
+  }
+  t.channel = r.has("channel") ? r.integer("channel") : 4;
+  r.finish();
+  return t;
+}
+
+Factor parse_factor(const py::handle& object, const std::string& what) {
+  DictReader r(object, what);
+  Factor f;
+  const std::string kind = r.text("kind");
+  static const std::pair<const char*, Factor::Kind> kinds[] = {
+      {"constant", Factor::Kind::constant}, {"texture", Factor::Kind::texture}, {"fresnel", Factor::Kind::fresnel},
+      {"layer_fresnel", Factor::Kind::layer_fresnel}, {"layer_facing", Factor::Kind::layer_facing}};
+  bool known = false;
+  for (const auto& [name, k] : kinds)
+    if (kind == name) f.kind = k, known = true;
+  if (!known) throw ValueError(concat(what, ": unknown factor kind '", kind, "'"));
+  f.value = r.number("value", 1);
+  if (f.kind == Factor::Kind::texture) f.texture = parse_texture_ref(r.required("texture"), what + " texture");
+  f.invert = r.has("invert") ? r.required("invert").cast<bool>() : false;
+  r.finish();
+  return f;
+}
+
+Closure parse_closure(const py::handle& object, const std::string& what) {
+  DictReader r(object, what);
+  Closure c;
+  const std::string type = r.text("type");
+  static const std::pair<const char*, Closure::Type> types[] = {
+      {"principled", Closure::Type::principled}, {"diffuse", Closure::Type::diffuse},
+      {"glossy", Closure::Type::glossy}, {"glass", Closure::Type::glass}, {"refraction", Closure::Type::refraction},
+      {"translucent", Closure::Type::translucent}, {"transparent", Closure::Type::transparent},
+      {"emission", Closure::Type::emission}};
+  bool known = false;
+  for (const auto& [name, t] : types)
+    if (type == name) c.type = t, known = true;
+  if (!known) throw ValueError(concat(what, ": unknown closure type '", type, "'"));
+  c.weight = r.float3("weight", c.weight);
+  c.color = r.float3("color", c.color);
+  if (r.has("color_texture")) c.color_texture = parse_texture_ref(r.required("color_texture"), what + " color_texture");
+  c.roughness = r.number("roughness", c.roughness);
+  if (r.has("roughness_texture"))
+    c.roughness_texture = parse_texture_ref(r.required("roughness_texture"), what + " roughness_texture");
+  c.ior = r.number("ior", c.ior);
+  c.metallic = r.number("metallic", c.metallic);
+  c.specular = r.number("specular", c.specular);
+  c.transmission = r.number("transmission", c.transmission);
+  if (r.has("distribution")) {
+    const std::string d = r.text("distribution");
+    if (d == "ggx") c.distribution = Closure::Distribution::ggx;
+    else if (d == "beckmann") c.distribution = Closure::Distribution::beckmann;
+    else if (d == "sharp") c.distribution = Closure::Distribution::sharp;
+    else throw ValueError(concat(what, ": distribution must be 'ggx', 'beckmann' or 'sharp', got '", d, "'"));
+  }
+  if (r.has("factors")) {
+    const py::object factors = r.required("factors");
+    if (!py::isinstance<py::list>(factors)) throw ValueError(what + " 'factors' must be a list");
+    for (const auto& f : factors) c.factors.push_back(parse_factor(f, concat(what, " factor ", c.factors.size())));
+  }
+  r.finish();
+  return c;
+}
+
 Material parse_material(const py::handle& object, std::size_t index) {
   DictReader r(object, concat("scene material ", index));
   Material m;
-  m.base_color = r.float3("base_color");
+  if (r.has("closures")) {
+    const py::object closures = r.required("closures");
+    if (!py::isinstance<py::list>(closures)) throw ValueError(r.what() + " 'closures' must be a list");
+    for (const auto& c : closures)
+      m.closures.push_back(parse_closure(c, concat(r.what(), " closure ", m.closures.size())));
+    m.base_color = r.float3("base_color", m.base_color);
+  } else {
+    m.base_color = r.float3("base_color");
+  }
   m.metallic = r.number("metallic", m.metallic);
   m.specular = r.number("specular", m.specular);
   m.roughness = r.number("roughness", m.roughness);
@@ -150,6 +229,14 @@ Light parse_light(const py::handle& object, std::size_t index) {
   } else {
     throw ValueError(concat(r.what(), ": type must be 'point', 'spot', 'sun' or 'area', got '", type, "'"));
   }
+  if (r.has("soft_shape")) {
+    const std::string shape = r.text("soft_shape");
+    if (shape != "disk" && shape != "sphere")
+      throw ValueError(concat(r.what(), ": soft_shape must be 'disk' or 'sphere', got '", shape, "'"));
+    l.soft_shape = shape == "disk" ? Light::SoftShape::disk : Light::SoftShape::sphere;
+  }
+  if (r.has("visibility")) l.visibility = unsigned(r.integer("visibility"));
+  if (r.has("cast_shadow")) l.cast_shadow = r.required("cast_shadow").cast<bool>();
   r.finish();
   return l;
 }
@@ -220,10 +307,36 @@ Scene parse_scene(const py::handle& object) {
     if (!py::isinstance<py::list>(lights)) throw ValueError("scene 'lights' must be a list of dicts");
     for (const auto& l : lights) s.lights.push_back(parse_light(l, s.lights.size()));
   }
+  if (r.has("textures")) {
+    const py::object textures = r.required("textures");
+    if (!py::isinstance<py::list>(textures)) throw ValueError("scene 'textures' must be a list of arrays");
+    for (const auto& t : textures) {
+      const std::string what = concat("scene texture ", s.textures.size());
+      FloatArray a;
+      try {
+        a = t.cast<FloatArray>();
+      } catch (const py::cast_error&) {
+        throw ValueError(what + " must be numeric");
+      }
+      if (a.ndim() != 3 || a.shape(2) != 4) throw ValueError(what + " must have shape (H, W, 4)");
+      s.textures.push_back(Image::copy_of(py_bridge::view_of(a, what)));
+    }
+  }
   if (r.has("world")) {
     DictReader w(r.required("world"), "scene world");
     s.world_radiance = w.float3("radiance");
+    if (w.has("map")) s.world_map = w.integer("map");
+    if (w.has("rotation")) {
+      const FloatArray m = shaped(w, "rotation", {3, 3});
+      std::copy(m.data(), m.data() + 9, s.world_rotation.begin());
+    }
     w.finish();
+  }
+  if (r.has("triangle_visibility")) {
+    const auto v = integer_array(r, "triangle_visibility");
+    if (v.ndim() != 1 || v.shape(0) != count)
+      throw ValueError(concat("scene 'triangle_visibility' must have shape (", count, ",)"));
+    for (py::ssize_t t = 0; t < count; ++t) s.triangle_visibility.push_back(std::uint8_t(v.at(t) & 0xFF));
   }
   s.camera = parse_camera(r.required("camera"));
   r.finish();
@@ -251,7 +364,8 @@ scene: a dict (unknown or missing keys raise ValueError naming them):
   materials           list of dicts: base_color (3,) required; optional metallic 0,
                       specular 0.5, roughness 0.5, transmission 0, ior 1.45,
                       emission (3,) 0 (radiance W/m^2/sr, strength included),
-                      base_color_texture float32 (H, W, 3) linear (replaces base_color)
+                      base_color_texture float32 (H, W, 3) linear (replaces base_color);
+                      or "closures": a list of Cycles closures (docs/lpe_guides.md)
   lights              optional list of dicts, by "type":
                       point: position, intensity (W/sr), radius 0
                       spot:  position, direction (unit, where it shines), intensity,
@@ -261,7 +375,11 @@ scene: a dict (unknown or missing keys raise ValueError naming them):
                       area:  center, axis_u, axis_v, normal (unit; emits along +normal
                              only), size_u, size_v (full sizes, disk: diameters),
                              radiance (W/m^2/sr), shape "rect" or "disk" ("rect")
-  world               optional {"radiance": (3,)} constant, W/m^2/sr
+  world               optional {"radiance": (3,), "map": texture index, "rotation": (3, 3)}:
+                      constant W/m^2/sr, times an equirectangular map if given
+  textures            optional list of float32 (H, W, 4) linear RGBA images (row 0 top)
+  triangle_visibility optional int (T,) ray visibility bits (camera 1, diffuse 2,
+                      glossy 4, transmission 8, shadow 16)
   camera              type "perspective" | "orthographic", camera_to_world (4, 4)
                       (looks down local -Z, +Y up), width, height (pixels),
                       tan_half_fov_x, tan_half_fov_y (perspective), ortho_width,
@@ -275,13 +393,20 @@ void bind_tracer(py::module_& m) {
   m.def(
       "trace_lpe",
       [](const py::dict& scene_dict, const std::vector<std::string>& expressions, int samples, std::uint64_t seed,
-         int threads, int max_bounces, std::function<bool(double)> progress) {
+         int threads, int max_bounces, std::function<bool(double)> progress, int diffuse_bounces, int glossy_bounces,
+         int transmission_bounces, int transparent_bounces, bool caustics_reflective, bool caustics_refractive) {
         const Scene scene = parse_scene(scene_dict);
         TraceOptions options;
         options.samples = samples;
         options.seed = seed;
         options.threads = threads;
         options.max_bounces = max_bounces;
+        options.diffuse_bounces = diffuse_bounces;
+        options.glossy_bounces = glossy_bounces;
+        options.transmission_bounces = transmission_bounces;
+        options.transparent_bounces = transparent_bounces;
+        options.caustics_reflective = caustics_reflective;
+        options.caustics_refractive = caustics_refractive;
         TraceProgress callback = py_bridge::with_gil([&](double fraction) {
           return progress ? progress(fraction) : true;
         });
@@ -297,7 +422,9 @@ void bind_tracer(py::module_& m) {
         return py::make_tuple(images, alpha);
       },
       py::arg("scene"), py::arg("expressions"), py::arg("samples") = 64, py::arg("seed") = 0, py::arg("threads") = 0,
-      py::arg("max_bounces") = 8, py::arg("progress") = nullptr, kTraceDoc);
+      py::arg("max_bounces") = 8, py::arg("progress") = nullptr, py::arg("diffuse_bounces") = 1024,
+      py::arg("glossy_bounces") = 1024, py::arg("transmission_bounces") = 1024, py::arg("transparent_bounces") = 1024,
+      py::arg("caustics_reflective") = true, py::arg("caustics_refractive") = true, kTraceDoc);
   m.def(
       "check_lpe", [](const std::string& expression) { compile_lpe(expression); }, py::arg("expression"),
       "Raise ValueError (with the 0-based position) if the light path expression is malformed.");

@@ -1,0 +1,121 @@
+"""The validation gallery (scenes/lpe_gallery.py): every scene rendered by
+Cycles with its Light Path passes and traced by Tempera at matched settings
+(same bounce limits, caustics off as in the guide cache), compared buffer
+by buffer after a small blur:
+
+    FULL  = Combined             vs  L.*E
+    LDE   = DiffDir x DiffCol    vs  LDE
+    LSE   = GlossDir x GlossCol  vs  LSE
+    LDDE  = DiffInd x DiffCol    vs  L.*DDE
+
+over the pixels Cycles sees geometry in (alpha > 0.5). Figures:
+* mean error: |mean(tracer) - mean(Cycles)| / mean(Cycles) of the luminance,
+  at most MEAN_TOLERANCE = 5 %;
+* correlation: Pearson's correlation of the blurred luminance images, at
+  least CORRELATION_TOLERANCE = 0.98 (light in the right places).
+A buffer Cycles leaves (nearly) empty, below 1 % of FULL's mean, must be as
+empty in the tracer (its mean below 2 % of FULL's) and is not correlated.
+"""
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "scenes"))
+import lpe_gallery  # noqa: E402
+
+SAMPLES = 64  # Cycles and the tracer alike
+MEAN_TOLERANCE = 0.05
+CORRELATION_TOLERANCE = 0.98
+BLUR = 2  # box radius in pixels: 5 x 5
+BUFFERS = {"FULL": "L.*E", "LDE": "LDE", "LSE": "LSE", "LDDE": "L.*DDE"}
+PASSES = {"Combined": "RGBA", "DiffDir": "RGB", "DiffInd": "RGB", "DiffCol": "RGB", "GlossDir": "RGB",
+          "GlossCol": "RGB"}
+LUMINANCE = np.array([0.2126, 0.7152, 0.0722], np.float32)
+
+
+def box_blur(image, radius=BLUR):
+    """Mean over (2r + 1)^2 pixels, edges clamped."""
+    out = image.astype(np.float64)
+    for axis in (0, 1):
+        padded = np.pad(out, [(radius, radius) if a == axis else (0, 0) for a in range(out.ndim)], mode="edge")
+        c = np.cumsum(padded, axis=axis)
+        c = np.concatenate([np.zeros_like(np.take(c, [0], axis=axis)), c], axis=axis)
+        n = out.shape[axis]
+        out = (np.take(c, range(2 * radius + 1, n + 2 * radius + 1), axis=axis) -
+               np.take(c, range(0, n), axis=axis)) / (2 * radius + 1)
+    return out
+
+
+def compare(traced, reference, mask, full_mean):
+    """(mean error, correlation, reference mean, traced mean) of luminance over `mask`;
+    correlation is None for a buffer Cycles leaves empty."""
+    t, r = traced @ LUMINANCE, reference @ LUMINANCE
+    t_mean, r_mean = float(t[mask].mean()), float(r[mask].mean())
+    if r_mean < 0.01 * full_mean:
+        return None, None, r_mean, t_mean
+    bt, br = box_blur(t)[mask], box_blur(r)[mask]
+    correlation = float(np.corrcoef(bt, br)[0, 1])
+    return abs(t_mean - r_mean) / r_mean, correlation, r_mean, t_mean
+
+
+def cycles_buffers(scene, tmp, samples=SAMPLES):
+    """Cycles' buffers of the scene, with the guide cache's render settings."""
+    from tempera.blender import guide_render
+
+    layer = scene.view_layers[0]
+    guide_render._configure(scene, layer, samples, PASSES, 0)
+    path = guide_render._render(scene, Path(tmp) / f"{scene.name}.exr", 1)
+    p = guide_render._read_passes(path, layer.name, PASSES)
+    rgb = {k: v[:, :, :3] for k, v in p.items()}
+    return {"FULL": rgb["Combined"], "LDE": rgb["DiffDir"] * rgb["DiffCol"],
+            "LSE": rgb["GlossDir"] * rgb["GlossCol"], "LDDE": rgb["DiffInd"] * rgb["DiffCol"],
+            "alpha": p["Combined"][:, :, 3]}
+
+
+def traced_buffers(scene, samples=SAMPLES):
+    """The tracer's buffers at the scene's current settings (after
+    cycles_buffers: caustics off, as Cycles rendered)."""
+    from tempera.blender.scene_export import evaluated_depsgraph, export_scene, path_settings
+    from tempera.lpe import trace_lpe
+
+    size = (scene.render.resolution_x, scene.render.resolution_y)
+    scene_dict, warnings = export_scene(scene, evaluated_depsgraph(scene, scene.view_layers[0], 1), size)
+    images, alpha = trace_lpe(scene_dict, list(BUFFERS.values()), samples=samples, **path_settings(scene))
+    return dict(zip(BUFFERS, images), alpha=alpha), warnings
+
+
+def gallery_figures(cycles, traced):
+    mask = cycles["alpha"] > 0.5
+    full_mean = float((cycles["FULL"] @ LUMINANCE)[mask].mean())
+    return {b: compare(traced[b], cycles[b], mask, full_mean) for b in BUFFERS}, full_mean
+
+
+@pytest.fixture(scope="module")
+def results(tmp_path_factory):
+    return {}
+
+
+@pytest.mark.parametrize("key", list(lpe_gallery.SCENES))
+def test_gallery_scene_matches_cycles(key, tmp_path):
+    scene = lpe_gallery.build(key)
+    try:
+        cycles = cycles_buffers(scene, tmp_path)
+        traced, warnings = traced_buffers(scene)
+    finally:
+        lpe_gallery.remove(scene)
+    figures, full_mean = gallery_figures(cycles, traced)
+    failures = []
+    for buffer, (error, correlation, r_mean, t_mean) in figures.items():
+        if error is None:
+            print(f"{key} {buffer}: empty in Cycles ({r_mean:.4g}), tracer {t_mean:.4g}")
+            if t_mean > 0.02 * full_mean:
+                failures.append(f"{buffer}: Cycles empty, tracer mean {t_mean:.4g}")
+            continue
+        print(f"{key} {buffer}: mean error {error:.4f}, correlation {correlation:.4f} "
+              f"(Cycles {r_mean:.4g}, tracer {t_mean:.4g})")
+        if error > MEAN_TOLERANCE or correlation < CORRELATION_TOLERANCE:
+            failures.append(f"{buffer}: mean error {error:.4f}, correlation {correlation:.4f}")
+    print(f"{key} warnings: {warnings}")
+    assert not failures, f"{key}: " + "; ".join(failures)
