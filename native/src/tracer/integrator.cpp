@@ -230,12 +230,20 @@ class Tracer {
                                Float3 throughput, float previous_pdf, const std::vector<int>& states,
                                std::vector<Float3>& sums) const {
     for (const Light& l : scene_.lights) {
-      if (l.type != Light::Type::area || !(l.visibility & kind)) continue;
+      if (!(l.visibility & kind)) continue;
       float t, pdf;
-      if (!cross_area_light(l, o, d, t_near, t_far, t, pdf)) continue;
-      const float total = travelled + t;
-      pdf *= (total * total) / (t * t);  // NEE measures from the scattering vertex
-      add_emission(states, sums, throughput * l.radiance, mis_weight(previous_pdf, pdf));
+      Float3 radiance = l.radiance;
+      if (l.type == Light::Type::area) {
+        if (!cross_area_light(l, o, d, t_near, t_far, t, pdf)) continue;
+        const float total = travelled + t;
+        pdf *= (total * total) / (t * t);  // NEE measures from the scattering vertex
+      } else if (l.type == Light::Type::point || l.type == Light::Type::spot) {
+        // Measured from this segment's origin: exact unless a transparent surface came between.
+        if (!cross_soft_light(l, o, d, t_near, t_far, t, pdf, radiance)) continue;
+      } else {
+        continue;
+      }
+      add_emission(states, sums, throughput * radiance, mis_weight(previous_pdf, pdf));
     }
   }
 

@@ -60,6 +60,7 @@ bool sample_light(const Light& l, Float3 p, float u1, float u2, LightSample& out
         out.distance = b - std::sqrt(std::fmax(0.0f, b * b - c));
         out.point = p + out.wi * out.distance;
         out.radiance = l.intensity * (solid_angle / (kPi * l.radius * l.radius));
+        out.pdf = 1 / solid_angle;
       } else {
         // A disk of the light's radius facing p (Cycles 3.x's soft point lights).
         const auto disk = sample_disk(u1, u2);
@@ -71,8 +72,9 @@ bool sample_light(const Light& l, Float3 p, float u1, float u2, LightSample& out
         // Radiance I / (pi r^2) over the pdf 1 / (pi r^2) per area, to solid angle.
         const float cos_l = dot(frame.n, out.wi);
         out.radiance = l.intensity * (cos_l / (out.distance * out.distance));
+        // A disk BSDF rays can hit too (l.radius > 0): its pdf per solid angle.
+        out.pdf = l.radius > 0 && cos_l > 0 ? out.distance * out.distance / (kPi * l.radius * l.radius * cos_l) : 0;
       }
-      out.pdf = 0;
       if (l.type == Light::Type::spot) {
         const float attenuation = spot_attenuation(l, -out.wi);
         if (!(attenuation > 0)) return false;
@@ -102,6 +104,35 @@ bool sample_light(const Light& l, Float3 p, float u1, float u2, LightSample& out
     }
   }
   return false;
+}
+
+bool cross_soft_light(const Light& l, Float3 o, Float3 d, float t_near, float t_far, float& t, float& pdf,
+                      Float3& radiance) {
+  if (!(l.radius > 0)) return false;
+  const Float3 to_centre = l.position - o;
+  const float d0 = length(to_centre);
+  if (!(d0 > l.radius)) return false;
+  const float r2 = l.radius * l.radius;
+  if (l.soft_shape == Light::SoftShape::sphere) {
+    const float b = dot(d, to_centre), c = d0 * d0 - r2, disc = b * b - c;
+    if (disc < 0 || b <= 0) return false;
+    t = b - std::sqrt(disc);
+    const float cos_max = std::sqrt(std::fmax(0.0f, 1 - r2 / (d0 * d0)));
+    pdf = 1 / (2 * kPi * (1 - cos_max));
+  } else {
+    // The disk facing the ray's origin (Cycles 3.x).
+    const Float3 n = to_centre / d0;  // from the origin towards the light
+    const float cos_l = dot(d, n);
+    if (cos_l <= 0) return false;
+    t = d0 / cos_l;
+    const Float3 q = o + d * t - l.position;
+    if (dot(q, q) > r2) return false;
+    pdf = t * t / (kPi * r2 * cos_l);
+  }
+  if (!(t > t_near && t < t_far)) return false;
+  radiance = l.intensity / (kPi * r2);
+  if (l.type == Light::Type::spot) radiance = radiance * spot_attenuation(l, -d);
+  return max_component(radiance) > 0;
 }
 
 bool cross_area_light(const Light& l, Float3 o, Float3 d, float t_near, float t_far, float& t, float& pdf) {

@@ -28,6 +28,13 @@ float area_of(const Light& l);
 // (t_near, t_far): its distance, and the pdf (solid angle) of NEE choosing it.
 bool cross_area_light(const Light& l, Float3 o, Float3 d, float t_near, float t_far, float& t, float& pdf);
 
+// Where the ray (o, d) hits the disk (or sphere) of a point or spot light
+// with a radius, within (t_near, t_far): distance, NEE pdf (solid angle)
+// and radiance (spot attenuation included). Cycles' soft lights are
+// reachable by BSDF rays.
+bool cross_soft_light(const Light& l, Float3 o, Float3 d, float t_near, float t_far, float& t, float& pdf,
+                      Float3& radiance);
+
 // Converts a point sampled on an emitting surface (pdf per area) to a
 // direction sample; one-sided unless two_sided.
 bool to_area_sample(Float3 to_x, Float3 normal, Float3 radiance, float pdf_area, LightSample& out,
