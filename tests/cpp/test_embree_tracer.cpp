@@ -316,3 +316,153 @@ TEST(Tracer, SpotLightIsAPointLightInsideItsCone) {
   const double d2 = 2 * 0.125 * 0.125 + 1;
   EXPECT_NEAR(r.images[0].at(8, 7, 0), 0.5 / kPi * 10 / std::pow(d2, 2.0), 0.03);
 }
+
+// ------------------------------------------------------------------ Cycles closures
+
+namespace {
+
+Closure closure(Closure::Type type, Float3 color, float roughness = 0.5f) {
+  Closure c;
+  c.type = type;
+  c.color = color;
+  c.roughness = roughness;
+  return c;
+}
+
+Material of(std::vector<Closure> closures) {
+  Material m;
+  m.closures = std::move(closures);
+  return m;
+}
+
+Factor constant(float value, bool invert) {
+  Factor f;
+  f.value = value;
+  f.invert = invert;
+  return f;
+}
+
+}  // namespace
+
+TEST(Tracer, MixShaderWeightsItsClosures) {
+  Scene s = sun_scene(1);
+  Closure a = closure(Closure::Type::diffuse, {0.8f, 0.8f, 0.8f}), b = closure(Closure::Type::diffuse, {0.2f, 0.4f, 0.6f});
+  a.factors = {constant(0.3f, true)};  // the first shader: 1 - fac
+  b.factors = {constant(0.3f, false)};
+  s.materials = {of({a, b})};
+  const TraceResult r = trace_lpe(s, {"LDE", "LSE"}, options(64));
+  for (int c = 0; c < 3; ++c) {
+    const double albedo = 0.7 * 0.8 + 0.3 * (0.2 + 0.2 * c);
+    EXPECT_NEAR(mean(r.images[0], c), albedo / kPi * (2 + c), 0.02 * albedo / kPi * (2 + c));
+  }
+  EXPECT_EQ(mean(r.images[1]), 0.0);  // Diffuse BSDFs have no glossy lobe
+}
+
+TEST(Tracer, GlossyClosureIsOnlyS) {
+  Scene s = sun_scene(0.9f);
+  s.materials = {of({closure(Closure::Type::glossy, {1, 1, 1}, 0.6f)})};
+  const TraceResult r = trace_lpe(s, {"LDE", "LSE"}, options(16));
+  EXPECT_EQ(mean(r.images[0]), 0.0);
+  EXPECT_GT(mean(r.images[1]), 0.01);
+}
+
+TEST(Tracer, FresnelFactorAtNormalIncidence) {
+  // Seen and lit from straight above, a Fresnel(1.5) mix keeps 1 - 0.04 of the diffuse.
+  Scene s = sun_scene(1);
+  Closure d = closure(Closure::Type::diffuse, {0.5f, 0.5f, 0.5f});
+  Factor f;
+  f.kind = Factor::Kind::fresnel;
+  f.value = 1.5f;
+  f.invert = true;
+  d.factors = {f};
+  s.materials = {of({d})};
+  const TraceResult r = trace_lpe(s, {"LDE"}, options(16));
+  const double expected = 0.96 * 0.5 / kPi * 2;
+  EXPECT_NEAR(mean(r.images[0], 0), expected, 0.01 * expected);
+}
+
+TEST(Tracer, TransparentSurfaceIsPassedWithoutAnEvent) {
+  // A half-transparent black sheet between the camera, the sun and the floor:
+  // the floor is seen through it (x 0.5) and lit through it (x 0.5), and the
+  // path is still LDE.
+  Scene s = sun_scene(1);
+  s.materials.push_back(of({closure(Closure::Type::transparent, {0.5f, 0.5f, 0.5f})}));
+  add_quad(s, {-100, -100, 1}, {100, -100, 1}, {100, 100, 1}, {-100, 100, 1}, 1);
+  const TraceResult r = trace_lpe(s, {"LDE", "L.*E"}, options(32));
+  const double expected = 0.25 * 0.6 / kPi * 2;
+  EXPECT_NEAR(mean(r.images[0], 0), expected, 0.02 * expected);
+  EXPECT_NEAR(mean(r.images[1], 0), expected, 0.02 * expected);
+}
+
+TEST(Tracer, TranslucentLightsThroughTheSurfaceAsD) {
+  Scene s = sun_scene(1);
+  s.lights[0].direction = {0, 0, -1};  // the sun is below the sheet
+  s.materials = {of({closure(Closure::Type::translucent, {0.6f, 0.6f, 0.6f})})};
+  const TraceResult r = trace_lpe(s, {"LDE"}, options(32));
+  EXPECT_NEAR(mean(r.images[0], 0), 0.6 / kPi * 2, 0.02 * 0.6 / kPi * 2);
+}
+
+TEST(Tracer, EnvironmentMapIsImportanceSampledAndUpIsTheTopRow) {
+  // A map bright above the horizon only: a white plane facing up sees pi x 1.
+  Scene s;
+  s.materials = {lambert(1.0f)};
+  add_floor(s, 1000, 0);
+  Image map(64, 32, 4);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 64; ++x)
+      for (int c = 0; c < 3; ++c) map.at(x, y, c) = 1;
+  s.textures = {map};
+  s.world_map = 0;
+  s.world_radiance = {1, 1, 1};
+  s.camera = top_camera(5, 2, 8);
+  const TraceResult r = trace_lpe(s, {"LDE"}, options(64));
+  EXPECT_NEAR(mean(r.images[0]), 1.0, 0.02);
+}
+
+TEST(Tracer, BounceLimitsAndCausticsOptionsRemovePaths) {
+  // A diffuse floor and a glossy wall under a sun.
+  Scene s = sun_scene(0.7f);
+  s.materials.push_back(of({closure(Closure::Type::glossy, {0.9f, 0.9f, 0.9f}, 0.3f)}));
+  add_quad(s, {-2, 1, 0}, {2, 1, 0}, {2, 1, 3}, {-2, 1, 3}, 1);
+  s.camera = top_camera(5, 4, 16);
+  TraceOptions o = options(16);
+  const TraceResult all = trace_lpe(s, {"L.*DDE", "LS+DE", "LDE"}, o);
+  EXPECT_GT(mean(all.images[1]), 0.0);
+  o.diffuse_bounces = 0;
+  o.caustics_reflective = false;
+  const TraceResult cut = trace_lpe(s, {"L.*DDE", "LS+DE", "LDE"}, o);
+  EXPECT_EQ(mean(cut.images[0]), 0.0);  // no second diffuse bounce
+  EXPECT_EQ(mean(cut.images[1]), 0.0);  // no glossy lobe after a diffuse bounce
+  EXPECT_NEAR(mean(cut.images[2]), mean(all.images[2]), 1e-6);  // direct light untouched
+}
+
+TEST(Tracer, RayVisibilityHidesFromCameraButNotFromShadows) {
+  Scene s = sun_scene(1);
+  s.materials.push_back(lambert(0.5f));
+  add_quad(s, {-100, -100, 1}, {100, -100, 1}, {100, 100, 1}, {-100, 100, 1}, 1);
+  s.triangle_visibility = {kVisibleAll, kVisibleAll, kVisibleAll & ~kVisibleCamera, kVisibleAll & ~kVisibleCamera};
+  const TraceResult r = trace_lpe(s, {"LDE"}, options(4));
+  EXPECT_EQ(mean(r.alpha), 1.0);       // the camera sees the floor
+  EXPECT_EQ(mean(r.images[0]), 0.0);  // which the hidden sheet still shadows
+}
+
+TEST(Tracer, SoftPointLightAsDiskOrSphere) {
+  // Far from the light both shapes give the point light's law; the sphere is
+  // also reached by BSDF rays (MIS), the disk facing the shaded point too.
+  for (const auto shape : {Light::SoftShape::disk, Light::SoftShape::sphere}) {
+    Scene s;
+    s.materials = {lambert(0.5f)};
+    add_floor(s, 100, 0);
+    Light point;
+    point.type = Light::Type::point;
+    point.position = {0, 0, 3};
+    point.radius = 0.3f;
+    point.soft_shape = shape;
+    point.intensity = {10, 10, 10};
+    s.lights = {point};
+    s.camera = top_camera(2.5f, 0.2f, 4);
+    const TraceResult r = trace_lpe(s, {"LDE"}, options(256));
+    const double expected = 0.5 / kPi * 10 / 9;
+    EXPECT_NEAR(mean(r.images[0]), expected, 0.03 * expected) << int(shape);
+  }
+}
