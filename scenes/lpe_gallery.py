@@ -324,10 +324,10 @@ def s_mix_glossy_diffuse(name):
 
 def s_fresnel_beckmann(name):
     scene = base_scene(name)
-    _sphere(scene, mix_glossy_diffuse(f"{name} sphere", (0.1, 0.5, 0.2), 0.25, 0.0, "BECKMANN",
+    _sphere(scene, mix_glossy_diffuse(f"{name} sphere", (0.1, 0.5, 0.2), 0.4, 0.0, "BECKMANN",
                                       ("ShaderNodeFresnel", {"IOR": 1.6}, "Fac")))
     _cube(scene, diffuse(f"{name} cube", (0.7, 0.7, 0.2)))
-    add_light(scene, "AREA", 400.0, (1.8, -1.5, 2.8), SPHERE_AT, shape="RECTANGLE", size=1.2, size_y=0.6)
+    add_light(scene, "AREA", 600.0, (1.8, -1.5, 2.8), SPHERE_AT, shape="RECTANGLE", size=2.0, size_y=1.0)
     return scene
 
 
