@@ -441,7 +441,7 @@ def test_materials_become_cycles_closures():
     bsdf = tree.nodes["Principled BSDF"]
     for name, value in (("Metallic", 0.3), ("Specular", 0.6), ("Roughness", 0.2), ("Transmission", 0.1),
                         ("IOR", 1.5), ("Emission Strength", 2.0)):
-        bsdf.inputs[name].default_value = value
+        bsdf.inputs[name].default_value = value  # Principled v1 socket names (Blender 3.4)
     bsdf.inputs["Emission"].default_value = (1.0, 0.5, 0.0, 1)
     image = bpy.data.images.new("LPE texture", 2, 2)  # a byte image in sRGB
     image.pixels = [0.5, 0.5, 0.5, 1, 1, 0, 0, 1,  # bottom row: grey, red
@@ -465,7 +465,10 @@ def test_materials_become_cycles_closures():
     # Mix Shader by Fresnel of a Diffuse and a Glossy, inside a node group.
     mixed, tree, surface = _surface_tree("LPE mixed")
     group = bpy.data.node_groups.new("LPE group", "ShaderNodeTree")
-    group.outputs.new("NodeSocketShader", "Shader")
+    if hasattr(group, "interface"):  # Blender 4
+        group.interface.new_socket("Shader", in_out="OUTPUT", socket_type="NodeSocketShader")
+    else:
+        group.outputs.new("NodeSocketShader", "Shader")
     g_out = group.nodes.new("NodeGroupOutput")
     diffuse = group.nodes.new("ShaderNodeBsdfDiffuse")
     diffuse.inputs["Color"].default_value = (0.7, 0.1, 0.1, 1)

@@ -130,3 +130,27 @@ def test_gallery_scene_matches_cycles(key, tmp_path):
             failures.append(f"{buffer}: mean error {error:.4f}, correlation {correlation:.4f}")
     print(f"{key} warnings: {warnings}")
     assert not failures, f"{key}: " + "; ".join(failures)
+
+
+def test_gallery_figures_catch_a_wrong_material(tmp_path):
+    """The figures are not lenient: the Mix Shader sphere traced as what the
+    exporter used to make of it (a diffuse surface of a viewport white) fails them."""
+    from tempera.blender.scene_export import evaluated_depsgraph, export_scene, path_settings
+    from tempera.lpe import trace_lpe
+
+    scene = lpe_gallery.build("mix_glossy_diffuse")
+    try:
+        cycles = cycles_buffers(scene, tmp_path)
+        size = (scene.render.resolution_x, scene.render.resolution_y)
+        scene_dict, _ = export_scene(scene, evaluated_depsgraph(scene, scene.view_layers[0], 1), size)
+        mixed = [i for i, m in enumerate(scene_dict["materials"]) if len(m["closures"]) == 2]
+        assert len(mixed) == 1  # the sphere's Mix Shader: a diffuse and a glossy closure
+        scene_dict["materials"][mixed[0]] = {"base_color": np.full(3, 0.8, np.float32)}
+        images, _ = trace_lpe(scene_dict, list(BUFFERS.values()), samples=SAMPLES, **path_settings(scene))
+    finally:
+        lpe_gallery.remove(scene)
+    figures, _ = gallery_figures(cycles, dict(zip(BUFFERS, images)))
+    failing = [b for b, (e, c, _, _) in figures.items()
+               if e is not None and (e > MEAN_TOLERANCE or c < CORRELATION_TOLERANCE)]
+    print(f"wrong material: failing buffers {failing}")
+    assert {"FULL", "LDE"} <= set(failing)
