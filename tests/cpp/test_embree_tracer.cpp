@@ -44,11 +44,12 @@ void add_sphere(Scene& s, Float3 centre, float radius, int material, int rings =
     }
 }
 
-Material lambert(float albedo) {
+Material lambert(float albedo) {  // a Diffuse BSDF
+  Closure c;
+  c.type = Closure::Type::diffuse;
+  c.color = {albedo, albedo, albedo};
   Material m;
-  m.base_color = {albedo, albedo, albedo};
-  m.specular = 0;
-  m.roughness = 1;
+  m.closures = {c};
   return m;
 }
 
@@ -158,8 +159,10 @@ TEST(Tracer, DiskAreaLightMatchesClosedForm) {
 TEST(Tracer, EmissiveQuadLightsLikeAnAreaLight) {
   // Camera between the light (z = 1) and the floor, so it only sees the floor.
   Scene emissive;
-  emissive.materials = {lambert(0.5f), lambert(0.0f)};
-  emissive.materials[1].emission = {2, 2, 2};
+  Material glow;  // the Principled-like format: black, emitting
+  glow.base_color = {0, 0, 0};
+  glow.emission = {2, 2, 2};
+  emissive.materials = {lambert(0.5f), glow};
   add_floor(emissive, 100, 0);
   add_quad(emissive, {-0.5f, -0.5f, 1}, {-0.5f, 0.5f, 1}, {0.5f, 0.5f, 1}, {0.5f, -0.5f, 1}, 1);
   emissive.camera = top_camera(0.5f, 2, 8);
@@ -206,7 +209,7 @@ TEST(Tracer, CausticsNeedAMirror) {
   mirror.roughness = 0;
   s.materials.push_back(mirror);
   add_sphere(s, {0, 0, 1.5f}, 0.5f, 1);
-  const TraceResult with = trace_lpe(s, caustics, options(16));
+  const TraceResult with = trace_lpe(s, caustics, options(128));  // caustic paths are rare
   EXPECT_GT(mean(with.images[0]), 0.0);
 }
 
@@ -321,7 +324,7 @@ TEST(Tracer, SpotLightIsAPointLightInsideItsCone) {
 
 namespace {
 
-Closure closure(Closure::Type type, Float3 color, float roughness = 0.5f) {
+Closure closure(Closure::Type type, Float3 color, float roughness = 0) {
   Closure c;
   c.type = type;
   c.color = color;
@@ -420,8 +423,9 @@ TEST(Tracer, EnvironmentMapIsImportanceSampledAndUpIsTheTopRow) {
 }
 
 TEST(Tracer, BounceLimitsAndCausticsOptionsRemovePaths) {
-  // A diffuse floor and a glossy wall under a sun.
+  // A diffuse floor and a glossy wall (facing -y) under a sun that lights both.
   Scene s = sun_scene(0.7f);
+  s.lights[0].direction = normalize(Float3{0.3f, -0.65f, 0.7f});
   s.materials.push_back(of({closure(Closure::Type::glossy, {0.9f, 0.9f, 0.9f}, 0.3f)}));
   add_quad(s, {-2, 1, 0}, {2, 1, 0}, {2, 1, 3}, {-2, 1, 3}, 1);
   s.camera = top_camera(5, 4, 16);
@@ -465,4 +469,14 @@ TEST(Tracer, SoftPointLightAsDiskOrSphere) {
     const double expected = 0.5 / kPi * 10 / 9;
     EXPECT_NEAR(mean(r.images[0]), expected, 0.03 * expected) << int(shape);
   }
+}
+
+TEST(Tracer, DiffuseRoughnessIsOrenNayar) {
+  // Lit and seen from straight above, Cycles' Oren-Nayar (Fujii) gives
+  // albedo x E / (pi + (3 pi - 4) / 6 sigma): darker than Lambert.
+  Scene s = sun_scene(1);
+  s.materials = {of({closure(Closure::Type::diffuse, {0.6f, 0.6f, 0.6f}, 0.8f)})};
+  const TraceResult r = trace_lpe(s, {"LDE"}, options(16));
+  const double expected = 0.6 * 2 / (kPi + (3 * kPi - 4) / 6 * 0.8);
+  EXPECT_NEAR(mean(r.images[0], 0), expected, 0.01 * expected);
 }

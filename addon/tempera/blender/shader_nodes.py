@@ -431,12 +431,10 @@ class ShaderInterpreter:
             return _scaled(a, fac, invert=True) + _scaled(b, fac, invert=False)
         if kind == "ShaderNodeAddShader":
             return self.closures(inp[0], ctx) + self.closures(inp[1], ctx)
-        if kind == "ShaderNodeBsdfDiffuse":
-            roughness = self.scalar(inp["Roughness"], ctx)
-            if not roughness.constant or float(roughness.const) > 1e-3:
-                self.warn(f"Diffuse BSDF '{node.name}': roughness (Oren-Nayar) is not modelled; Lambert is used.")
+        if kind == "ShaderNodeBsdfDiffuse":  # Lambert, Oren-Nayar with a roughness
             self._normal_ignored(node)
-            return [self._closure("diffuse", color=self.color(inp["Color"], ctx))]
+            return [self._closure("diffuse", color=self.color(inp["Color"], ctx),
+                                  roughness=self.scalar(inp["Roughness"], ctx))]
         if kind in ("ShaderNodeBsdfGlossy", "ShaderNodeBsdfAnisotropic"):
             return [self.glossy(node, ctx)]
         if kind in ("ShaderNodeBsdfGlass", "ShaderNodeBsdfRefraction"):

@@ -66,8 +66,8 @@ struct Factor {
 // reflections S, refraction T; transparent is no event (the path goes on).
 struct Closure {
   enum class Type {
-    principled,   // Principled BSDF (v1 model: Lambert + GGX with Schlick Fresnel + smooth glass)
-    diffuse,      // Lambert
+    principled,   // Principled BSDF (v1 model: Disney diffuse + GGX with Schlick Fresnel + smooth glass)
+    diffuse,      // Lambert, or Oren-Nayar with a roughness
     glossy,       // microfacet reflection tinted by color, no Fresnel (Glossy, Anisotropic)
     glass,        // smooth dielectric: Fresnel reflection S + refraction T, both tinted
     refraction,   // smooth refraction only, tinted, no Fresnel
@@ -80,7 +80,7 @@ struct Closure {
   std::vector<Factor> factors;
   Float3 color{0.8f, 0.8f, 0.8f};
   TextureRef color_texture;  // replaces color (rgb)
-  float roughness = 0.5f;    // Blender's: alpha = roughness^2; below 0.01 singular
+  float roughness = 0;       // Blender's: alpha = roughness^2, below 0.01 singular; Diffuse: Oren-Nayar sigma
   TextureRef roughness_texture;  // replaces roughness (its channel)
   float ior = 1.45f;
   // Principled only:

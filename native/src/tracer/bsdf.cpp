@@ -104,7 +104,8 @@ void add_principled(ShadingPoint& s, Float3 weight, Float3 base, float metallic,
   const float specular_f0 = 0.08f * std::max(specular, 0.0f);
   const Float3 f0 = Float3{specular_f0, specular_f0, specular_f0} * (1 - metallic) + base * metallic;
   Lobe diffuse;
-  diffuse.kind = LobeKind::lambert;
+  diffuse.kind = LobeKind::principled_diffuse;
+  diffuse.a = roughness;
   diffuse.weight = weight * base * ((1 - metallic) * (1 - transmission));
   add_lobe(s, diffuse);
   add_lobe(s, reflection_lobe(weight * (1 - (1 - metallic) * transmission), roughness, false, FresnelMode::schlick,
@@ -126,10 +127,22 @@ void add_closure(const Scene& scene, ShadingPoint& s, const Closure& c, const Su
       add_principled(s, weight, color, c.metallic, c.specular, closure_roughness(scene, c, at), c.transmission,
                      c.ior);
       break;
-    case Closure::Type::diffuse:
+    case Closure::Type::diffuse: {
+      Lobe l;
+      l.weight = weight * color;
+      const float sigma = closure_roughness(scene, c, at);
+      if (sigma > 0) {  // Cycles' Oren-Nayar (Fujii's form), roughness as sigma
+        l.kind = LobeKind::oren_nayar;
+        const float div = 1 / (kPi + ((3 * kPi - 4) / 6) * sigma);
+        l.a = div;
+        l.b = sigma * div;
+      }
+      add_lobe(s, l);
+      break;
+    }
     case Closure::Type::translucent: {
       Lobe l;
-      l.kind = c.type == Closure::Type::diffuse ? LobeKind::lambert : LobeKind::translucent;
+      l.kind = LobeKind::translucent;
       l.weight = weight * color;
       add_lobe(s, l);
       break;
@@ -260,6 +273,27 @@ LobeValue evaluate(const ShadingPoint& s, const Lobe& l, Float3 wi) {
   }
   if (cos_i <= 0 || dot(s.ng, wi) <= 0) return {};
   if (l.kind == LobeKind::lambert) return {l.weight * (cos_i / kPi), cos_i / kPi};
+  if (l.kind == LobeKind::oren_nayar) {
+    const float cos_v = std::max(dot(s.n, s.wo), 0.0f);
+    float t = dot(wi, s.wo) - cos_i * cos_v;
+    if (t > 0) t /= std::max(cos_i, cos_v) + 1e-30f;
+    return {l.weight * (cos_i * (l.a + l.b * t)), cos_i / kPi};
+  }
+  if (l.kind == LobeKind::principled_diffuse) {
+    // Disney's diffuse as Cycles 3.x's Principled BSDF has it: Fresnel-shaped
+    // darkening at grazing angles plus roughness-driven retro-reflection.
+    const float cos_v = std::max(dot(s.n, s.wo), 0.0f);
+    auto schlick_weight = [](float c) {
+      const float m = std::clamp(1 - c, 0.0f, 1.0f);
+      return m * m * m * m * m;
+    };
+    const float fl = schlick_weight(cos_i), fv = schlick_weight(cos_v);
+    const Float3 h = normalize(wi + s.wo);
+    const float cos_lh = dot(wi, h);
+    const float rr = 2 * l.a * cos_lh * cos_lh;
+    const float value = (1 - 0.5f * fl) * (1 - 0.5f * fv) + rr * (fl + fv + fl * fv * (rr - 1));
+    return {l.weight * (cos_i * value / kPi), cos_i / kPi};
+  }
   const float cos_o = dot(s.n, s.wo);
   if (cos_o <= 0) return {};
   const Float3 h = normalize(wi + s.wo);
@@ -328,7 +362,7 @@ bool sample(const ShadingPoint& s, Rng& rng, Scatter& out) {
     return true;
   }
   Float3 wi;
-  if (l.kind == LobeKind::lambert) {
+  if (l.kind == LobeKind::lambert || l.kind == LobeKind::oren_nayar || l.kind == LobeKind::principled_diffuse) {
     wi = Frame(s.n).to_world(sample_cosine(u1, u2));
   } else if (l.kind == LobeKind::translucent) {
     wi = Frame(-s.n).to_world(sample_cosine(u1, u2));

@@ -16,13 +16,16 @@ namespace tempera::tracer {
 constexpr float kSingularRoughness = 0.01f;  // below: a perfect mirror / smooth glass
 constexpr int kMaxLobes = 16;
 
-enum class LobeKind { lambert, translucent, microfacet, mirror, dielectric };
+// lambert: Diffuse BSDF; oren_nayar: Diffuse BSDF with roughness (Cycles' Fujii form);
+// principled_diffuse: Principled v1's diffuse with its retro-reflection.
+enum class LobeKind { lambert, oren_nayar, principled_diffuse, translucent, microfacet, mirror, dielectric };
 enum class FresnelMode { none, schlick, dielectric };
 
 struct Lobe {
   LobeKind kind = LobeKind::lambert;
   Float3 weight;            // colour times closure weight
   float alpha2 = 0;         // microfacet: alpha^2
+  float a = 0, b = 0;       // oren_nayar: A, B; principled_diffuse: a = roughness
   bool beckmann = false;    // microfacet: Beckmann instead of GGX
   FresnelMode fresnel = FresnelMode::none;
   Float3 f0;                // schlick
@@ -30,10 +33,11 @@ struct Lobe {
   bool reflect = true, refract = true;  // dielectric: which parts exist (refraction-only closures, caustic filter)
   float pick = 0;           // selection probability
   bool singular() const { return kind == LobeKind::mirror || kind == LobeKind::dielectric; }
-  LpeEvent event() const {
-    return kind == LobeKind::lambert || kind == LobeKind::translucent ? LpeEvent::D : LpeEvent::S;
+  bool diffuse() const {
+    return kind == LobeKind::lambert || kind == LobeKind::oren_nayar || kind == LobeKind::principled_diffuse ||
+           kind == LobeKind::translucent;
   }
-  bool diffuse() const { return kind == LobeKind::lambert || kind == LobeKind::translucent; }
+  LpeEvent event() const { return diffuse() ? LpeEvent::D : LpeEvent::S; }
 };
 
 struct ShadingPoint {
