@@ -464,6 +464,25 @@ def s_ray_visibility(name):
     cube_obj = _cube(scene, diffuse(f"{name} cube", (0.9, 0.2, 0.2)))
     cube_obj.visible_diffuse = False  # no red bleeding onto the floor
     _key(scene)
+    # Lights' own visibility: one that lights only glossy lobes (none here:
+    # it must add nothing), one that casts no shadows.
+    glossy_only = add_light(scene, "POINT", 800.0, (-2.0, -1.5, 2.5), shadow_soft_size=0.3)
+    glossy_only.visible_diffuse = False
+    unshadowed = add_light(scene, "AREA", 150.0, (-0.5, 1.0, 2.8), (0, 0, 0), shape="SQUARE", size=0.5)
+    unshadowed.data.cycles.cast_shadow = False
+    return scene
+
+
+def s_glass(name):
+    """A sharp Glass sphere and a Refraction cube: seen through, and their
+    (opaque, caustics off) shadows."""
+    scene = base_scene(name)
+    _sphere(scene, glass(f"{name} sphere"))
+    mat, tree, out = _tree(f"{name} cube")
+    node = _node(tree, "ShaderNodeBsdfRefraction", Color=(0.8, 0.9, 0.8, 1), IOR=1.3, _distribution="SHARP")
+    tree.links.new(node.outputs[0], out.inputs["Surface"])
+    _cube(scene, mat)
+    _key(scene, radius=1.0)  # a large reflection in the glass: LSE not dominated by noise
     return scene
 
 
@@ -498,6 +517,7 @@ SCENES = {
     "translucent_transparent": s_translucent_transparent,
     "bounce_limits": s_bounce_limits,
     "ray_visibility": s_ray_visibility,
+    "glass": s_glass,
     "public_style": s_public_style,
 }
 
