@@ -170,9 +170,10 @@ struct Scene {
   std::vector<Light> lights;
   Float3 world_radiance;  // constant, W/m^2/sr; multiplies world_map if there is one
   // Optional equirectangular environment (Blender's Environment Texture):
-  // an index into textures. A world direction d is turned by world_rotation
-  // (row-major 3x3, the inverse of the Mapping node's rotation), then read at
-  // u = 0.5 - atan2(y, x) / (2 pi), v = 0.5 + asin(z) / pi.
+  // an index into textures. A world direction d is turned into the map's
+  // frame by world_rotation (row-major 3x3 M, d' = M d: the rotation of a
+  // Point-type Mapping node in front of the texture), then read at
+  // u = 0.5 - atan2(y', x') / (2 pi), v = 0.5 + asin(z') / pi.
   int world_map = -1;
   std::array<float, 9> world_rotation{1, 0, 0, 0, 1, 0, 0, 0, 1};
   std::vector<Image> textures;  // RGBA float images referenced by TextureRef and world_map
