@@ -486,6 +486,23 @@ def s_glass(name):
     return scene
 
 
+def s_rough_glass(name):
+    """A rough GGX Glass sphere and a rough Beckmann Refraction cube."""
+    scene = base_scene(name)
+    mat, tree, out = _tree(f"{name} sphere")
+    node = _node(tree, "ShaderNodeBsdfGlass", Color=(0.95, 0.95, 1.0, 1), IOR=1.5, Roughness=0.3,
+                 _distribution="GGX")
+    tree.links.new(node.outputs[0], out.inputs["Surface"])
+    _sphere(scene, mat)
+    mat, tree, out = _tree(f"{name} cube")
+    node = _node(tree, "ShaderNodeBsdfRefraction", Color=(0.9, 0.8, 0.7, 1), IOR=1.4, Roughness=0.2,
+                 _distribution="BECKMANN")
+    tree.links.new(node.outputs[0], out.inputs["Surface"])
+    _cube(scene, mat)
+    _key(scene, radius=0.5)
+    return scene
+
+
 def s_public_style(name):
     """As a user's StyLit exemplar scene: a Mix Shader of Glossy (0.32) and
     Diffuse on the sphere, a 3500 W point light of radius 2 m, a backdrop
@@ -518,6 +535,7 @@ SCENES = {
     "bounce_limits": s_bounce_limits,
     "ray_visibility": s_ray_visibility,
     "glass": s_glass,
+    "rough_glass": s_rough_glass,
     "public_style": s_public_style,
 }
 

@@ -438,13 +438,15 @@ class ShaderInterpreter:
         if kind in ("ShaderNodeBsdfGlossy", "ShaderNodeBsdfAnisotropic"):
             return [self.glossy(node, ctx)]
         if kind in ("ShaderNodeBsdfGlass", "ShaderNodeBsdfRefraction"):
-            roughness = self.scalar(inp["Roughness"], ctx)
-            if node.distribution != "SHARP" and (not roughness.constant or
-                                                 float(roughness.const) >= SINGULAR_ROUGHNESS):
-                self.warn(f"{node.bl_label} '{node.name}': rough transmission is traced as smooth.")
+            distribution = getattr(node, "distribution", "GGX")
+            mapped = {"SHARP": "sharp", "BECKMANN": "beckmann", "GGX": "ggx"}.get(distribution)
+            if mapped is None:
+                self.warn(f"{node.bl_label} '{node.name}': distribution {distribution} is traced as GGX.")
+                mapped = "ggx"
             self._normal_ignored(node)
             return [self._closure("glass" if kind == "ShaderNodeBsdfGlass" else "refraction",
-                                  color=self.color(inp["Color"], ctx),
+                                  color=self.color(inp["Color"], ctx), distribution=mapped,
+                                  roughness=self.scalar(inp["Roughness"], ctx),
                                   ior=self.constant_scalar(inp["IOR"], ctx, f"'{node.name}' IOR"))]
         if kind == "ShaderNodeBsdfTranslucent":
             self._normal_ignored(node)
@@ -519,9 +521,11 @@ class ShaderInterpreter:
             specular = self.constant_scalar(inp["Specular"], ctx, f"Principled '{node.name}' Specular")
         transmission = self.constant_scalar(get("Transmission Weight", "Transmission"), ctx,
                                             f"Principled '{node.name}' Transmission")
+        roughness = self.scalar(get("Roughness"), ctx)
+        if transmission > 0 and (not roughness.constant or float(roughness.const) >= SINGULAR_ROUGHNESS):
+            self.warn(f"Principled '{node.name}': rough transmission is traced as smooth glass.")
         closure = self._closure("principled", color=base, metallic=metallic, specular=specular,
-                                transmission=transmission, ior=ior,
-                                roughness=self.scalar(get("Roughness"), ctx))
+                                transmission=transmission, ior=ior, roughness=roughness)
         out = [closure]
         emission_color = get("Emission Color", "Emission")
         strength = self.constant_scalar(get("Emission Strength"), ctx, "Emission Strength") \

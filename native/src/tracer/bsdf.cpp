@@ -155,6 +155,21 @@ void add_closure(const Scene& scene, ShadingPoint& s, const Closure& c, const Su
     }
     case Closure::Type::glass:
     case Closure::Type::refraction: {
+      const float r = c.distribution == Closure::Distribution::sharp ? 0.0f : closure_roughness(scene, c, at);
+      if (r >= kSingularRoughness) {
+        // Rough glass as Cycles 3.x builds it: a microfacet reflection weighted
+        // by the Fresnel of the shading normal, and a microfacet refraction by
+        // the rest (Refraction BSDF: the refraction alone, unweighted).
+        const float eta = s.front ? c.ior : 1 / c.ior;
+        const float fresnel = c.type == Closure::Type::glass ? fresnel_dielectric(dot(at.n, at.wo), eta) : 0.0f;
+        const bool beckmann = c.distribution == Closure::Distribution::beckmann;
+        if (fresnel > 0) add_lobe(s, reflection_lobe(weight * color * fresnel, r, beckmann, FresnelMode::none, {}));
+        Lobe t = reflection_lobe(weight * color * (1 - fresnel), r, beckmann, FresnelMode::none, {});
+        t.kind = LobeKind::microfacet_transmission;
+        t.eta = eta;
+        add_lobe(s, t);
+        break;
+      }
       Lobe l;
       l.kind = LobeKind::dielectric;
       l.weight = weight * color;
@@ -253,6 +268,8 @@ void filter_caustics(ShadingPoint& s, bool reflective, bool refractive) {
     Lobe l = s.lobes[i];
     if (l.kind == LobeKind::microfacet || l.kind == LobeKind::mirror) {
       if (!reflective) continue;
+    } else if (l.kind == LobeKind::microfacet_transmission) {
+      if (!refractive) continue;
     } else if (l.kind == LobeKind::dielectric) {
       l.reflect &= reflective;
       l.refract &= refractive;
@@ -270,6 +287,31 @@ LobeValue evaluate(const ShadingPoint& s, const Lobe& l, Float3 wi) {
   if (l.kind == LobeKind::translucent) {
     if (cos_i >= 0 || dot(s.ng, wi) >= 0) return {};
     return {l.weight * (-cos_i / kPi), -cos_i / kPi};
+  }
+  if (l.kind == LobeKind::microfacet_transmission) {
+    const float cos_o = dot(s.n, s.wo);
+    if (cos_i >= 0 || dot(s.ng, wi) >= 0 || cos_o <= 0) return {};
+    // The refraction half vector, on the shading normal's side.
+    Float3 h = -(s.wo + wi * l.eta);
+    const float len = length(h);
+    if (!(len > 0)) return {};
+    h = h / len;
+    if (dot(h, s.n) < 0) h = -h;
+    const float cos_ho = dot(h, s.wo), cos_hi = dot(h, wi);
+    if (cos_ho <= 0 || cos_hi >= 0) return {};
+    const float cos_h = dot(s.n, h);
+    float d, g;
+    if (l.beckmann) {
+      d = beckmann_d(cos_h, l.alpha2);
+      g = beckmann_g1(-cos_i, l.alpha2) * beckmann_g1(cos_o, l.alpha2);
+    } else {
+      d = ggx_d(cos_h, l.alpha2);
+      g = ggx_g1(-cos_i, l.alpha2) * ggx_g1(cos_o, l.alpha2);
+    }
+    const float denom = cos_ho + l.eta * cos_hi;
+    const float jacobian = l.eta * l.eta * -cos_hi / (denom * denom);  // d(omega_h) / d(omega_i)
+    // Radiance is not rescaled by eta^2 (as in Cycles).
+    return {l.weight * (d * g * cos_ho * jacobian / cos_o), d * cos_h * jacobian};
   }
   if (cos_i <= 0 || dot(s.ng, wi) <= 0) return {};
   if (l.kind == LobeKind::lambert) return {l.weight * (cos_i / kPi), cos_i / kPi};
@@ -366,6 +408,17 @@ bool sample(const ShadingPoint& s, Rng& rng, Scatter& out) {
     wi = Frame(s.n).to_world(sample_cosine(u1, u2));
   } else if (l.kind == LobeKind::translucent) {
     wi = Frame(-s.n).to_world(sample_cosine(u1, u2));
+  } else if (l.kind == LobeKind::microfacet_transmission) {
+    const float tan2 = l.beckmann ? -l.alpha2 * std::log(std::max(1 - u1, 1e-12f)) : l.alpha2 * u1 / (1 - u1);
+    const float cos_h = 1 / std::sqrt(1 + tan2), sin_h = std::sqrt(std::fmax(0.0f, 1 - cos_h * cos_h));
+    const float phi = 2 * kPi * u2;
+    const Float3 h = Frame(s.n).to_world({sin_h * std::cos(phi), sin_h * std::sin(phi), cos_h});
+    const float cos_ho = dot(s.wo, h);
+    if (cos_ho <= 0) return false;
+    const float sin_t2 = (1 - cos_ho * cos_ho) / (l.eta * l.eta);
+    if (sin_t2 >= 1) return false;  // total internal reflection: not this lobe's
+    const float cos_t = std::sqrt(1 - sin_t2);
+    wi = normalize(-s.wo / l.eta + h * (cos_ho / l.eta - cos_t));
   } else {
     const float tan2 = l.beckmann ? -l.alpha2 * std::log(std::max(1 - u1, 1e-12f)) : l.alpha2 * u1 / (1 - u1);
     const float cos_h = 1 / std::sqrt(1 + tan2), sin_h = std::sqrt(std::fmax(0.0f, 1 - cos_h * cos_h));
@@ -377,7 +430,8 @@ bool sample(const ShadingPoint& s, Rng& rng, Scatter& out) {
   if (value.pdf <= 0) return false;
   const float pdf = mixture_pdf(s, wi);
   // One-sample estimator of the sampled lobe; MIS weights use the mixture pdf.
-  out = {l.event(), &l, wi, value.f / (l.pick * value.pdf), pdf, l.kind == LobeKind::translucent};
+  out = {l.event(), &l, wi, value.f / (l.pick * value.pdf), pdf,
+         l.kind == LobeKind::translucent || l.kind == LobeKind::microfacet_transmission};
   return true;
 }
 

@@ -18,7 +18,10 @@ constexpr int kMaxLobes = 16;
 
 // lambert: Diffuse BSDF; oren_nayar: Diffuse BSDF with roughness (Cycles' Fujii form);
 // principled_diffuse: Principled v1's diffuse with its retro-reflection.
-enum class LobeKind { lambert, oren_nayar, principled_diffuse, translucent, microfacet, mirror, dielectric };
+// microfacet_transmission: rough refraction (Walter et al. 2007), no Fresnel inside (Cycles 3.x).
+enum class LobeKind {
+  lambert, oren_nayar, principled_diffuse, translucent, microfacet, microfacet_transmission, mirror, dielectric
+};
 enum class FresnelMode { none, schlick, dielectric };
 
 struct Lobe {
@@ -37,7 +40,9 @@ struct Lobe {
     return kind == LobeKind::lambert || kind == LobeKind::oren_nayar || kind == LobeKind::principled_diffuse ||
            kind == LobeKind::translucent;
   }
-  LpeEvent event() const { return diffuse() ? LpeEvent::D : LpeEvent::S; }
+  LpeEvent event() const {
+    return diffuse() ? LpeEvent::D : kind == LobeKind::microfacet_transmission ? LpeEvent::T : LpeEvent::S;
+  }
 };
 
 struct ShadingPoint {

@@ -298,24 +298,27 @@ class Tracer {
   // triangles, one for a mapped world), each event's lobes filed under it.
   void next_event(const ShadingPoint& s, Float3 throughput, const std::vector<int>& states,
                   std::vector<Float3>& sums, Rng& rng) const {
-    const LpeEvent events[2] = {LpeEvent::D, LpeEvent::S};
-    bool wanted[2] = {false, false};
-    bool any_lobe[2] = {false, false};
+    constexpr int kEvents = 3;
+    const LpeEvent events[kEvents] = {LpeEvent::D, LpeEvent::S, LpeEvent::T};
+    auto bucket = [](const Lobe& lobe) { return lobe.event() == LpeEvent::D ? 0 : lobe.event() == LpeEvent::S ? 1 : 2; };
+    bool wanted[kEvents] = {false, false, false};
+    bool any_lobe[kEvents] = {false, false, false};
     for (int i = 0; i < s.count; ++i)
-      if (!s.lobes[i].singular() && s.lobes[i].pick > 0) any_lobe[s.lobes[i].event() == LpeEvent::S] = true;
-    for (int e = 0; e < 2; ++e)
+      if (!s.lobes[i].singular() && s.lobes[i].pick > 0) any_lobe[bucket(s.lobes[i])] = true;
+    for (int e = 0; e < kEvents; ++e)
       for (std::size_t k = 0; k < dfas_.size() && any_lobe[e] && !wanted[e]; ++k)
         wanted[e] = dfas_[k].accepts(dfas_[k].step(dfas_[k].step(states[k], events[e]), LpeEvent::L));
-    if (!wanted[0] && !wanted[1]) return;
+    if (!wanted[0] && !wanted[1] && !wanted[2]) return;
 
     auto shade_sample = [&](const LightSample& ls, unsigned light_visibility, bool shadows) {
-      Float3 f[2];
+      Float3 f[kEvents];
       bool any = false;
       for (int i = 0; i < s.count; ++i) {
         const Lobe& lobe = s.lobes[i];
-        const int e = lobe.event() == LpeEvent::S;
+        const int e = bucket(lobe);
         if (lobe.singular() || !wanted[e]) continue;
-        if (!(light_visibility & (lobe.diffuse() ? kVisibleDiffuse : kVisibleGlossy))) continue;
+        const unsigned needs = lobe.diffuse() ? kVisibleDiffuse : e == 1 ? kVisibleGlossy : kVisibleTransmission;
+        if (!(light_visibility & needs)) continue;
         const LobeValue v = evaluate(s, lobe, ls.wi);
         if (v.pdf > 0) f[e] += v.f, any = true;
       }
@@ -337,7 +340,7 @@ class Tracer {
         if (!(max_component(pass) > 0)) return;
       }
       const float weight = ls.pdf > 0 && bsdf_pdf > 0 ? power_heuristic(ls.pdf, bsdf_pdf) : 1.0f;
-      for (int e = 0; e < 2; ++e) {
+      for (int e = 0; e < kEvents; ++e) {
         if (!(max_component(f[e]) > 0)) continue;
         const Float3 c = throughput * f[e] * ls.radiance * pass * weight;
         for (std::size_t k = 0; k < dfas_.size(); ++k)
