@@ -480,3 +480,21 @@ TEST(Tracer, DiffuseRoughnessIsOrenNayar) {
   const double expected = 0.6 * 2 / (kPi + (3 * kPi - 4) / 6 * 0.8);
   EXPECT_NEAR(mean(r.images[0], 0), expected, 0.01 * expected);
 }
+
+TEST(Tracer, RoughGlassSphereInAFurnaceLosesLittleEnergy) {
+  // Clear glass in a white world: what comes out is at most what went in,
+  // and a single-scattering microfacet model loses only a little at roughness 0.3.
+  Scene s;
+  Closure glass = closure(Closure::Type::glass, {1, 1, 1}, 0.3f);
+  glass.ior = 1.5f;
+  s.materials = {of({glass})};
+  add_sphere(s, {0, 0, 0}, 1, 0);
+  s.world_radiance = {1, 1, 1};
+  s.camera = top_camera(5, 0.8f, 8);  // sees only the sphere's middle
+  TraceOptions o = options(64);
+  o.max_bounces = 64;
+  const TraceResult r = trace_lpe(s, {"L.*E", "L.*TE"}, o);
+  EXPECT_GT(mean(r.images[0]), 0.85);
+  EXPECT_LT(mean(r.images[0]), 1.02);
+  EXPECT_GT(mean(r.images[1]), 0.5);  // most of it came through the glass
+}
