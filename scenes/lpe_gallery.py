@@ -385,11 +385,17 @@ def s_large_point(name):
 
 
 def s_spot(name):
+    """A spot light with a blend, and a node tree tinting it."""
     scene = base_scene(name)
     _sphere(scene, diffuse(f"{name} sphere", (0.8, 0.8, 0.8)))
     _cube(scene, diffuse(f"{name} cube", (0.2, 0.4, 0.8)))
-    add_light(scene, "SPOT", 1500.0, (1.0, -2.0, 3.5), (0, 0.2, 0), shadow_soft_size=0.1,
-              spot_size=math.radians(60), spot_blend=0.3)
+    spot = add_light(scene, "SPOT", 1500.0, (1.0, -2.0, 3.5), (0, 0.2, 0), shadow_soft_size=0.1,
+                     spot_size=math.radians(60), spot_blend=0.3)
+    # A light node tree: Cycles multiplies colour x power by its Emission node.
+    spot.data.use_nodes = True
+    emission_node = spot.data.node_tree.nodes["Emission"]
+    emission_node.inputs["Color"].default_value = (1.0, 0.7, 0.5, 1)
+    emission_node.inputs["Strength"].default_value = 1.5
     return scene
 
 

@@ -333,9 +333,7 @@ def _light(obj, matrix, warnings):
     light = obj.data
     position = matrix[:3, 3]
     z_axis = matrix[:3, 2] / np.linalg.norm(matrix[:3, 2])  # Blender lights shine down their local -Z
-    if light.use_nodes:
-        warnings.append(f"Light '{obj.name}': light node trees are ignored by the light-path tracer "
-                        "(colour x power is used).")
+    tint = _light_node_tint(obj, warnings)
     if light.type in ("POINT", "SPOT"):
         # Cycles 4.0 made soft point and spot lights spheres; before, disks facing the shaded point.
         import bpy  # noqa: PLC0415  (the version decides the shape)
@@ -362,7 +360,35 @@ def _light(obj, matrix, warnings):
                             "(it emits over the full hemisphere).")
     else:
         raise SceneExportError(f"Light '{obj.name}' has an unknown type {light.type!r}")
+    for key in ("intensity", "irradiance", "radiance"):
+        if key in out:
+            out[key] = np.asarray(out[key], np.float64) * tint
     return {k: (np.asarray(v, np.float32) if isinstance(v, np.ndarray) else v) for k, v in out.items()}
+
+
+def _light_node_tint(obj, warnings):
+    """The factor a light's node tree puts on its colour x power: Cycles
+    multiplies them by the Emission node plugged into the Light Output
+    (colour x strength; 1 without nodes). Only constant trees are modelled."""
+    light = obj.data
+    if not light.use_nodes or light.node_tree is None:
+        return np.ones(3)
+    owner = f"Light '{obj.name}'"
+    output = light.node_tree.get_output_node("CYCLES")
+    if output is None:
+        return np.ones(3)
+    interpreter = ShaderInterpreter(owner, warnings, ImageCache())
+    closures = interpreter.closures(output.inputs["Surface"])
+    if not closures:
+        return np.zeros(3) if output.inputs["Surface"].is_linked else np.ones(3)
+    tint = np.zeros(3)
+    for c in closures:
+        if c["type"] != "emission" or c.get("factors") or "color" not in c:
+            warnings.append(f"{owner}: its node tree varies (textures, mixes) and is not modelled; its constant "
+                            "part is used.")
+            continue
+        tint += np.asarray(c["color"], np.float64) * np.asarray(c["weight"], np.float64)
+    return tint
 
 
 def _world(world, warnings, images, textures):
