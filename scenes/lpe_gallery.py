@@ -441,6 +441,13 @@ def s_hdri(name):
     return scene
 
 
+def s_world_visibility(name):
+    """The HDRI world invisible to glossy rays: it lights the diffuse lobes only."""
+    scene = s_hdri(name)
+    scene.world.cycles_visibility.glossy = False
+    return scene
+
+
 def s_translucent_transparent(name):
     scene = base_scene(name)
     _mesh_object(scene, "Leaf", plane, [leaf(f"{name} leaf")], location=(0.6, 0.0, 0.8),
@@ -537,6 +544,7 @@ SCENES = {
     "emissive_mesh": s_emissive_mesh,
     "world_color": s_world_color,
     "hdri": s_hdri,
+    "world_visibility": s_world_visibility,
     "translucent_transparent": s_translucent_transparent,
     "bounce_limits": s_bounce_limits,
     "ray_visibility": s_ray_visibility,

@@ -252,6 +252,7 @@ def scene_from_dict(scene: dict):
         w = _Reader(r.required("world"), "scene world")
         s.world_radiance = w.required("radiance")
         s.world_map = w.integer("map", -1)
+        s.world_visibility = w.integer("visibility", 31)
         if w.has("rotation"):
             rotation = np.asarray(w.required("rotation"), np.float32)
             if rotation.shape != (3, 3):

@@ -289,6 +289,7 @@ void bind_scene_types(py::module_& m) {
       .def_readwrite("lights", &Scene::lights)
       .def_readwrite("world_map", &Scene::world_map, "index into textures of an equirectangular world; -1: none")
       .def_readwrite("world_rotation", &Scene::world_rotation, "row-major 3x3 turning world directions into the map's")
+      .def_readwrite("world_visibility", &Scene::world_visibility, "bits of the rays that see the world")
       .def_readwrite("camera", &Scene::camera)
       .def("validate", &validate_scene, "Raise ValueError naming the first problem of the scene.");
   float3_field(scene, "world_radiance", &Scene::world_radiance);

@@ -498,3 +498,15 @@ TEST(Tracer, RoughGlassSphereInAFurnaceLosesLittleEnergy) {
   EXPECT_LT(mean(r.images[0]), 1.02);
   EXPECT_GT(mean(r.images[1]), 0.5);  // most of it came through the glass
 }
+
+TEST(Tracer, WorldRayVisibility) {
+  // A world invisible to diffuse rays lights nothing diffusely.
+  Scene s;
+  s.materials = {lambert(1.0f)};
+  add_floor(s, 1000, 0);
+  s.world_radiance = {0.7f, 0.7f, 0.7f};
+  s.world_visibility = kVisibleAll & ~kVisibleDiffuse;
+  s.camera = top_camera(5, 2, 8);
+  const TraceResult r = trace_lpe(s, {"LDE"}, options(16));
+  EXPECT_EQ(mean(r.images[0]), 0.0);
+}

@@ -93,6 +93,9 @@ def export_scene(scene, depsgraph, size):
         offset += len(verts)
     textures = []
     world = _world(scene.world, warnings, images, textures)
+    world_visibility = _world_visibility(scene.world)
+    if world_visibility != 31:
+        world["visibility"] = world_visibility
     material_list = [_index_textures(m, textures) for m in (materials.list or [default_surface()])]
     visibility = _stack(geometry["visibility"], (0,), np.int32)
     out = {
@@ -117,6 +120,18 @@ def _visibility(obj):
     bits = 0
     for prop, bit in VISIBILITY_BITS:
         if getattr(obj, prop, True):
+            bits |= bit
+    return bits
+
+
+def _world_visibility(world):
+    """Ray visibility bits of the world (World > Settings > Ray Visibility)."""
+    settings = getattr(world, "cycles_visibility", None) if world is not None else None
+    if settings is None:
+        return 31
+    bits = 16
+    for prop, bit in (("camera", 1), ("diffuse", 2), ("glossy", 4), ("transmission", 8)):
+        if getattr(settings, prop, True):
             bits |= bit
     return bits
 

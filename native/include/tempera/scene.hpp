@@ -176,6 +176,8 @@ struct Scene {
   // u = 0.5 - atan2(y', x') / (2 pi), v = 0.5 + asin(z') / pi.
   int world_map = -1;
   std::array<float, 9> world_rotation{1, 0, 0, 0, 1, 0, 0, 0, 1};
+  // Which rays see the world (bits of Visibility: Blender's World > Ray Visibility).
+  unsigned world_visibility = kVisibleAll;
   std::vector<Image> textures;  // RGBA float images referenced by TextureRef and world_map
   // Optional per-triangle ray visibility (bits of Visibility); empty: all visible.
   std::vector<std::uint8_t> triangle_visibility;

@@ -106,8 +106,10 @@ class Tracer {
       add_area_lights_crossed(origin, direction, t_near, t_geometry, travelled, kind, throughput, previous_pdf,
                               states, sums);
       if (!hit_geometry) {
-        const float weight = world_.sampled() ? mis_weight(previous_pdf, world_.pdf(direction)) : 1.0f;
-        add_emission(states, sums, throughput * world_.radiance(direction), weight);
+        if (scene_.world_visibility & kind) {
+          const float weight = world_.sampled() ? mis_weight(previous_pdf, world_.pdf(direction)) : 1.0f;
+          add_emission(states, sums, throughput * world_.radiance(direction), weight);
+        }
         return;
       }
       const SurfaceInput at = surface_input(hit, origin, direction);
@@ -355,7 +357,7 @@ class Tracer {
     if (!emissive_.empty() && sample_emissive_triangle(s.p, rng, ls)) shade_sample(ls, kVisibleAll, true);
     if (world_.sampled()) {
       const float u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform(), u4 = rng.uniform();
-      if (world_.sample(u1, u2, u3, u4, ls)) shade_sample(ls, kVisibleAll, true);
+      if (world_.sample(u1, u2, u3, u4, ls)) shade_sample(ls, scene_.world_visibility, true);
     }
   }
 
