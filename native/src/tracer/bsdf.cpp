@@ -13,8 +13,10 @@ Float3 schlick(Float3 f0, float cos_theta) {
 }
 
 float ggx_d(float cos_h, float alpha2) {
+  // sin^2 + cos^2 alpha^2 rather than cos^2 (alpha^2 - 1) + 1, which rounds to 0
+  // at the peak of a nearly smooth surface.
   const float c2 = cos_h * cos_h;
-  const float d = c2 * (alpha2 - 1) + 1;
+  const float d = std::max(0.0f, 1 - c2) + c2 * alpha2;
   return alpha2 / (kPi * d * d);
 }
 float ggx_g1(float cos_v, float alpha2) {
@@ -281,7 +283,18 @@ void filter_caustics(ShadingPoint& s, bool reflective, bool refractive) {
   set_picks(s);
 }
 
+LobeValue evaluate_lobe(const ShadingPoint& s, const Lobe& l, Float3 wi);
+
+bool finite3(Float3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// Degenerate half vectors of nearly smooth lobes can overflow: such values are dropped.
 LobeValue evaluate(const ShadingPoint& s, const Lobe& l, Float3 wi) {
+  const LobeValue v = evaluate_lobe(s, l, wi);
+  if (!finite3(v.f) || !std::isfinite(v.pdf)) return {};
+  return v;
+}
+
+LobeValue evaluate_lobe(const ShadingPoint& s, const Lobe& l, Float3 wi) {
   if (l.pick <= 0 || l.singular()) return {};
   const float cos_i = dot(s.n, wi);
   if (l.kind == LobeKind::translucent) {
@@ -429,6 +442,7 @@ bool sample(const ShadingPoint& s, Rng& rng, Scatter& out) {
   const LobeValue value = evaluate(s, l, wi);
   if (value.pdf <= 0) return false;
   const float pdf = mixture_pdf(s, wi);
+  if (!std::isfinite(pdf) || !finite3(value.f / (l.pick * value.pdf))) return false;
   // One-sample estimator of the sampled lobe; MIS weights use the mixture pdf.
   out = {l.event(), &l, wi, value.f / (l.pick * value.pdf), pdf,
          l.kind == LobeKind::translucent || l.kind == LobeKind::microfacet_transmission};
