@@ -113,11 +113,6 @@ def gallery_figures(cycles, traced):
     return {b: compare(traced[b], cycles[b], mask, full_mean) for b in BUFFERS}, full_mean
 
 
-@pytest.fixture(scope="module")
-def results(tmp_path_factory):
-    return {}
-
-
 @pytest.mark.parametrize("key", list(lpe_gallery.SCENES))
 def test_gallery_scene_matches_cycles(key, tmp_path):
     scene = lpe_gallery.build(key)

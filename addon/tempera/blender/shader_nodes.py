@@ -268,8 +268,8 @@ class ShaderInterpreter:
                     self.warn(f"'{node.name}' combines textures with different coordinates; the second is read "
                               "at the first's.")
                 v = _resample(v, h, w)
-            is_color = v.channel == 4 and v.texels.shape[2] == 4 and _looks_color(values, v)
-            arrays.append(v.rgb_texels() if is_color else v.scalar_texels()[:, :, None])
+            # Colour textures read RGB; scalar ones (a channel) broadcast as one value per texel.
+            arrays.append(v.rgb_texels() if v.channel == 4 else v.scalar_texels()[:, :, None])
         result = np.asarray(fn(*arrays), np.float32)
         if result.ndim == 3 and result.shape[2] == 3:
             return _color_texture(result, base.uv)
@@ -593,10 +593,6 @@ def _describe_default(socket):
     if hasattr(value, "__len__"):
         return "(" + ", ".join(f"{v:.3g}" for v in value[:3]) + ")"
     return f"{value:.3g}"
-
-
-def _looks_color(values, v):
-    return v.channel == 4
 
 
 def _resample(v, h, w):
