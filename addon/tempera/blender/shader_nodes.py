@@ -72,6 +72,8 @@ class Value:
         if self.texels is None:
             c = np.atleast_1d(np.asarray(self.const, np.float64))
             return Value(const=float(c[0] if c.size == 1 else c[:3] @ LUMINANCE))
+        if self.channel == 4:  # a colour texture as a value: its luminance, texel by texel
+            return _scalar_texture(self.scalar_texels(), self.uv)
         return self
 
     def scalar_texels(self):
