@@ -361,6 +361,29 @@ def s_principled_texture(name):
     return scene
 
 
+def s_principled_layers(name):
+    """Principled v1 with clearcoat over a red base, and with subsurface."""
+    scene = base_scene(name)
+    coat = bpy.data.materials.new(f"{name} coat")
+    coat.use_nodes = True
+    bsdf = coat.node_tree.nodes["Principled BSDF"]
+    bsdf.inputs["Base Color"].default_value = (0.6, 0.05, 0.05, 1)
+    bsdf.inputs["Roughness"].default_value = 0.6
+    bsdf.inputs["Clearcoat"].default_value = 1.0
+    bsdf.inputs["Clearcoat Roughness"].default_value = 0.15
+    _sphere(scene, coat)
+    skin = bpy.data.materials.new(f"{name} skin")
+    skin.use_nodes = True
+    bsdf = skin.node_tree.nodes["Principled BSDF"]
+    bsdf.inputs["Base Color"].default_value = (0.8, 0.6, 0.5, 1)
+    bsdf.inputs["Subsurface"].default_value = 0.5
+    bsdf.inputs["Subsurface Color"].default_value = (0.9, 0.3, 0.2, 1)
+    bsdf.inputs["Subsurface Radius"].default_value = (0.05, 0.02, 0.01)
+    _cube(scene, skin)
+    _key(scene, radius=0.5)
+    return scene
+
+
 def s_default_surfaces(name):
     """An empty material slot (Cycles' default grey), a material without
     nodes (its viewport colour) and a mesh with no slot at all."""
@@ -536,6 +559,7 @@ SCENES = {
     "layer_weight": s_layer_weight,
     "group_texture": s_group_texture,
     "principled_texture": s_principled_texture,
+    "principled_layers": s_principled_layers,
     "default_surfaces": s_default_surfaces,
     "large_point": s_large_point,
     "spot": s_spot,

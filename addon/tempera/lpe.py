@@ -114,10 +114,11 @@ def _closure(value, what):
     r = _Reader(value, what)
     c = _native.Closure()
     c.type = _enum(_native.Closure.Type, r.text("type", CLOSURE_TYPES))
-    for key in ("weight", "color"):
+    for key in ("weight", "color", "subsurface_color"):
         if r.has(key):
             setattr(c, key, r.required(key))
-    for key in ("roughness", "ior", "metallic", "specular", "transmission"):
+    for key in ("roughness", "ior", "metallic", "specular", "transmission", "subsurface", "clearcoat",
+                "clearcoat_roughness"):
         if r.has(key):
             setattr(c, key, r.number(key))
     for key in ("color_texture", "roughness_texture"):

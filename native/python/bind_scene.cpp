@@ -130,8 +130,12 @@ void bind_scene_types(py::module_& m) {
       .def_readwrite("ior", &Closure::ior)
       .def_readwrite("metallic", &Closure::metallic)
       .def_readwrite("specular", &Closure::specular)
-      .def_readwrite("transmission", &Closure::transmission);
+      .def_readwrite("transmission", &Closure::transmission)
+      .def_readwrite("subsurface", &Closure::subsurface)
+      .def_readwrite("clearcoat", &Closure::clearcoat)
+      .def_readwrite("clearcoat_roughness", &Closure::clearcoat_roughness);
   float3_field(closure, "weight", &Closure::weight);
+  float3_field(closure, "subsurface_color", &Closure::subsurface_color);
   float3_field(closure, "color", &Closure::color);
 
   py::class_<Material> material(m, "Material", "A surface: its closures, or the Principled-like fields if none.");

@@ -539,9 +539,24 @@ class ShaderInterpreter:
         if not alpha.constant or float(alpha.const) < 1:
             out = _scaled(out, alpha, invert=False) + _scaled([self._closure("transparent", color=Value(
                 const=np.ones(3)))], alpha, invert=True)
+        if not v2:  # Principled v1 (Cycles 3.x): subsurface colours the diffuse, clearcoat is a GGX lobe
+            subsurface = self.constant_scalar(inp["Subsurface"], ctx, "Subsurface")
+            if subsurface > 0:
+                ss_color = self.color(inp["Subsurface Color"], ctx)
+                closure["subsurface"] = subsurface
+                closure["subsurface_color"] = np.asarray(
+                    ss_color.const if ss_color.texels is None else ss_color.texels[:, :, :3].reshape(-1, 3).mean(0),
+                    np.float32)[:3]
+                self.warn(f"Principled '{node.name}': subsurface scattering is traced as diffuse reflection of "
+                          "the mixed colour (no light transport under the surface).")
+            clearcoat = self.constant_scalar(inp["Clearcoat"], ctx, "Clearcoat")
+            if clearcoat > 0:
+                closure["clearcoat"] = clearcoat
+                closure["clearcoat_roughness"] = self.constant_scalar(inp["Clearcoat Roughness"], ctx,
+                                                                      "Clearcoat Roughness")
         ignored = []
-        for names, neutral in ((("Subsurface Weight", "Subsurface"), 0.0), (("Sheen Weight", "Sheen"), 0.0),
-                               (("Coat Weight", "Clearcoat"), 0.0), (("Anisotropic",), 0.0)):
+        for names, neutral in ((("Subsurface Weight",), 0.0), (("Sheen Weight", "Sheen"), 0.0),
+                               (("Coat Weight",), 0.0), (("Anisotropic",), 0.0)):
             socket = get(*names)
             if socket is not None and (socket.is_linked or abs(float(socket.default_value) - neutral) > 1e-6):
                 ignored.append(socket.name)

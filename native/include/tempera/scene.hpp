@@ -85,6 +85,9 @@ struct Closure {
   float ior = 1.45f;
   // Principled only:
   float metallic = 0, specular = 0.5f, transmission = 0;
+  float subsurface = 0;  // mixes subsurface_color into the diffuse colour (scattering itself not traced)
+  Float3 subsurface_color{0.8f, 0.8f, 0.8f};
+  float clearcoat = 0, clearcoat_roughness = 0.03f;  // a GGX lobe, F0 0.04, weight 0.25 clearcoat
 };
 
 // A surface. With `closures` empty it is the single Principled closure given

@@ -125,10 +125,17 @@ void add_closure(const Scene& scene, ShadingPoint& s, const Closure& c, const Su
   if (!(max_component(weight) > 0)) return;
   const Float3 color = closure_color(scene, c, at);
   switch (c.type) {
-    case Closure::Type::principled:
-      add_principled(s, weight, color, c.metallic, c.specular, closure_roughness(scene, c, at), c.transmission,
-                     c.ior);
+    case Closure::Type::principled: {
+      const float ss = std::clamp(c.subsurface, 0.0f, 1.0f);
+      add_principled(s, weight, color * (1 - ss) + c.subsurface_color * ss, c.metallic, c.specular,
+                     closure_roughness(scene, c, at), c.transmission, c.ior);
+      if (c.clearcoat > 0) {
+        const float r = std::clamp(c.clearcoat_roughness, 0.0f, 1.0f);
+        add_lobe(s, reflection_lobe(weight * (0.25f * c.clearcoat), r, false, FresnelMode::schlick,
+                                    {0.04f, 0.04f, 0.04f}));
+      }
       break;
+    }
     case Closure::Type::diffuse: {
       Lobe l;
       l.weight = weight * color;
