@@ -539,6 +539,20 @@ def s_rough_glass(name):
     return scene
 
 
+def s_filter_glossy(name):
+    """Glossy seen in glossy with Cycles' default Filter Glossy (1.0): a
+    nearly smooth sphere over a half-glossy floor."""
+    scene = base_scene(name, floor=mix_glossy_diffuse(f"{name} floor", (0.4, 0.4, 0.45), 0.05, 0.5))
+    scene.cycles.blur_glossy = 1.0
+    mat, tree, out = _tree(f"{name} sphere")
+    node = _node(tree, "ShaderNodeBsdfGlossy", Color=(0.9, 0.8, 0.6, 1), Roughness=0.03, _distribution="GGX")
+    tree.links.new(node.outputs[0], out.inputs["Surface"])
+    _sphere(scene, mat)
+    _cube(scene, diffuse(f"{name} cube", (0.2, 0.4, 0.8)))
+    _key(scene, radius=0.5)
+    return scene
+
+
 def s_public_style(name):
     """As a user's StyLit exemplar scene: a Mix Shader of Glossy (0.32) and
     Diffuse on the sphere, a 3500 W point light of radius 2 m, a backdrop
@@ -571,6 +585,7 @@ SCENES = {
     "world_visibility": s_world_visibility,
     "translucent_transparent": s_translucent_transparent,
     "bounce_limits": s_bounce_limits,
+    "filter_glossy": s_filter_glossy,
     "ray_visibility": s_ray_visibility,
     "glass": s_glass,
     "rough_glass": s_rough_glass,

@@ -290,6 +290,7 @@ def trace_lpe(
     transparent_bounces: int = 1024,
     caustics_reflective: bool = True,
     caustics_refractive: bool = True,
+    filter_glossy: float = 0.0,
 ):
     """Render one linear radiance image per light path expression.
 
@@ -300,7 +301,8 @@ def trace_lpe(
     ``threads``. ``max_bounces`` counts indirect bounces as Cycles does, and
     so do the per-kind limits (``diffuse_bounces`` ...; transparent surfaces
     count separately). ``caustics_reflective``/``caustics_refractive`` False
-    drop glossy/refractive lobes after a diffuse bounce, as Cycles' options do.
+    drop glossy/refractive lobes after a diffuse bounce, as Cycles' options do;
+    ``filter_glossy`` is Cycles' Filter Glossy (0: off).
     ``progress(fraction)`` returning False cancels (raises ``tempera.Cancelled``).
 
     Returns ``(images, alpha)``: a list of float32 (H, W, 3) arrays in the
@@ -320,4 +322,5 @@ def trace_lpe(
                              transmission_bounces=int(transmission_bounces),
                              transparent_bounces=int(transparent_bounces),
                              caustics_reflective=bool(caustics_reflective),
-                             caustics_refractive=bool(caustics_refractive))
+                             caustics_refractive=bool(caustics_refractive),
+                             filter_glossy=float(filter_glossy))

@@ -70,7 +70,8 @@ void bind_tracer(py::module_& m) {
       "trace_lpe",
       [](const Scene& scene, const std::vector<std::string>& expressions, int samples, std::uint64_t seed,
          int threads, int max_bounces, std::function<bool(double)> progress, int diffuse_bounces, int glossy_bounces,
-         int transmission_bounces, int transparent_bounces, bool caustics_reflective, bool caustics_refractive) {
+         int transmission_bounces, int transparent_bounces, bool caustics_reflective, bool caustics_refractive,
+         float filter_glossy) {
         TraceOptions options;
         options.samples = samples;
         options.seed = seed;
@@ -82,6 +83,7 @@ void bind_tracer(py::module_& m) {
         options.transparent_bounces = transparent_bounces;
         options.caustics_reflective = caustics_reflective;
         options.caustics_refractive = caustics_refractive;
+        options.filter_glossy = filter_glossy;
         TraceProgress callback = py_bridge::with_gil([&](double fraction) {
           return progress ? progress(fraction) : true;
         });
@@ -99,7 +101,8 @@ void bind_tracer(py::module_& m) {
       py::arg("scene"), py::arg("expressions"), py::arg("samples") = 64, py::arg("seed") = 0, py::arg("threads") = 0,
       py::arg("max_bounces") = 8, py::arg("progress") = nullptr, py::arg("diffuse_bounces") = 1024,
       py::arg("glossy_bounces") = 1024, py::arg("transmission_bounces") = 1024, py::arg("transparent_bounces") = 1024,
-      py::arg("caustics_reflective") = true, py::arg("caustics_refractive") = true, kTraceDoc);
+      py::arg("caustics_reflective") = true, py::arg("caustics_refractive") = true, py::arg("filter_glossy") = 0.0f,
+      kTraceDoc);
   m.def(
       "check_lpe", [](const std::string& expression) { compile_lpe(expression); }, py::arg("expression"),
       "Raise ValueError (with the 0-based position) if the light path expression is malformed.");

@@ -279,7 +279,7 @@ def scene_fingerprint(scene, frame):
         "view_layer": guide_view_layer(scene).name, "world": _world_fingerprint(scene.world),
         "bounces": [scene.cycles.max_bounces, scene.cycles.diffuse_bounces, scene.cycles.glossy_bounces,
                     scene.cycles.transmission_bounces, scene.cycles.transparent_max_bounces,
-                    scene.cycles.caustics_reflective, scene.cycles.caustics_refractive],
+                    scene.cycles.caustics_reflective, scene.cycles.caustics_refractive, scene.cycles.blur_glossy],
         "pixel_aspect": [render.pixel_aspect_x, render.pixel_aspect_y],
         "film": [scene.cycles.film_exposure, scene.cycles.pixel_filter_type, scene.cycles.filter_width],
         "camera_data": _camera_fingerprint(scene.camera.data),

@@ -154,7 +154,8 @@ def path_settings(scene):
     return {"max_bounces": int(c.max_bounces), "diffuse_bounces": int(c.diffuse_bounces),
             "glossy_bounces": int(c.glossy_bounces), "transmission_bounces": int(c.transmission_bounces),
             "transparent_bounces": int(c.transparent_max_bounces),
-            "caustics_reflective": bool(c.caustics_reflective), "caustics_refractive": bool(c.caustics_refractive)}
+            "caustics_reflective": bool(c.caustics_reflective), "caustics_refractive": bool(c.caustics_refractive),
+            "filter_glossy": float(c.blur_glossy)}
 
 
 def _rendered_objects(view_layer, warnings):

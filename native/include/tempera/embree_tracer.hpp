@@ -27,6 +27,10 @@ struct TraceOptions {
   // Cycles' caustics options: false drops glossy (reflective) or refractive
   // lobes at a vertex reached by a diffuse bounce, so those paths do not exist.
   bool caustics_reflective = true, caustics_refractive = true;
+  // Cycles' Filter Glossy (Blender's blur_glossy; 0: off): after a bounce of
+  // pdf p (the smallest so far), glossy lobes get a microfacet alpha of at
+  // least sqrt(1 - p * (1 / filter_glossy)) / 2 where that is below 1.
+  float filter_glossy = 0;
 };
 
 struct TraceResult {

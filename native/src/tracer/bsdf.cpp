@@ -157,9 +157,11 @@ void add_closure(const Scene& scene, ShadingPoint& s, const Closure& c, const Su
       break;
     }
     case Closure::Type::glossy: {
-      const float r = c.distribution == Closure::Distribution::sharp ? 0.0f : closure_roughness(scene, c, at);
-      add_lobe(s, reflection_lobe(weight * color, r, c.distribution == Closure::Distribution::beckmann,
-                                  FresnelMode::none, {}));
+      const bool sharp = c.distribution == Closure::Distribution::sharp;
+      Lobe l = reflection_lobe(weight * color, sharp ? 0.0f : closure_roughness(scene, c, at),
+                               c.distribution == Closure::Distribution::beckmann, FresnelMode::none, {});
+      l.sharp = sharp;
+      add_lobe(s, l);
       break;
     }
     case Closure::Type::glass:
@@ -291,6 +293,18 @@ void filter_caustics(ShadingPoint& s, bool reflective, bool refractive) {
 }
 
 LobeValue evaluate_lobe(const ShadingPoint& s, const Lobe& l, Float3 wi);
+
+void blur_glossy(ShadingPoint& s, float alpha) {
+  const float alpha2 = alpha * alpha;
+  for (int i = 0; i < s.count; ++i) {
+    Lobe& l = s.lobes[i];
+    const bool blurrable = l.kind == LobeKind::microfacet || l.kind == LobeKind::microfacet_transmission ||
+                           (l.kind == LobeKind::mirror && !l.sharp);
+    if (!blurrable || l.alpha2 >= alpha2) continue;
+    l.alpha2 = alpha2;
+    if (l.kind == LobeKind::mirror) l.kind = LobeKind::microfacet;
+  }
+}
 
 bool finite3(Float3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 

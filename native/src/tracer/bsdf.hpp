@@ -34,6 +34,7 @@ struct Lobe {
   Float3 f0;                // schlick
   float eta = 1;            // dielectric: n behind / n in front; microfacet with dielectric Fresnel
   bool reflect = true, refract = true;  // dielectric: which parts exist (refraction-only closures, caustic filter)
+  bool sharp = false;       // mirror: a Sharp distribution (never blurred by Filter Glossy)
   float pick = 0;           // selection probability
   bool singular() const { return kind == LobeKind::mirror || kind == LobeKind::dielectric; }
   bool diffuse() const {
@@ -73,6 +74,9 @@ Float3 constant_emission(const Material& material);  // for picking emissive tri
 
 // Drops lobes (after a diffuse bounce, Cycles' caustics options) and renormalises picks.
 void filter_caustics(ShadingPoint& s, bool reflective, bool refractive);
+// Cycles' Filter Glossy: microfacet lobes (and mirrors that are not Sharp)
+// get at least the microfacet alpha `alpha`.
+void blur_glossy(ShadingPoint& s, float alpha);
 
 struct LobeValue {
   Float3 f;        // BSDF value times |cos(wi)|

@@ -93,6 +93,7 @@ class Tracer {
     Float3 throughput{1, 1, 1};
     float previous_pdf = 0;   // mixture pdf of the BSDF sample that led here; 0: camera or singular
     float travelled = 0;      // distance along this direction since the last scattering vertex
+    float min_ray_pdf = kInfinity;  // smallest pdf of the non-singular bounces so far (Filter Glossy)
     unsigned kind = kVisibleCamera;
     int bounces = 0, diffuse = 0, glossy = 0, transmission = 0, transparent = 0;
     bool after_diffuse = false, first = true;
@@ -124,6 +125,10 @@ class Tracer {
           transmission > options_.transmission_bounces)
         return;
       if (after_diffuse) filter_caustics(s, options_.caustics_reflective, options_.caustics_refractive);
+      if (options_.filter_glossy > 0 && std::isfinite(min_ray_pdf)) {
+        const float blur_pdf = min_ray_pdf / options_.filter_glossy;
+        if (blur_pdf < 1) blur_glossy(s, std::sqrt(1 - blur_pdf) * 0.5f);
+      }
       next_event(s, throughput, states, sums, rng);
 
       Scatter scatter;
@@ -156,6 +161,7 @@ class Tracer {
       after_diffuse = scatter.lobe->diffuse();
       kind = scatter.lobe->diffuse() ? kVisibleDiffuse : ray_kind(scatter.event);
       previous_pdf = scatter.pdf;
+      if (scatter.pdf > 0) min_ray_pdf = std::min(min_ray_pdf, scatter.pdf);
       travelled = 0;
       origin = offset(at.p, at.ng, scatter.wi);
       direction = scatter.wi;
@@ -378,6 +384,7 @@ TraceResult trace_lpe(const Scene& scene, const std::vector<std::string>& expres
                       const TraceProgress& progress) {
   if (options.samples < 1 || options.samples > kMaxSamples)
     throw ValueError(concat("samples must be in [1, ", kMaxSamples, "], got ", options.samples));
+  if (!(options.filter_glossy >= 0)) throw ValueError(concat("filter_glossy must be >= 0, got ", options.filter_glossy));
   for (int limit : {options.max_bounces, options.diffuse_bounces, options.glossy_bounces,
                     options.transmission_bounces, options.transparent_bounces})
     if (limit < 0) throw ValueError(concat("bounce limits must be >= 0, got ", limit));
