@@ -513,3 +513,28 @@ TEST(Tracer, WorldRayVisibility) {
   const TraceResult r = trace_lpe(s, {"LDE"}, options(16));
   EXPECT_EQ(mean(r.images[0]), 0.0);
 }
+
+TEST(Tracer, FilterGlossyBlursMirrorsAfterADiffuseBounce) {
+  // A point light (radius 0: no ray can hit it) seen in a mirror from a
+  // diffuse floor: LS+DE is impossible, unless Filter Glossy blurs the
+  // mirror after the diffuse bounce so that light sampling reaches it.
+  Scene s;
+  s.materials = {lambert(0.8f)};
+  add_floor(s, 20, 0);
+  Material mirror;  // Principled metal, roughness 0: a mirror that Filter Glossy may blur
+  mirror.base_color = {0.9f, 0.9f, 0.9f};
+  mirror.metallic = 1;
+  mirror.roughness = 0;
+  s.materials.push_back(mirror);
+  add_sphere(s, {0, 0, 1.5f}, 0.5f, 1);
+  Light point;
+  point.type = Light::Type::point;
+  point.position = {1, 0, 4};
+  point.intensity = {50, 50, 50};
+  s.lights = {point};
+  s.camera = top_camera(6, 6, 16);
+  TraceOptions o = options(32);
+  EXPECT_EQ(mean(trace_lpe(s, {"LS+DE"}, o).images[0]), 0.0);
+  o.filter_glossy = 1;
+  EXPECT_GT(mean(trace_lpe(s, {"LS+DE"}, o).images[0]), 0.0);
+}
