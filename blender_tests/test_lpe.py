@@ -492,6 +492,24 @@ def test_materials_become_cycles_closures():
     assert second["type"] == "glossy" and second["distribution"] == "beckmann"
     assert second["roughness"] == pytest.approx(0.32) and not second["factors"][0]["invert"]
 
+    # Colour nodes are folded: the new Mix node (Blender 3.4+) multiplying two colours, through a reroute.
+    folded, tree, surface = _surface_tree("LPE folded")
+    diffuse_node = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    tree.links.new(diffuse_node.outputs[0], surface)
+    mix_node = tree.nodes.new("ShaderNodeMix")
+    mix_node.data_type, mix_node.blend_type = "RGBA", "MULTIPLY"
+    sockets = {s.name: s for s in mix_node.inputs if s.enabled}
+    sockets["Factor"].default_value = 1.0
+    sockets["A"].default_value = (0.5, 0.8, 1.0, 1)
+    sockets["B"].default_value = (0.4, 0.5, 0.2, 1)
+    reroute = tree.nodes.new("NodeReroute")
+    colour_out = next(s for s in mix_node.outputs if s.enabled)
+    tree.links.new(colour_out, reroute.inputs[0])
+    tree.links.new(reroute.outputs[0], diffuse_node.inputs["Color"])
+    (closure,) = convert_material(folded, warnings)["closures"]
+    assert warnings == []
+    np.testing.assert_allclose(closure["color"], [0.2, 0.4, 0.2], rtol=1e-5)
+
     # A shader the tracer does not model: a warning naming it, and a diffuse lobe of its own colour.
     velvet_material, tree, surface = _surface_tree("LPE velvet")
     velvet_material.diffuse_color = (0.1, 0.9, 0.1, 1)  # the viewport colour must not be used
@@ -502,7 +520,7 @@ def test_materials_become_cycles_closures():
     assert closure["type"] == "diffuse"
     np.testing.assert_allclose(closure["color"], [0.3, 0.2, 0.6], rtol=1e-6)
     assert len(warnings) == 1 and "LPE velvet" in warnings[0] and velvet.name in warnings[0]
-    for material in (plain, textured, mixed, velvet_material):
+    for material in (plain, textured, mixed, folded, velvet_material):
         bpy.data.materials.remove(material)
     bpy.data.node_groups.remove(group)
     bpy.data.images.remove(image)
