@@ -11,6 +11,13 @@ Prints and optionally writes JSON: wall time, peak memory (max RSS), final
 energy and the per-stage timings.
 
     PYTHONPATH=addon /usr/bin/python3 bench/bench_synthesis.py [--size 1024] [--json out.json]
+
+With --compare REV it builds the native module of git revision REV in a
+temporary worktree and runs this checkout and REV alternately (--repeats
+times each, every run in its own process), so that a speed-up is a ratio
+measured side by side on the same, possibly noisy, machine:
+
+    PYTHONPATH=addon /usr/bin/python3 bench/bench_synthesis.py --compare main~3 --repeats 3
 """
 import argparse
 import json
@@ -83,8 +90,64 @@ def guide_error(src, tgt, nnf):
     return float(np.mean([((a[sy, sx] - b) ** 2).sum(-1).mean() for a, b in zip(src, tgt)]))
 
 
+ROOT = __import__("pathlib").Path(__file__).resolve().parent.parent
+
+
+def build_revision(rev, folder):
+    """The native module of `rev`, built in a worktree under `folder`; returns its addon folder."""
+    import subprocess
+
+    tree = folder / "tree"
+    subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tree), rev], check=True,
+                   stdout=subprocess.DEVNULL)
+    build = folder / "build"
+    subprocess.run(["cmake", "-S", str(tree), "-B", str(build), "-DCMAKE_BUILD_TYPE=Release",
+                    "-DTEMPERA_BUILD_TESTS=OFF"], check=True, stdout=subprocess.DEVNULL)
+    subprocess.run(["cmake", "--build", str(build), "--target", "_native", "-j", str(__import__("os").cpu_count())],
+                   check=True, stdout=subprocess.DEVNULL)
+    return tree / "addon"
+
+
+def compare(args, rest):
+    """This checkout against args.compare, alternating runs; prints medians and ratios."""
+    import statistics
+    import subprocess
+    import sys
+    import tempfile
+    from pathlib import Path
+
+    with tempfile.TemporaryDirectory(prefix="tempera-bench-") as tmp:
+        other = build_revision(args.compare, Path(tmp))
+        try:
+            runs = {"this": [], args.compare: []}
+            for i in range(args.repeats):
+                for name, addon in (("this", ROOT / "addon"), (args.compare, other)):
+                    out = Path(tmp) / f"{i}-{len(runs[name])}.json"
+                    env = dict(__import__("os").environ, PYTHONPATH=str(addon))
+                    subprocess.run([sys.executable, __file__, *rest, "--json", str(out)], env=env, check=True,
+                                   stdout=subprocess.DEVNULL)
+                    runs[name].append(json.loads(out.read_text()))
+        finally:
+            subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(Path(tmp) / "tree")])
+    summary = {}
+    for name, results in runs.items():
+        summary[name] = {k: statistics.median(r[k] for r in results)
+                         for k in ("wall_seconds", "cpu_seconds", "peak_rss_mb", "final_energy", "guide_error",
+                                   "source_coverage")}
+        summary[name]["wall_all"] = [r["wall_seconds"] for r in results]
+    a, b = summary["this"], summary[args.compare]
+    summary["ratio_this_over_other"] = {k: a[k] / b[k] for k in ("wall_seconds", "cpu_seconds", "peak_rss_mb",
+                                                                 "final_energy", "guide_error", "source_coverage")}
+    print(json.dumps(summary, indent=1))
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(summary, f, indent=1)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--compare", metavar="REV", help="also run git revision REV, alternately, and compare")
+    parser.add_argument("--repeats", type=int, default=3, help="runs of each side with --compare")
     parser.add_argument("--size", type=int, default=1024, help="side of the square source and target")
     parser.add_argument("--usage", default="budget")
     parser.add_argument("--threads", type=int, default=0)
@@ -93,6 +156,10 @@ def main():
     parser.add_argument("--guide-variance", type=float, default=0.999)
     parser.add_argument("--json")
     args = parser.parse_args()
+    if args.compare:
+        rest = ["--size", str(args.size), "--usage", args.usage, "--threads", str(args.threads), "--em-iters",
+                str(args.em_iters), "--pm-iters", str(args.pm_iters), "--guide-variance", str(args.guide_variance)]
+        return compare(args, rest)
     s = args.size
     src, tgt, style = benchmark_scene(s)
     guides = [(a, b, 1.0) for a, b in zip(src, tgt)]

@@ -50,8 +50,17 @@ def test_classes_and_scene_settings_are_registered():
     assert bpy.types.TEMPERA_PT_output.bl_space_type == "PROPERTIES"
     settings = bpy.context.scene.tempera
     assert settings.output_dir == "//tempera/"
-    assert settings.patch_size == 5
-    assert settings.seed == 0
+    # The panel's defaults are the engine's and StyLit's, from the native tables.
+    import tempera
+
+    engine = tempera.SynthesisOptions()
+    assert settings.patch_size == engine.patch_size == 5
+    assert settings.seed == engine.seed == 1
+    assert settings.usage == engine.usage
+    for guide in tempera._native.light_path_guides():
+        assert getattr(settings, "weight_" + guide["name"].lower()) == pytest.approx(guide["weight"])
+    usage_items = {item.identifier for item in settings.bl_rna.properties["usage"].enum_items}
+    assert usage_items == set(tempera.USAGE_MODES)
     assert bpy.types.Scene.bl_rna.properties["tempera"].fixed_type.identifier == "TemperaSettings"
 
 

@@ -28,7 +28,7 @@ def exemplar(tmp_path_factory):
     import tempera
     from tempera import guide_cache
     from tempera.blender.guide_render import render_guides
-    from tempera.stylit_guides import tonemap
+    from tempera.stylize import tonemap
 
     folder = tmp_path_factory.mktemp("exemplar")
     scene = build_scene("Stylize exemplar")

@@ -51,8 +51,49 @@ def blue_yellow(size=96):
                         labelled_row([style, src_guide[..., None], tgt_guide[..., None], uniform, budget]))
 
 
+def output_modes(size=200):
+    """B' from the same search, made four ways: mean voting blends, the
+    others copy exemplar pixels (centre = a warp, Bénard 2013)."""
+    src, tgt, style = benchmark_scene(size)
+    guides = [(a, b, 1.0) for a, b in zip(src, tgt)]
+    results = [tempera.synthesize(style, guides, output=m, seed=1)[0] for m in ("mean", "centre", "mode", "random")]
+    tempera.write_image(str(OUT / "output_modes.png"), labelled_row([style, *results]))
+
+
+def usage_heat(stats, shape):
+    uses = np.zeros(shape[:2], np.float32)
+    np.add.at(uses, (stats.nnf[..., 1], stats.nnf[..., 0]), 1)
+    k = np.exp(-np.arange(-4, 5) ** 2 / (2 * 1.5 ** 2))
+    k /= k.sum()
+    uses = np.apply_along_axis(lambda r: np.convolve(r, k, "same"), 0, uses)
+    uses = np.apply_along_axis(lambda r: np.convolve(r, k, "same"), 1, uses)
+    return uses
+
+
+def histogram_term(size=128):
+    """Bénard 2013 Fig. 5 as a measurement: a repetitive exemplar and flat
+    guides; plain nearest neighbours pile onto a few tiles (bright spots in
+    the blurred usage map), the histogram term spreads them."""
+    rng = np.random.default_rng(10)
+    tile = rng.random((16, 16, 3), dtype=np.float32)
+    style = np.tile(tile, (size // 16, size // 16 * 3 // 2, 1)) + 0.02 * rng.random((size, size * 3 // 2, 3),
+                                                                                     dtype=np.float32)
+    flat_s = np.full(style.shape[:2], 0.5, np.float32)
+    flat_t = np.full((size * 3 // 4, size), 0.5, np.float32)
+    row, peaks = [style], []
+    for usage in ("none", "histogram"):
+        image, stats = tempera.synthesize(style, [(flat_s, flat_t)], usage=usage, seed=1)
+        heat = usage_heat(stats, style.shape)
+        peaks.append(heat.max())
+        row += [image, np.repeat((heat / 12.0)[..., None], 3, -1)]
+    tempera.write_image(str(OUT / "histogram_term.png"), labelled_row(row))
+    print(f"histogram term: peak blurred usage {peaks[0]:.1f} -> {peaks[1]:.1f}")
+
+
 if __name__ == "__main__":
     OUT.mkdir(parents=True, exist_ok=True)
     usage_modes()
     blue_yellow()
+    output_modes()
+    histogram_term()
     print("wrote", *sorted(p.name for p in OUT.glob("*.png")))

@@ -26,7 +26,7 @@ import demo_scene  # noqa: E402
 import tempera  # noqa: E402
 from tempera import guide_cache, guides  # noqa: E402
 from tempera.blender.guide_render import render_guides  # noqa: E402
-from tempera.stylit_guides import tonemap  # noqa: E402
+from tempera.stylize import tonemap  # noqa: E402
 
 OUT = ROOT / "docs" / "images" / "guide_cache_frame.png"
 FRAME = 4

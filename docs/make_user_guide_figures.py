@@ -15,7 +15,7 @@ import numpy as np
 
 import tempera
 from tempera import guide_cache
-from tempera.stylit_guides import tonemap
+from tempera.stylize import tonemap
 from tempera.stylize import StylizeJob
 
 IMAGES = Path(__file__).resolve().parent / "images"

@@ -116,7 +116,7 @@ def comparison_sheet(out, scene):
     import numpy as np
     import tempera
     from tempera import guide_cache, kit
-    from tempera.stylit_guides import tonemap
+    from tempera.stylize import tonemap
 
     style_path, exemplar_guides = kit.kit_exemplar()
     exemplar_render = tempera.read_image(str(style_path.parent / "render.png"))[:, :, :3]

@@ -36,7 +36,8 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 import scene_kit  # noqa: E402
 
-# The passes the StyLit guides need (see tempera.stylit_guides).
+# The passes of the kit's raw render (guides.exr); the light-path guides
+# themselves are in the kit's guide cache (guides/).
 EXEMPLAR_PASSES = ("Combined", "DiffDir", "DiffCol", "GlossDir", "GlossCol", "DiffInd")
 SCENE_NAME = "Tempera exemplar"
 

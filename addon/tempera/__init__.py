@@ -33,7 +33,7 @@ except ImportError as exc:  # not built, or built for another Python
 # Python API on top of the native module; public entry points are listed in __all__.
 from .contact_sheet import contact_sheet
 from .lpe import check_lpe, trace_lpe
-from .synthesis import USAGE_MODES, synthesize
+from .synthesis import USAGE_MODES, SynthesisOptions, synthesize
 
 __all__ = [
     "__version__",
@@ -43,6 +43,7 @@ __all__ = [
     "image_info",
     "read_image",
     "synthesize",
+    "SynthesisOptions",
     "trace_lpe",
     "USAGE_MODES",
     "write_image",

@@ -9,7 +9,7 @@ Layout of a cache folder (documented in docs/guide_cache.md):
 Channel names are "<guide>.<component>" (GUIDES below); masks are
 "mask.<OB_|CO_><name>.V"; light path expression guides are "lpe_<name>.R/G/B"
 (lpe_guide below). All values are float32 and linear (light-path
-guides are radiance, not tone-mapped: apply tempera.stylit_guides.tonemap).
+guides are radiance, not tone-mapped: apply tempera.stylize.tonemap).
 Images are rows top-down; x runs right and y down, velocities are in pixels
 with the conventions of tempera.guides.
 
@@ -28,16 +28,16 @@ from pathlib import Path
 
 import numpy as np
 
+from . import _native
+
 MANIFEST_NAME = "manifest.json"
 FORMAT_VERSION = 1
 
 # guide name -> channel components, in the order they are written.
 GUIDES = {
-    "FULL": "RGB",  # Combined: full global illumination
-    "LDE": "RGB",  # DiffDir * DiffCol: direct diffuse
-    "LSE": "RGB",  # GlossDir * GlossCol: direct specular
-    "LDDE": "RGB",  # DiffInd * DiffCol, caustics off: L.*DDE, diffuse interreflection
-    "LD12E": "RGB",  # (DiffDir + DiffInd) * DiffCol of a render with 1 diffuse, 0 glossy bounces
+    # StyLit's light paths (the native guide table), RGB radiance; how each is
+    # made from Cycles' passes: tempera.blender.guide_render.light_path_guides.
+    **{g["name"]: "RGB" for g in _native.light_path_guides()},
     "velocity_forward": "XY",  # V+: pixel p moves to p + V+ in the next frame
     "velocity_backward": "XY",  # V-: pixel p came from p - V- in the previous frame
     "occlusion_backward": "V",  # chi-: 1 visible in the previous frame, 0 disoccluded

@@ -16,14 +16,9 @@ import numpy as np
 
 from . import _native
 
-# The guides of the StyLit paper (thesis fig. 8.4), by name.
-STYLIT_EXPRESSIONS = {
-    "FULL": "L.*E",
-    "LDE": "LDE",
-    "LSE": "LSE",
-    "LDDE": "L.*DDE",
-    "LD12E": "LD{1,2}E",
-}
+# The guides of the StyLit paper (thesis fig. 8.4), by name (native guide table).
+STYLIT_EXPRESSIONS = {g["name"]: g["expression"] for g in _native.light_path_guides()}
+
 
 class _Reader:
     """One dict of the scene format, read strictly: a missing required key or

@@ -1,11 +1,19 @@
 """Limits and defaults of Tempera's user settings (no bpy: shared by the
-Blender UI, the tests and scripts that drive the engine without Blender)."""
+Blender UI, the tests and scripts that drive the engine without Blender).
+The engine's and StyLit's come from the native tables, where they are
+defined once (synthesis_options.hpp, stylit.hpp)."""
+from . import _native
 
 DEFAULT_OUTPUT_DIR = "//tempera/"  # "//" = relative to the .blend file
 
-PATCH_SIZE_DEFAULT = 5
-PATCH_SIZE_MIN = 3
-PATCH_SIZE_MAX = 15
+# name -> row of the engine's option table (name, flag, help, default, min, max, choices).
+ENGINE_OPTIONS = {row["name"]: row for row in _native.SynthesisOptions.table()}
+PATCH_SIZE_DEFAULT = ENGINE_OPTIONS["patch_size"]["default"]
+PATCH_SIZE_MIN = int(ENGINE_OPTIONS["patch_size"]["min"])
+# The panel stops at 15 (the engine takes up to the table's max, for very
+# coarse media, from scripts and the CLI).
+PATCH_SIZE_MAX = min(15, int(ENGINE_OPTIONS["patch_size"]["max"]))
+SEED_DEFAULT = ENGINE_OPTIONS["seed"]["default"]
 
 
 def odd_patch_size(size):
@@ -17,14 +25,13 @@ def odd_patch_size(size):
     return max(PATCH_SIZE_MIN, min(PATCH_SIZE_MAX, size))
 
 
-# Stylization defaults shared by the panel, scripts and the CLI's documentation.
-# StyLit's light-path guides (names as in the guide cache) and their weights:
-# LDE counts double because a painting's stroke density follows the direct
-# diffuse shading; L.*DDE counts half, at guide sample counts it is the
-# noisiest guide; LD{1,2}E is off by default (it needs a second render).
-DEFAULT_GUIDE_WEIGHTS = {"FULL": 1.0, "LDE": 2.0, "LSE": 1.0, "LDDE": 0.5, "LD12E": 0.0}
+# StyLit's light-path guides (names as in the guide cache): name, expression,
+# default weight, label and help, in matching order.
+LIGHT_PATH_GUIDES = tuple(_native.light_path_guides())
+DEFAULT_GUIDE_WEIGHTS = {g["name"]: g["weight"] for g in LIGHT_PATH_GUIDES}
 # Pull towards the previous stylized frame advected along the motion (Fišer
 # 2017, EbSynth); 0 stylizes every frame on its own. See docs/user_guide.md.
-DEFAULT_TEMPORAL_WEIGHT = 0.5
+DEFAULT_TEMPORAL_WEIGHT = _native.stylit_defaults()["temporal_weight"]
+DEFAULT_QUALITY = _native.stylit_defaults()["quality"]
 QUALITY_PRESETS = ("preview", "final")
 OUTPUT_FORMATS = ("png", "exr")

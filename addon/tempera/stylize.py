@@ -13,17 +13,32 @@ from typing import Callable, Iterable, Mapping, Optional
 import numpy as np
 
 from . import _native
+from .settings import DEFAULT_GUIDE_WEIGHTS as DEFAULT_WEIGHTS
+from .settings import LIGHT_PATH_GUIDES, QUALITY_PRESETS as QUALITIES
 
-GUIDES = ("FULL", "LDE", "LSE", "LDDE", "LD12E")
-DEFAULT_WEIGHTS = {"FULL": 1.0, "LDE": 2.0, "LSE": 1.0, "LDDE": 0.5, "LD12E": 0.0}
-QUALITIES = ("preview", "final")
+GUIDES = tuple(g["name"] for g in LIGHT_PATH_GUIDES)
 
 ProgressFn = Optional[Callable[[float], Optional[bool]]]
 
 
-def _stylit_options(weights, temporal_weight, quality, usage, patch_size, seed, threads):
-    options = dict(temporal_weight=float(temporal_weight), quality=str(quality), usage=str(usage),
-                   patch_size=int(patch_size), seed=int(seed), threads=int(threads))
+def tonemap(linear):
+    """Linear radiance -> guide values in [0, 1) as StyLit matches them:
+    NaN and negatives to 0, Reinhard x / (1 + x), then the sRGB encoding.
+    Per pixel, with no image-dependent normalization, so equal lighting gives
+    equal guides in the exemplar and in every frame."""
+    a = np.asarray(linear, dtype=np.float32)
+    flat = a.reshape(a.shape[0], -1) if a.ndim == 1 else a
+    return _native.tonemap_guide(np.ascontiguousarray(flat)).reshape(a.shape)
+
+
+def _stylit_options(weights, temporal_weight, quality, engine):
+    """The native options dict: StyLit's keys plus engine options (names of
+    tempera.SynthesisOptions; the native side rejects unknown ones)."""
+    options = dict(engine)
+    if temporal_weight is not None:
+        options["temporal_weight"] = float(temporal_weight)
+    if quality is not None:
+        options["quality"] = str(quality)
     if weights is not None:
         options["weights"] = {str(k): float(v) for k, v in dict(weights).items()}
     return options
@@ -41,9 +56,10 @@ class StylizeJob:
     exemplar_frame   frame of exemplar_guides to use (default: its only frame)
     weights          {guide: weight} overriding DEFAULT_WEIGHTS (<= 0 leaves a guide out)
     temporal_weight  pull towards the previous stylized frame advected along
-                     the motion (0 = frames independent)
+                     the motion (0 = frames independent; None = the default,
+                     settings.DEFAULT_TEMPORAL_WEIGHT)
     quality          "final" (engine defaults) or "preview" (fast, for interaction)
-    usage, patch_size, seed, threads   engine options (tempera.synthesize)
+    **engine         engine options (tempera.SynthesisOptions: usage, patch_size, seed, threads, ...)
     resume           skip frames whose output is current (see docs/cli.md)
 
     Construction checks every file and guide up front (FileNotFoundError,
@@ -53,13 +69,12 @@ class StylizeJob:
 
     def __init__(self, style, exemplar_guides, guides, frames: Iterable[int], out, *, exemplar_frame=None,
                  format="png", prefix="frame_", weights: Optional[Mapping[str, float]] = None,
-                 temporal_weight=0.0, quality="final", usage="budget", patch_size=5, seed=1, threads=0,
-                 resume=True):
+                 temporal_weight=None, quality=None, resume=True, **engine):
         config = dict(style=os.fspath(style), exemplar_guides=os.fspath(exemplar_guides),
                       guides=os.fspath(guides), frames=[int(f) for f in frames], out=os.fspath(out),
                       exemplar_frame=None if exemplar_frame is None else int(exemplar_frame),
                       format=str(format), prefix=str(prefix), resume=bool(resume),
-                      **_stylit_options(weights, temporal_weight, quality, usage, patch_size, seed, threads))
+                      **_stylit_options(weights, temporal_weight, quality, engine))
         self._job = _native.StylizeJob(config)
 
     @property
@@ -94,8 +109,8 @@ class StylizeJob:
 
 
 def stylize_frame(style, exemplar: Mapping, target: Mapping, *, previous=None, velocity_backward=None,
-                  occlusion_backward=None, weights=None, temporal_weight=0.0, quality="final", usage="budget",
-                  patch_size=5, seed=1, threads=0, progress: ProgressFn = None):
+                  occlusion_backward=None, weights=None, temporal_weight=None, quality=None,
+                  progress: ProgressFn = None, **engine):
     """One StyLit frame from arrays: ``exemplar`` and ``target`` map guide names
     (FULL, LDE, ...) to linear (H, W, 3) arrays as in a guide cache (they are
     tone-mapped here). Give ``previous`` (the previous stylized frame) with the
@@ -107,7 +122,7 @@ def stylize_frame(style, exemplar: Mapping, target: Mapping, *, previous=None, v
             raise ValueError("previous needs velocity_backward and occlusion_backward")
         temporal = dict(previous=_float(previous), velocity_backward=_float(velocity_backward),
                         occlusion_backward=_float(occlusion_backward))
-    options = _stylit_options(weights, temporal_weight, quality, usage, patch_size, seed, threads)
+    options = _stylit_options(weights, temporal_weight, quality, engine)
     return _native.stylize_frame(_float(style), {k: _float(v) for k, v in exemplar.items()},
                                  {k: _float(v) for k, v in target.items()}, options, temporal, progress)
 

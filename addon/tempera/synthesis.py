@@ -12,7 +12,6 @@ import numpy as np
 
 from . import _native
 
-USAGE_MODES = ("none", "penalty", "uniform", "budget")
 
 
 def _as_image(array, what: str) -> np.ndarray:
@@ -54,23 +53,32 @@ def _guide_tuple(index: int, guide) -> tuple:
     )
 
 
+def _option_help() -> str:
+    lines = []
+    for row in _native.SynthesisOptions.table():
+        choices = f" ({', '.join(row['choices'])})" if row["choices"] else ""
+        lines.append(f"    {row['name']} = {row['default']!r}{choices}: {row['help']}")
+    return "\n".join(lines)
+
+
+def _exemplar(index: int, exemplar) -> dict:
+    if not isinstance(exemplar, dict):
+        raise ValueError(f"exemplar {index}: expected a dict with 'style' and 'guides', got {type(exemplar).__name__}")
+    out = dict(exemplar)
+    for key in ("style", "mask", "orientation", "segments"):
+        if out.get(key) is not None:
+            out[key] = _as_image(out[key], f"exemplar {index} {key}")
+    out["guides"] = [_as_image(g, f"exemplar {index} guide {k}") for k, g in enumerate(out.get("guides", ()))]
+    return out
+
+
 def synthesize(
     style,
     guides: Iterable = (),
     *,
-    usage: str = "budget",
-    patch_size: int = 5,
-    levels: int = 0,
-    em_iterations: int = 6,
-    pm_iterations: int = 2,
-    style_weight: float = 1.0,
-    penalty_weight: float = 1.0,
-    guide_variance: float = 0.999,
-    axial_orientation: bool = True,
-    budget_coverage: float = 0.95,
-    budget_max_rounds: int = 16,
-    seed: int = 1,
-    threads: int = 0,
+    exemplars: Sequence[dict] = (),
+    reference=None,
+    fixed: Optional[dict] = None,
     source_mask=None,
     target_mask=None,
     source_orientation=None,
@@ -78,48 +86,66 @@ def synthesize(
     source_segments=None,
     target_segments=None,
     target_shape: Optional[Sequence[int]] = None,
+    options=None,
     progress: Optional[Callable[[float], Optional[bool]]] = None,
+    **option_values,
 ):
     """Synthesize B' from the exemplar ``style`` and guide pairs.
 
     ``guides``: (source, target[, weight]) tuples or dicts (see _guide_tuple);
     all sources are the size of ``style``, all targets the size of the output.
-    ``usage``: ``none``, ``penalty`` (occurrence penalty, ``penalty_weight``),
-    ``uniform`` (every source patch used equally; per ``*_segments`` label) or
-    ``budget`` (StyLit's error budget, the default).
-    ``guide_variance``: fraction of the weighted guide variance kept when the
-    guide channels are compressed by PCA (1.0 = exact matching, slower).
+    ``exemplars``: further exemplars of the source set (painted keyframes, the
+    frames of a video exemplar), dicts with ``style``, ``guides`` (one source
+    per guide pair, in order) and optional ``mask``, ``orientation``,
+    ``segments``, ``sequence`` and ``time``.
+    ``reference``: B' to start the coarsest level from (Color Me Noisy).
+    ``fixed``: hard constraints, dict(mask=, values=[, matches=(H, W, 3)
+    exemplar index, x, y]): those pixels keep their values and their
+    neighbours continue them.
     Orientations are per-pixel angles in radians (direction (cos a, sin a), x
-    right, y down); giving either enables rotation-aware patches. With
-    ``axial_orientation`` (default) they are taken modulo pi, like stroke
-    directions, and patches turn by the smallest angle that aligns them.
+    right, y down); giving either enables rotation-aware patches.
     ``progress(fraction)`` is called during the run; returning False cancels it
     (raises ``tempera.Cancelled``).
+    Engine options are keywords (or ``options=tempera.SynthesisOptions(...)``);
+    unknown names are errors. They are, with their defaults:
 
-    Returns ``(image, stats)``: the float32 (H, W, C) result and a dict with the
-    energy per level and iteration, seconds per stage, source coverage and the
-    final NNF (``stats["nnf"]``, (H, W, 2) source x, y per target pixel).
-    See docs/engine.md.
+    {options}
+
+    Returns ``(image, stats)``: the float32 (H, W, C) result and a
+    ``SynthesisStats`` (also readable as ``stats["name"]``): energy per level
+    and iteration, seconds per stage, source coverage, and the final match per
+    pixel: ``nnf`` ((H, W, 2) int source x, y), ``exemplar`` ((H, W), 0 =
+    ``style``) and ``field`` ((H, W, 2) sub-pixel positions). See docs/engine.md.
     """
-    if usage not in USAGE_MODES:
-        raise ValueError(f"unknown patch usage '{usage}' (choose {', '.join(USAGE_MODES)})")
+    opts = _native.SynthesisOptions() if options is None else options
+    for name, value in option_values.items():
+        if not hasattr(opts, name):
+            known = ", ".join(row["name"] for row in _native.SynthesisOptions.table())
+            raise TypeError(f"synthesize() got an unexpected keyword argument '{name}' (engine options: {known})")
+        setattr(opts, name, value)
+    opts.validate()
     style = _as_image(style, "style")
     guide_list = [_guide_tuple(i, g) for i, g in enumerate(guides)]
     if target_shape is not None:
         target_shape = (int(target_shape[0]), int(target_shape[1]))
     elif not guide_list:
         raise ValueError("give at least one guide pair or target_shape=(height, width)")
-    options = dict(usage=usage, patch_size=int(patch_size), levels=int(levels), em_iterations=int(em_iterations),
-                   pm_iterations=int(pm_iterations), style_weight=float(style_weight),
-                   penalty_weight=float(penalty_weight), guide_variance=float(guide_variance),
-                   axial_orientation=bool(axial_orientation), budget_coverage=float(budget_coverage),
-                   budget_max_rounds=int(budget_max_rounds), seed=int(seed), threads=int(threads))
     given_maps = dict(source_mask=source_mask, target_mask=target_mask, source_orientation=source_orientation,
                       target_orientation=target_orientation, source_segments=source_segments,
                       target_segments=target_segments)
     maps = {name: _as_image(m, name.replace("_", " ")) for name, m in given_maps.items() if m is not None}
+    exemplar_list = [_exemplar(i + 1, e) for i, e in enumerate(exemplars)]
+    if reference is not None:
+        reference = _as_image(reference, "reference")
+    if fixed is not None:
+        fixed = {k: (None if v is None else _as_image(v, f"fixed {k}")) for k, v in dict(fixed).items()}
 
     def report(fraction: float) -> bool:
         return True if progress is None else progress(fraction) is not False
 
-    return _native.synthesize(style, guide_list, options, maps, target_shape, report)
+    return _native.synthesize(style, guide_list, opts, maps, target_shape, exemplar_list, reference, fixed, report)
+
+
+synthesize.__doc__ = synthesize.__doc__.replace("    {options}", _option_help())
+USAGE_MODES = tuple(next(r["choices"] for r in _native.SynthesisOptions.table() if r["name"] == "usage"))
+SynthesisOptions = _native.SynthesisOptions

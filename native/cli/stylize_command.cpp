@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 namespace tempera::cli {
 namespace {
 
-const char* kStylizeHelp =
+const char* kStylizeHelpText =
     "usage: tempera stylize SCENE.blend --exemplar STYLE.png (--exemplar-scene EXEMPLAR.blend |\n"
     "                       --exemplar-guides DIR) --frames A-B --out DIR [options]\n"
     "       tempera stylize --guides DIR --exemplar STYLE.png --exemplar-guides DIR --frames A-B\n"
@@ -50,15 +50,16 @@ const char* kStylizeHelp =
     "  --out DIR               output folder\n"
     "\n"
     "stylization:\n"
-    "  --weights LIST          light-path guide weights (default FULL=1,LDE=2,LSE=1,LDDE=0.5,LD12E=0);\n"
+    "  --weights LIST          light-path guide weights (default @WEIGHTS@);\n"
     "                          guides not listed keep their default, 0 leaves a guide out\n"
     "  --temporal W            weight of the temporal guide: the previous stylized frame\n"
-    "                          advected along the motion (default 0 = frames independent)\n"
+    "                          advected along the motion (default 0.5; 0 = frames independent)\n"
     "  --quality Q             final (default) | preview (about 5x faster, for trying settings)\n"
     "  --usage MODE            none | penalty | uniform | budget (default budget)\n"
     "  --patch-size N          odd patch width (default 5)\n"
     "  --seed N                random seed (default 1)\n"
     "  --threads N             worker threads (default 0 = all cores)\n"
+    "  (any engine option of 'tempera synth --help', e.g. --em-iters 4 --window-sigma 3)\n"
     "  --format F              png (default) | exr (float, linear as painted)\n"
     "  --fps F                 frame rate of the video (default 24)\n"
     "  --no-video              do not encode OUT/stylized.mp4\n"
@@ -73,6 +74,16 @@ const char* kStylizeHelp =
     "painting and guide files (sizes and modification times); rerun the same command after\n"
     "an interruption. Ctrl-C stops within the current frame; finished frames are kept.\n"
     "Exit status: 0 done, 1 error, 2 bad usage, 130 interrupted.\n";
+
+// The help, with the guide weights' defaults from the guide table.
+std::string stylize_help() {
+  std::string defaults;
+  for (const auto& g : light_path_guides())
+    defaults += (defaults.empty() ? "" : ",") + std::string(g.name) + "=" + format_value(g.weight);
+  std::string text = kStylizeHelpText;
+  text.replace(text.find("@WEIGHTS@"), 9, defaults);
+  return text;
+}
 
 volatile std::sig_atomic_t g_interrupted = 0;
 
@@ -89,27 +100,6 @@ struct Options {
   BlenderSetup blender = default_blender_setup();
 };
 
-void parse_weights(const std::string& text, StylitOptions& opt) {
-  std::size_t start = 0;
-  while (start < text.size()) {
-    const std::size_t end = std::min(text.find(',', start), text.size());
-    const std::string item = text.substr(start, end - start);
-    const std::size_t eq = item.find('=');
-    if (eq == std::string::npos) throw ValueError(concat("--weights expects NAME=W items, got '", item, "'"));
-    const std::string name = item.substr(0, eq);
-    auto it = std::find_if(opt.weights.begin(), opt.weights.end(), [&](auto& w) { return w.first == name; });
-    if (it == opt.weights.end())
-      throw ValueError(concat("unknown guide '", name, "' in --weights (FULL, LDE, LSE, LDDE, LD12E)"));
-    const std::string number = item.substr(eq + 1);
-    float w = 0;
-    const auto [ptr, ec] = std::from_chars(number.data(), number.data() + number.size(), w);
-    if (ec != std::errc() || ptr != number.data() + number.size() || number.empty())
-      throw ValueError(concat("--weights: '", number, "' is not a number (in '", item, "')"));
-    it->second = w;
-    start = end + 1;
-  }
-}
-
 Options parse(const Args& args) {
   Options o;
   std::size_t first = 0;
@@ -125,13 +115,9 @@ Options parse(const Args& args) {
     else if (flag == "--guides") o.guides = r.value(flag);
     else if (flag == "--frames") o.frames = parse_frames(o.frames_text = r.value(flag));
     else if (flag == "--out") o.out = r.value(flag);
-    else if (flag == "--weights") parse_weights(r.value(flag), o.stylit);
+    else if (flag == "--weights") parse_guide_weights(r.value(flag), o.stylit.weights);
     else if (flag == "--temporal") o.stylit.temporal_weight = r.number<float>(flag);
     else if (flag == "--quality") o.stylit.quality = parse_quality(r.value(flag));
-    else if (flag == "--usage") o.stylit.synthesis.usage = parse_patch_usage(r.value(flag));
-    else if (flag == "--patch-size") o.stylit.synthesis.patch_size = r.number<int>(flag);
-    else if (flag == "--seed") o.stylit.synthesis.seed = r.number<std::uint64_t>(flag);
-    else if (flag == "--threads") o.stylit.synthesis.threads = r.number<int>(flag);
     else if (flag == "--format") o.format = r.value(flag);
     else if (flag == "--fps") o.fps = r.number<double>(flag);
     else if (flag == "--no-video") o.video = false;
@@ -139,8 +125,10 @@ Options parse(const Args& args) {
     else if (flag == "--samples") o.samples = std::to_string(r.number<int>(flag));
     else if (flag == "--blender") o.blender.blender = r.value(flag);
     else if (flag == "--addon-path") o.blender.addon = r.value(flag);
-    else throw ValueError(concat("unknown option '", flag, "' (see tempera stylize --help)"));
+    else if (!set_from_flag(o.stylit.synthesis, synthesis_option_table(), flag.substr(2), [&] { return r.value(flag); }))
+      throw ValueError(concat("unknown option '", flag, "' (see tempera stylize --help)"));
   }
+  validate(o.stylit.synthesis);
   if (o.exemplar.empty()) throw ValueError("--exemplar is required (the painting)");
   if (o.frames.empty()) throw ValueError("--frames is required (e.g. --frames 1-24)");
   if (o.out.empty()) throw ValueError("--out is required (the output folder)");
@@ -245,7 +233,7 @@ int interrupted(const std::vector<FrameResult>& results) {
 
 int run_stylize(const Args& args) {
   if (ArgReader(args, "stylize").wants_help() || args.empty()) {
-    std::cout << kStylizeHelp;
+    std::cout << stylize_help();
     return args.empty() ? 2 : 0;
   }
   Options o = parse(args);  // usage errors propagate: exit status 2

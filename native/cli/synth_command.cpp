@@ -8,38 +8,34 @@
 #include "cli_args.hpp"
 #include "tempera/error.hpp"
 #include "tempera/image_io.hpp"
+#include "tempera/patch_usage.hpp"
 #include "tempera/synthesis.hpp"
 
 namespace tempera::cli {
 namespace {
 
-const char* kSynthHelp =
-    "usage: tempera synth --style S.png --guide SRC.png TGT.png [--weight W] ... --output OUT.png [options]\n"
-    "\n"
-    "Synthesizes OUT from the exemplar S where the guides agree (StyLit image analogies).\n"
-    "A --weight applies to the --guide pair before it (default 1).\n"
-    "\n"
-    "options:\n"
-    "  --style FILE            exemplar (A')\n"
-    "  --guide SRC TGT         a guide pair: SRC has the size of the style, TGT of the output;\n"
-    "                          FILE:LAYER takes one layer of a multilayer EXR, e.g. a guide cache\n"
-    "                          frame: --guide ex/frame_0001.exr:LDE shot/frame_0012.exr:LDE\n"
-    "  --weight W              weight of the preceding guide pair\n"
-    "  --output FILE           result (B'); PNG/JPEG are clamped to [0,1], EXR/TIFF keep float\n"
-    "  --usage MODE            none | penalty | uniform | budget (default budget)\n"
-    "  --patch-size N          odd patch width (default 5)\n"
-    "  --levels N              pyramid levels (default 0 = automatic)\n"
-    "  --em-iters N            search+vote iterations per level (default 6)\n"
-    "  --pm-iters N            PatchMatch sweeps per search (default 2)\n"
-    "  --style-weight W        weight of the style term (default 1)\n"
-    "  --penalty-weight W      occurrence penalty lambda for --usage penalty (default 1)\n"
-    "  --guide-variance F     guide variance kept by PCA compression (default 0.999; 1 = exact)\n"
-    "  --source-mask FILE      exemplar pixels that may be copied (> 0.5)\n"
-    "  --target-mask FILE      output pixels to synthesize (> 0.5)\n"
-    "  --seed N                random seed (default 1)\n"
-    "  --threads N             worker threads (default 0 = all cores)\n"
-    "  --stats FILE            write energies, timings and coverage as JSON\n"
-    "  --quiet                 no progress on stderr\n";
+std::string synth_help() {
+  return "usage: tempera synth --style S.png --guide SRC.png TGT.png [--weight W] ... --output OUT.png [options]\n"
+         "\n"
+         "Synthesizes OUT from the exemplar S where the guides agree (StyLit image analogies).\n"
+         "A --weight applies to the --guide pair before it (default 1).\n"
+         "\n"
+         "inputs and outputs:\n"
+         "  --style FILE            exemplar (A')\n"
+         "  --guide SRC TGT         a guide pair: SRC has the size of the style, TGT of the output;\n"
+         "                          FILE:LAYER takes one layer of a multilayer EXR, e.g. a guide cache\n"
+         "                          frame: --guide ex/frame_0001.exr:LDE shot/frame_0012.exr:LDE\n"
+         "  --weight W              weight of the preceding guide pair\n"
+         "  --output FILE           result (B'); PNG/JPEG are clamped to [0,1], EXR/TIFF keep float\n"
+         "  --source-mask FILE      exemplar pixels that may be copied (> 0.5)\n"
+         "  --target-mask FILE      output pixels to synthesize (> 0.5)\n"
+         "  --reference FILE        B' to start the coarsest level from (Color Me Noisy)\n"
+         "  --stats FILE            write energies, timings and coverage as JSON\n"
+         "  --quiet                 no progress on stderr\n"
+         "\n"
+         "engine options (lists are comma-separated):\n" +
+         flags_help<SynthesisOptions>(synthesis_option_table());
+}
 
 struct GuideFiles {
   std::string source, target;
@@ -83,10 +79,10 @@ void write_stats(const std::string& path, const SynthesisResult& r, const Synthe
 int run_synth(const Args& args) {
   ArgReader in(args, "synth");
   if (in.wants_help()) {
-    std::cout << kSynthHelp;
+    std::cout << synth_help();
     return 0;
   }
-  std::string style_path, output_path, stats_path, source_mask_path, target_mask_path;
+  std::string style_path, output_path, stats_path, source_mask_path, target_mask_path, reference_path;
   std::vector<GuideFiles> guides;
   SynthesisOptions opt;
   bool quiet = false;
@@ -102,21 +98,13 @@ int run_synth(const Args& args) {
       if (guides.empty()) throw ValueError("--weight must follow a --guide pair");
       guides.back().weight = in.number<float>(flag);
     } else if (flag == "--output") output_path = in.value(flag);
-    else if (flag == "--usage") opt.usage = parse_patch_usage(in.value(flag));
-    else if (flag == "--patch-size") opt.patch_size = in.number<int>(flag);
-    else if (flag == "--levels") opt.levels = in.number<int>(flag);
-    else if (flag == "--em-iters") opt.em_iterations = in.number<int>(flag);
-    else if (flag == "--pm-iters") opt.pm_iterations = in.number<int>(flag);
-    else if (flag == "--style-weight") opt.style_weight = in.number<float>(flag);
-    else if (flag == "--penalty-weight") opt.penalty_weight = in.number<float>(flag);
-    else if (flag == "--guide-variance") opt.guide_variance = in.number<double>(flag);
     else if (flag == "--source-mask") source_mask_path = in.value(flag);
     else if (flag == "--target-mask") target_mask_path = in.value(flag);
-    else if (flag == "--seed") opt.seed = in.number<std::uint64_t>(flag);
-    else if (flag == "--threads") opt.threads = in.number<int>(flag);
+    else if (flag == "--reference") reference_path = in.value(flag);
     else if (flag == "--stats") stats_path = in.value(flag);
     else if (flag == "--quiet") quiet = true;
-    else throw ValueError(concat("unknown option '", flag, "' (see tempera synth --help)"));
+    else if (!set_from_flag(opt, synthesis_option_table(), flag.substr(2), [&] { return in.value(flag); }))
+      throw ValueError(concat("unknown option '", flag, "' (see tempera synth --help)"));
   }
   if (style_path.empty()) throw ValueError("--style is required");
   if (output_path.empty()) throw ValueError("--output is required");
@@ -137,7 +125,8 @@ int run_synth(const Args& args) {
                               style.height()));
     input.guides.add(guides[i].source, sources[i].view(), targets[i].view(), guides[i].weight);
   }
-  Image source_mask, target_mask;
+  Image source_mask, target_mask, reference;
+  if (!reference_path.empty()) input.reference = (reference = read_input(reference_path)).view();
   if (!source_mask_path.empty()) input.source_mask = (source_mask = read_mask(source_mask_path)).view();
   if (!target_mask_path.empty()) input.target_mask = (target_mask = read_mask(target_mask_path)).view();
 

@@ -8,9 +8,11 @@
 #include <cmath>
 #include <set>
 
+#include "bind_options.hpp"
 #include "numpy_bridge.hpp"
 #include "tempera/contact_sheet.hpp"
 #include "tempera/process.hpp"
+#include "tempera/pyramid.hpp"
 #include "tempera/stylit.hpp"
 #include "tempera/stylize_job.hpp"
 
@@ -20,8 +22,14 @@ using py_bridge::FloatArray;
 
 namespace {
 
-const std::set<std::string> kStylitKeys = {"weights", "temporal_weight", "quality", "usage",
-                                           "patch_size", "seed", "threads"};
+// StyLit's own keys; every other key is an engine option (SynthesisOptions).
+const std::set<std::string> kStylitKeys = {"weights", "temporal_weight", "quality"};
+
+std::set<std::string> stylit_keys() {
+  std::set<std::string> keys = kStylitKeys;
+  for_each_field(synthesis_option_table(), [&](const auto& f) { keys.insert(f.name); });
+  return keys;
+}
 const std::set<std::string> kJobKeys = {"style", "exemplar_guides", "exemplar_frame", "guides", "frames",
                                         "out", "format", "prefix", "resume"};
 
@@ -40,11 +48,8 @@ void set_weights(StylitOptions& opt, const py::dict& weights) {
   for (const auto& [key, value] : weights) {
     const std::string name = py::str(key);
     auto it = std::find_if(opt.weights.begin(), opt.weights.end(), [&](auto& w) { return w.first == name; });
-    if (it == opt.weights.end()) {
-      std::string known;
-      for (const auto& g : light_path_guides()) known += (known.empty() ? "" : ", ") + g;
-      throw ValueError(concat("unknown guide '", name, "' in weights (StyLit guides: ", known, ")"));
-    }
+    if (it == opt.weights.end())
+      throw ValueError(concat("unknown guide '", name, "' in weights (StyLit guides: ", light_path_guide_names(), ")"));
     it->second = value.cast<float>();
   }
 }
@@ -54,16 +59,19 @@ StylitOptions parse_stylit(const py::dict& d) {
   if (d.contains("weights")) set_weights(opt, d["weights"].cast<py::dict>());
   if (d.contains("temporal_weight")) opt.temporal_weight = d["temporal_weight"].cast<float>();
   if (d.contains("quality")) opt.quality = parse_quality(d["quality"].cast<std::string>());
-  if (d.contains("usage")) opt.synthesis.usage = parse_patch_usage(d["usage"].cast<std::string>());
-  if (d.contains("patch_size")) opt.synthesis.patch_size = d["patch_size"].cast<int>();
-  if (d.contains("seed")) opt.synthesis.seed = d["seed"].cast<std::uint64_t>();
-  if (d.contains("threads")) opt.synthesis.threads = d["threads"].cast<int>();
+  py::dict engine;
+  std::set<std::string> engine_keys;
+  for_each_field(synthesis_option_table(), [&](const auto& f) { engine_keys.insert(f.name); });
+  for (const auto& [key, value] : d)
+    if (engine_keys.count(py::str(key))) engine[key] = value;
+  py_bridge::set_from_dict(opt.synthesis, synthesis_option_table(), engine, "engine option");
+  validate(opt.synthesis);
   active_guides(opt);  // errors now, not in the middle of a run
   return opt;
 }
 
 StylizeJobConfig parse_job_config(const py::dict& d) {
-  reject_unknown(d, kJobKeys, kStylitKeys, "StylizeJob config");
+  reject_unknown(d, kJobKeys, stylit_keys(), "StylizeJob config");
   for (const char* key : {"style", "exemplar_guides", "guides", "frames", "out"})
     if (!d.contains(key)) throw ValueError(concat("StylizeJob config needs '", key, "'"));
   StylizeJobConfig c;
@@ -113,7 +121,7 @@ GuideFrame guide_frame(const py::dict& arrays, const char* what, std::vector<Flo
 
 py::tuple stylize_frame_py(const FloatArray& style, const py::dict& exemplar, const py::dict& target,
                            const py::dict& options, const py::object& temporal, const py::object& progress) {
-  reject_unknown(options, kStylitKeys, {}, "stylize_frame option");
+  reject_unknown(options, stylit_keys(), {}, "stylize_frame option");
   const StylitOptions opt = parse_stylit(options);
   std::vector<FloatArray> keep;
   const GuideFrame ex = guide_frame(exemplar, "exemplar", keep), tg = guide_frame(target, "target", keep);
@@ -195,6 +203,44 @@ void bind_stylize(py::module_& m) {
       py::arg("previous"), py::arg("current"), py::arg("velocity_backward"), py::arg("visible"),
       "Mean absolute colour change along valid motion; use tempera.temporal.flicker.");
   m.def(
+      "stylit_defaults",
+      [] {
+        const StylitOptions o;
+        py::dict d;
+        d["temporal_weight"] = o.temporal_weight;
+        d["quality"] = quality_name(o.quality);
+        return d;
+      },
+      "StyLit's own defaults (the engine's are SynthesisOptions.table()).");
+  m.def(
+      "light_path_guides",
+      [] {
+        py::list out;
+        for (const auto& g : light_path_guides()) {
+          py::dict d;
+          d["name"] = g.name;
+          d["expression"] = g.expression;
+          d["weight"] = g.weight;
+          d["label"] = g.label;
+          d["help"] = g.help;
+          out.append(d);
+        }
+        return out;
+      },
+      "StyLit's light-path guides: name, expression, default weight, label, help (the one table, stylit.hpp).");
+  m.def(
+      "box_blur",
+      [](const FloatArray& image, float width) {
+        const ImageView v = py_bridge::view_of(image, "image");
+        Image out;
+        {
+          py::gil_scoped_release release;
+          out = box_blur(v, width);
+        }
+        return py_bridge::to_numpy(std::move(out));
+      },
+      py::arg("image"), py::arg("width"), "Box low-pass of `width` pixels (pyramid.hpp), clamped at the borders.");
+  m.def(
       "tonemap_guide",
       [](const FloatArray& linear) {
         const ImageView v = py_bridge::view_of(linear, "linear");
@@ -205,7 +251,7 @@ void bind_stylize(py::module_& m) {
         }
         return py_bridge::to_numpy(std::move(out));
       },
-      py::arg("linear"), "x/(1+x) then sRGB, as tempera.stylit_guides.tonemap.");
+      py::arg("linear"), "Linear radiance -> guide values in [0, 1): x/(1+x), then sRGB (use tempera.stylize.tonemap).");
   m.def(
       "contact_sheet",
       [](const std::vector<FloatArray>& images, int columns, int gap, int margin, std::vector<float> background) {

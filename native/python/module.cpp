@@ -76,6 +76,8 @@ void bind_synthesis(py::module_& m);  // bind_synthesis.cpp
 void bind_guides(py::module_& m);     // bind_guides.cpp
 void bind_stylize(py::module_& m);    // bind_stylize.cpp
 void bind_tracer(py::module_& m);     // bind_tracer.cpp
+void bind_noisy(py::module_& m);      // bind_noisy.cpp
+void bind_tcia(py::module_& m);       // bind_tcia.cpp
 
 PYBIND11_MODULE(_native, m) {
   m.doc() = "Tempera native engine";
@@ -86,4 +88,6 @@ PYBIND11_MODULE(_native, m) {
   bind_guides(m);
   bind_stylize(m);
   bind_tracer(m);
+  bind_noisy(m);
+  bind_tcia(m);
 }

@@ -18,6 +18,16 @@ void FeatureImage::set_channels(int first, const ImageView& image, float scale) 
       data[i * stride + first + c] = image.data[i * image.channels + c] * scale;
 }
 
+void FeatureImage::set_channels(int first, const ImageView& image, const std::vector<float>& scales) {
+  if (image.width != width || image.height != height || first + image.channels > stride ||
+      int(scales.size()) != image.channels)
+    throw ValueError("internal: feature channels do not fit the feature image");
+  const std::size_t n = std::size_t(width) * height;
+  for (std::size_t i = 0; i < n; ++i)
+    for (int c = 0; c < image.channels; ++c)
+      data[i * stride + first + c] = image.data[i * image.channels + c] * scales[c];
+}
+
 void sample_bilinear(const float* data, int width, int height, int stride, int channels, float x,
                      float y, float* out) {
   x = std::clamp(x, 0.0f, float(width - 1));
@@ -89,22 +99,44 @@ template <bool Weighted>
   return sum;
 }
 
+// Axis-aligned patches under a window: each pixel's SSD is weighted.
+[[gnu::always_inline]] inline float distance_windowed(const PatchSpace& s, int sx, int sy, int tx, int ty,
+                                                      float cutoff) {
+  const Window w = clip(s, tx, ty);
+  const int stride = s.source->stride, side = 2 * s.radius + 1;
+  float sum = 0.0f;
+  for (int dy = w.dy0; dy <= w.dy1; ++dy) {
+    const float* row_w = s.window + (dy + s.radius) * side + s.radius;
+    for (int dx = w.dx0; dx <= w.dx1; ++dx) {
+      const float* a = s.source->pixel(sx + dx, sy + dy);
+      const float* b = s.target->pixel(tx + dx, ty + dy);
+      const float d = s.target_weights ? weighted_ssd(a, b, s.target_weights->pixel(tx + dx, ty + dy), stride)
+                                       : ssd(a, b, stride);
+      sum += row_w[dx] * d;
+    }
+    if (sum >= cutoff) return sum;
+  }
+  return sum;
+}
+
 // Rotated patches: the source is sampled bilinearly along rotated offsets.
 [[gnu::always_inline]] inline float distance_rotated(const PatchSpace& s, int sx, int sy, int tx, int ty, float cutoff) {
   const Window w = clip(s, tx, ty);
   const int stride = s.source->stride;
   const float phi = s.rotation(sx, sy, tx, ty);
   const float c = std::cos(phi), sn = std::sin(phi);
+  const int side = 2 * s.radius + 1;
   float sample[256];
   float sum = 0.0f;
   for (int dy = w.dy0; dy <= w.dy1; ++dy) {
     for (int dx = w.dx0; dx <= w.dx1; ++dx) {
+      const float weight = s.window ? s.window[(dy + s.radius) * side + dx + s.radius] : 1.0f;
       const float x = sx + c * dx - sn * dy, y = sy + sn * dx + c * dy;
       sample_bilinear(s.source->data.data(), s.source->width, s.source->height, stride, stride, x, y,
                       sample);
       const float* b = s.target->pixel(tx + dx, ty + dy);
-      sum += s.target_weights ? weighted_ssd(sample, b, s.target_weights->pixel(tx + dx, ty + dy), stride)
-                              : ssd(sample, b, stride);
+      sum += weight * (s.target_weights ? weighted_ssd(sample, b, s.target_weights->pixel(tx + dx, ty + dy), stride)
+                                        : ssd(sample, b, stride));
     }
     if (sum >= cutoff) return sum;
   }
@@ -118,6 +150,7 @@ template <bool Weighted>
 __attribute__((target_clones("avx2", "default")))
 float patch_distance(const PatchSpace& space, int sx, int sy, int tx, int ty, float cutoff) {
   if (space.rotated()) return distance_rotated(space, sx, sy, tx, ty, cutoff);
+  if (space.window) return distance_windowed(space, sx, sy, tx, ty, cutoff);
   if (space.target_weights) return distance_aligned<true>(space, sx, sy, tx, ty, cutoff);
   return distance_aligned<false>(space, sx, sy, tx, ty, cutoff);
 }

@@ -33,13 +33,28 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
+// The best match of one target pixel while it is being searched.
+struct Best {
+  std::int32_t x, y;
+  float rx, ry, dist, cost;  // cost = dist + source cost + field terms
+};
+
 struct Matcher {
   const PatchSpace& space;
   const SearchConstraints& cons;
+  const PatchMatchParams& params;
+  const OffsetField* snapshot;
   int sw, sh, margin;
 
-  Matcher(const PatchSpace& s, const SearchConstraints& c)
-      : space(s), cons(c), sw(s.source->width), sh(s.source->height), margin(s.source_margin()) {}
+  Matcher(const PatchSpace& s, const SearchConstraints& c, const PatchMatchParams& p, const OffsetField* snap)
+      : space(s), cons(c), params(p), snapshot(snap), sw(s.source->width), sh(s.source->height),
+        margin(s.source_margin()) {}
+
+  float field_cost(int tx, int ty, int sx, int sy) const {
+    float sum = 0.0f;
+    for (const EnergyTerm* t : params.field_terms) sum += t->pair_cost(*params.context, *snapshot, tx, ty, sx, sy);
+    return sum;
+  }
 
   // Starts loading the first rows of the source patch at (cx, cy), if valid.
   inline void prefetch(int cx, int cy) const {
@@ -51,61 +66,84 @@ struct Matcher {
     }
   }
 
-  // Tries source (cx, cy) for target (tx, ty); keeps it if it lowers the cost.
-  inline void try_candidate(int cx, int cy, int tx, int ty, int segment, std::int32_t& bx, std::int32_t& by,
-                            float& bd, float& bcost) const {
+  // Tries source (cx, cy) (remainder rx, ry) for target (tx, ty); keeps it if
+  // it lowers the cost.
+  inline void try_candidate(int cx, int cy, float rx, float ry, int tx, int ty, int segment, Best& b) const {
     if (cx < margin || cy < margin || cx >= sw - margin || cy >= sh - margin) return;
-    if (cx == bx && cy == by) return;
+    if (cx == b.x && cy == b.y) return;
     const std::size_t si = std::size_t(cy) * sw + cx;
     if (!cons.allowed(si, segment)) return;
-    const float pen = cons.penalty(si);
-    const float d = patch_distance(space, cx, cy, tx, ty, bcost - pen);
-    if (d + pen < bcost) {
-      bx = cx;
-      by = cy;
-      bd = d;
-      bcost = d + pen;
-    }
+    float extra = cons.cost(si);
+    if (!params.field_terms.empty()) extra += field_cost(tx, ty, cx, cy);
+    if (extra >= b.cost) return;
+    const float d = patch_distance(space, cx, cy, tx, ty, b.cost - extra);
+    if (d + extra < b.cost) b = Best{cx, cy, rx, ry, d, d + extra};
   }
 };
 
 }  // namespace
 
-void random_nnf(const PatchSpace& space, const SearchConstraints& cons, Nnf& nnf, std::uint64_t seed,
-                int threads) {
+void random_field(const PatchSpace& space, const SearchConstraints& cons, OffsetField& field, std::uint64_t seed,
+                  int threads) {
   const int tw = space.target->width, th = space.target->height;
-  nnf = Nnf(tw, th);
+  field = OffsetField(tw, th);
   parallel_for(th, threads, [&](int ty) {
     for (int tx = 0; tx < tw; ++tx) {
-      const std::size_t i = nnf.index(tx, ty);
+      const std::size_t i = field.index(tx, ty);
       if (!cons.target_active[i]) continue;
       Rng rng(seed, i);
       const auto& pool = cons.valid_by_segment[cons.segment_of_target(i)];
       const std::int32_t s = pool[rng.below(int(pool.size()))];
-      nnf.x[i] = s % space.source->width;
-      nnf.y[i] = s / space.source->width;
-      nnf.dist[i] = patch_distance(space, nnf.x[i], nnf.y[i], tx, ty, kInf);
+      field.x[i] = s % space.source->width;
+      field.y[i] = s / space.source->width;
+      field.dist[i] = patch_distance(space, field.x[i], field.y[i], tx, ty, kInf);
     }
   });
 }
 
-void refresh_distances(const PatchSpace& space, const SearchConstraints& cons, Nnf& nnf, int threads) {
-  parallel_for(nnf.height, threads, [&](int ty) {
-    for (int tx = 0; tx < nnf.width; ++tx) {
-      const std::size_t i = nnf.index(tx, ty);
-      if (cons.target_active[i]) nnf.dist[i] = patch_distance(space, nnf.x[i], nnf.y[i], tx, ty, kInf);
+void refresh_distances(const PatchSpace& space, const SearchConstraints& cons, OffsetField& field, int threads) {
+  parallel_for(field.height, threads, [&](int ty) {
+    for (int tx = 0; tx < field.width; ++tx) {
+      const std::size_t i = field.index(tx, ty);
+      if (cons.target_active[i]) field.dist[i] = patch_distance(space, field.x[i], field.y[i], tx, ty, kInf);
     }
   });
 }
 
-void patchmatch(const PatchSpace& space, const SearchConstraints& cons, Nnf& nnf, const PatchMatchParams& params,
-                std::uint64_t stream) {
-  const Matcher m(space, cons);
-  const int tw = nnf.width, th = nnf.height;
+void legalize_field(const PatchSpace& space, const SearchConstraints& cons, OffsetField& field) {
+  const int sw = space.source->width, sh = space.source->height, margin = space.source_margin();
+  for (std::size_t i = 0; i < field.x.size(); ++i) {
+    if (!cons.target_active[i]) {
+      field.x[i] = field.y[i] = 0;
+      field.rx[i] = field.ry[i] = 0.0f;
+      continue;
+    }
+    const int x = std::clamp<int>(field.x[i], margin, sw - 1 - margin);
+    const int y = std::clamp<int>(field.y[i], margin, sh - 1 - margin);
+    const int segment = cons.segment_of_target(i);
+    if (x == field.x[i] && y == field.y[i] && cons.allowed(std::size_t(y) * sw + x, segment)) continue;
+    // Masked out here (or another segment): any valid source of the segment,
+    // chosen deterministically from the position.
+    const auto& pool = cons.valid_by_segment[segment];
+    const std::int32_t s = pool[mix64(i) % pool.size()];
+    field.x[i] = s % sw;
+    field.y[i] = s / sw;
+    field.rx[i] = field.ry[i] = 0.0f;
+  }
+}
+
+void patchmatch(const PatchSpace& space, const SearchConstraints& cons, OffsetField& field,
+                const PatchMatchParams& params, std::uint64_t stream) {
+  const int tw = field.width, th = field.height;
   const int bands = (th + params.band_rows - 1) / params.band_rows;
-  const int max_radius = std::max(m.sw, m.sh);
+  const SourceLayout* layout = cons.layout;
+  const bool video = layout && std::any_of(layout->next_frame.begin(), layout->next_frame.end(),
+                                           [](int s) { return s >= 0; });
+  const std::vector<std::uint8_t>& matched = cons.matched();
   for (int iter = 0; iter < params.iterations; ++iter) {
-    const Nnf snapshot = nnf;  // what other bands see of this band's neighbours
+    const OffsetField snapshot = field;  // what other bands see of this band's neighbours
+    const Matcher m(space, cons, params, &snapshot);
+    const int max_radius = std::max(m.sw, m.sh);
     const bool forward = iter % 2 == 0;
     const int step = forward ? 1 : -1;
     parallel_for(bands, params.threads, [&](int band) {
@@ -115,24 +153,36 @@ void patchmatch(const PatchSpace& space, const SearchConstraints& cons, Nnf& nnf
         const int ty = forward ? y0 + row : y1 - 1 - row;
         for (int col = 0; col < tw; ++col) {
           const int tx = forward ? col : tw - 1 - col;
-          const std::size_t i = nnf.index(tx, ty);
+          const std::size_t i = field.index(tx, ty);
           if (!cons.target_active[i]) continue;
           const int segment = cons.segment_of_target(i);
-          std::int32_t bx = nnf.x[i], by = nnf.y[i];
-          float bd = nnf.dist[i];
-          float bcost = bd + cons.penalty(std::size_t(by) * m.sw + bx);
+          Best b{field.x[i], field.y[i], field.rx[i], field.ry[i], field.dist[i], 0.0f};
+          b.cost = b.dist + cons.cost(std::size_t(b.y) * m.sw + b.x);
+          if (!params.field_terms.empty()) b.cost += m.field_cost(tx, ty, b.x, b.y);
           // Propagation from the neighbours already visited in this sweep.
           const int nbr[2][2] = {{-step, 0}, {0, -step}};
           for (const auto& d : nbr) {
             const int nx = tx + d[0], ny = ty + d[1];
             if (nx < 0 || ny < 0 || nx >= tw || ny >= th) continue;
-            const std::size_t ni = nnf.index(nx, ny);
-            if (!cons.target_active[ni]) continue;
+            const std::size_t ni = field.index(nx, ny);
+            if (!matched[ni]) continue;
             const bool inside = ny >= y0 && ny < y1;
-            const Nnf& src = inside ? nnf : snapshot;
+            const OffsetField& src = inside ? field : snapshot;
             int cx, cy;
             propagate_candidate(space, src.x[ni], src.y[ni], nx, ny, d[0], d[1], cx, cy);
-            m.try_candidate(cx, cy, tx, ty, segment, bx, by, bd, bcost);
+            m.try_candidate(cx, cy, src.rx[ni], src.ry[ni], tx, ty, segment, b);
+          }
+          // Candidates the method proposes (Bénard's ribbons).
+          if (params.candidates && !params.candidates->empty())
+            for (std::uint32_t k = params.candidates->begin[i]; k < params.candidates->begin[i + 1]; ++k)
+              m.try_candidate(params.candidates->x[k], params.candidates->y[k], 0.0f, 0.0f, tx, ty, segment, b);
+          // A video exemplar: the same place one frame later and earlier.
+          if (video) {
+            const int s = layout->source_at(b.y);
+            for (int o : {layout->next_frame[s], layout->previous_frame[s]})
+              if (o >= 0)
+                m.try_candidate(b.x, b.y - layout->rects[s].y0 + layout->rects[o].y0, b.rx, b.ry, tx, ty, segment,
+                                b);
           }
           // Random search in shrinking windows around the match after
           // propagation (Barnes et al. 2009). The candidates are drawn first
@@ -141,57 +191,20 @@ void patchmatch(const PatchSpace& space, const SearchConstraints& cons, Nnf& nnf
           int cand[2 * 32], n = 0;
           for (int r = max_radius; r >= 1 && n < 64; r /= 2)
             for (int k = 0; k < params.random_tries_per_scale && n < 64; ++k, n += 2) {
-              cand[n] = bx + rng.between(-r, r);
-              cand[n + 1] = by + rng.between(-r, r);
+              cand[n] = b.x + rng.between(-r, r);
+              cand[n + 1] = b.y + rng.between(-r, r);
               m.prefetch(cand[n], cand[n + 1]);
             }
-          for (int k = 0; k < n; k += 2) m.try_candidate(cand[k], cand[k + 1], tx, ty, segment, bx, by, bd, bcost);
-          nnf.x[i] = bx;
-          nnf.y[i] = by;
-          nnf.dist[i] = bd;
+          for (int k = 0; k < n; k += 2) m.try_candidate(cand[k], cand[k + 1], 0.0f, 0.0f, tx, ty, segment, b);
+          field.x[i] = b.x;
+          field.y[i] = b.y;
+          field.rx[i] = b.rx;
+          field.ry[i] = b.ry;
+          field.dist[i] = b.dist;
         }
       }
     });
   }
-}
-
-Nnf upsample_nnf(const Nnf& coarse, const PatchSpace& space, const SearchConstraints& cons, int fw, int fh) {
-  Nnf fine(fw, fh);
-  const int sw = space.source->width, sh = space.source->height, margin = space.source_margin();
-  for (int ty = 0; ty < fh; ++ty) {
-    for (int tx = 0; tx < fw; ++tx) {
-      const std::size_t i = fine.index(tx, ty);
-      if (!cons.target_active[i]) continue;
-      const int px = std::min(tx / 2, coarse.width - 1), py = std::min(ty / 2, coarse.height - 1);
-      const std::size_t pi = coarse.index(px, py);
-      int cx = 2 * coarse.x[pi], cy = 2 * coarse.y[pi];
-      const int ox = tx - 2 * px, oy = ty - 2 * py;
-      if (space.rotated()) {
-        float rx, ry;
-        rotate_offset(space.rotation(std::clamp(cx, 0, sw - 1), std::clamp(cy, 0, sh - 1), tx, ty), float(ox),
-                      float(oy), rx, ry);
-        cx += int(std::lround(rx));
-        cy += int(std::lround(ry));
-      } else {
-        cx += ox;
-        cy += oy;
-      }
-      cx = std::clamp(cx, margin, sw - 1 - margin);
-      cy = std::clamp(cy, margin, sh - 1 - margin);
-      const int segment = cons.segment_of_target(i);
-      if (!cons.allowed(std::size_t(cy) * sw + cx, segment)) {
-        // Parent's match is masked out at this level: fall back to any valid
-        // source of the segment, chosen deterministically from the position.
-        const auto& pool = cons.valid_by_segment[segment];
-        const std::int32_t s = pool[mix64(i) % pool.size()];
-        cx = s % sw;
-        cy = s / sw;
-      }
-      fine.x[i] = cx;
-      fine.y[i] = cy;
-    }
-  }
-  return fine;
 }
 
 }  // namespace tempera

@@ -6,6 +6,7 @@
 #include "tempera/error.hpp"
 #include "tempera/image_io.hpp"
 #include "tempera/motion.hpp"
+#include "tempera/option_table.hpp"
 #include "tempera/parallel.hpp"
 
 namespace tempera {
@@ -13,7 +14,7 @@ namespace {
 
 bool is_light_path_guide(const std::string& name) {
   const auto& known = light_path_guides();
-  return std::find(known.begin(), known.end(), name) != known.end();
+  return std::any_of(known.begin(), known.end(), [&](const LightPathGuide& g) { return name == g.name; });
 }
 
 std::string joined(const std::vector<std::string>& names) {
@@ -39,6 +40,28 @@ void require_channels(const ImageView& image, int channels, const char* what) {
 }
 
 }  // namespace
+
+std::string light_path_guide_names() {
+  std::string out;
+  for (const auto& g : light_path_guides()) out += (out.empty() ? "" : ", ") + std::string(g.name);
+  return out;
+}
+
+void parse_guide_weights(const std::string& text, std::vector<std::pair<std::string, float>>& weights) {
+  std::size_t start = 0;
+  while (start < text.size()) {
+    const std::size_t end = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, end - start);
+    const std::size_t eq = item.find('=');
+    if (eq == std::string::npos) throw ValueError(concat("--weights expects NAME=W items, got '", item, "'"));
+    const std::string name = item.substr(0, eq);
+    auto it = std::find_if(weights.begin(), weights.end(), [&](auto& w) { return w.first == name; });
+    if (it == weights.end())
+      throw ValueError(concat("unknown guide '", name, "' in --weights (", light_path_guide_names(), ")"));
+    it->second = parse_number<float>(item.substr(eq + 1), concat("--weights '", item, "'"));
+    start = end + 1;
+  }
+}
 
 const Image& GuideFrame::get(const std::string& name) const {
   auto it = guides.find(name);
@@ -104,7 +127,7 @@ std::vector<std::pair<std::string, float>> active_guides(const StylitOptions& op
   std::vector<std::string> seen;
   for (const auto& [name, weight] : options.weights) {
     if (!is_light_path_guide(name))
-      throw ValueError(concat("unknown guide '", name, "' (StyLit guides: ", joined(light_path_guides()), ")"));
+      throw ValueError(concat("unknown guide '", name, "' (StyLit guides: ", light_path_guide_names(), ")"));
     if (std::find(seen.begin(), seen.end(), name) != seen.end())
       throw ValueError(concat("guide '", name, "' is weighted twice"));
     if (!std::isfinite(weight)) throw ValueError(concat("weight of guide '", name, "' is not finite"));

@@ -86,12 +86,8 @@ std::string settings_text(const StylizeJobConfig& c) {
   std::ostringstream s;
   s << "weights=";
   for (const auto& [name, weight] : active_guides(c.stylit)) s << name << ":" << weight << ",";
-  s << ";temporal=" << c.stylit.temporal_weight << ";quality=" << quality_name(c.stylit.quality)
-    << ";usage=" << patch_usage_name(o.usage) << ";patch_size=" << o.patch_size << ";levels=" << o.levels
-    << ";em=" << o.em_iterations << ";pm=" << o.pm_iterations << ";style_weight=" << o.style_weight
-    << ";penalty_weight=" << o.penalty_weight << ";guide_variance=" << o.guide_variance
-    << ";budget=" << o.budget_coverage << "/" << o.budget_max_rounds << ";seed=" << o.seed
-    << ";format=" << c.format;
+  s << ";temporal=" << c.stylit.temporal_weight << ";quality=" << quality_name(c.stylit.quality) << ";"
+    << settings_text(o, synthesis_option_table()) << "format=" << c.format;
   return s.str();
 }
 

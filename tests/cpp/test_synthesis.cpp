@@ -97,7 +97,7 @@ TEST(Synthesis, UniformUsesEverySourcePatchKOrKPlusOneTimes) {
   const int margin = 2, valid = (32 - 2 * margin) * (32 - 2 * margin), targets = 40 * 40;
   const int K = targets / valid, R = targets % valid;
   std::map<int, int> uses;
-  for (std::size_t i = 0; i < r.nnf.x.size(); ++i) ++uses[r.nnf.y[i] * 32 + r.nnf.x[i]];
+  for (std::size_t i = 0; i < r.field.x.size(); ++i) ++uses[r.field.y[i] * 32 + r.field.x[i]];
   ASSERT_EQ(int(uses.size()), valid) << "every valid source patch must be used";
   int extra = 0;
   for (auto& [p, n] : uses) {
@@ -124,8 +124,8 @@ TEST(Synthesis, UniformCountsHoldPerSegment) {
   std::map<int, int> uses;
   for (int y = 0; y < 30; ++y)
     for (int x = 0; x < 36; ++x) {
-      const std::size_t i = r.nnf.index(x, y);
-      const int sx = r.nnf.x[i], sy = r.nnf.y[i];
+      const std::size_t i = r.field.index(x, y);
+      const int sx = r.field.x[i], sy = r.field.y[i];
       EXPECT_EQ(src_seg.at(sx, sy, 0), tgt_seg.at(x, y, 0)) << "match crosses segments at " << x << "," << y;
       ++uses[sy * 32 + sx];
     }
@@ -339,9 +339,9 @@ TEST(Synthesis, BudgetKeepsMisfitPatchesOffTheFrameBorder) {
     int n = 0;
     for (int y = 0; y < 60; ++y)
       for (int x = 0; x < 80; ++x) {
-        const std::size_t i = r.nnf.index(x, y);
+        const std::size_t i = r.field.index(x, y);
         const bool ring = x < 2 || y < 2 || x >= 78 || y >= 58;
-        n += ring && misfit(r.nnf.x[i], r.nnf.y[i]);
+        n += ring && misfit(r.field.x[i], r.field.y[i]);
       }
     return n;
   };

@@ -7,7 +7,7 @@ import pytest
 
 import tempera
 from tempera import _native, guide_cache
-from tempera.stylit_guides import tonemap
+from tempera.stylize import tonemap
 from tempera.stylize import StylizeJob, stylize_frame
 
 from conftest import assert_releases_gil
@@ -127,3 +127,31 @@ def test_frames_split_over_machines_stay_current(inputs):
         assert [j.run_frame(i)["status"] for i in range(len(frames))] == ["stylized"] * len(frames)
     whole = split_job([1, 2, 3])
     assert [whole.run_frame(i)["status"] for i in range(3)] == ["skipped"] * 3
+
+
+def test_tonemap_values():
+    from tempera.color import linear_to_srgb
+
+    x = np.array([0.0, 1.0, 3.0, 1e9], dtype=np.float32)
+    expected = linear_to_srgb(np.array([0.0, 0.5, 0.75, 1.0]))
+    np.testing.assert_allclose(tonemap(x), expected, atol=1e-5)
+    np.testing.assert_array_equal(tonemap(np.array([-1.0, np.nan])), [0.0, 0.0])
+    ramp = tonemap(np.linspace(0.0, 50.0, 2001))
+    assert np.all(np.diff(ramp) > 0)  # strictly increasing: highlights stay distinct
+    image = np.random.default_rng(0).uniform(0, 3, (4, 5, 3)).astype(np.float32)
+    np.testing.assert_array_equal(tonemap(image)[1:3, 2:4], tonemap(image[1:3, 2:4]))  # per pixel
+
+
+def test_one_guide_table_everywhere():
+    """Names, expressions and default weights of the light-path guides come
+    from the native table alone."""
+    import tempera
+    from tempera import guide_cache, lpe, settings, stylize
+
+    table = tempera._native.light_path_guides()
+    names = [g["name"] for g in table]
+    assert list(stylize.GUIDES) == names and names == ["FULL", "LDE", "LSE", "LDDE", "LD12E"]
+    assert stylize.DEFAULT_WEIGHTS == settings.DEFAULT_GUIDE_WEIGHTS == {g["name"]: g["weight"] for g in table}
+    assert lpe.STYLIT_EXPRESSIONS["LDDE"] == "L.*DDE" and set(lpe.STYLIT_EXPRESSIONS) == set(names)
+    assert all(guide_cache.GUIDES[n] == "RGB" for n in names)
+    assert settings.SEED_DEFAULT == tempera.SynthesisOptions().seed == 1

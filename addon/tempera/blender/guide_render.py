@@ -22,7 +22,7 @@ import numpy as np
 
 from .. import guide_cache, guides, read_image
 from ..lpe import check_lpe, trace_lpe
-from ..stylit_guides import tonemap
+from ..stylize import tonemap
 from .scene_export import SceneExportError, evaluated_depsgraph, export_scene, path_settings
 
 

@@ -39,6 +39,10 @@ USAGE_ITEMS = (
      "nowhere (no wash-out, no forced misfits). The default"),
     ("uniform", "Uniform", "Every exemplar patch used equally often (LazyFluids); may force misfits"),
     ("penalty", "Occurrence Penalty", "Overused patches cost more (Kaspar et al.); a softer uniformity"),
+    ("histogram", "Usage Histogram", "Patches used far more than their share cost more (Bénard et al. 2013): "
+     "breaks up repeated blotches while keeping the best fits"),
+    ("footprint", "Footprint", "Patches whose area of the exemplar is already covered cost more (Fluidymation): "
+     "even coverage for fluids and natural media"),
     ("none", "None", "Plain nearest neighbours: fastest, may wash out into few favourite patches"),
 )
 QUALITY_ITEMS = (
@@ -55,14 +59,14 @@ RESULT_ITEMS = (
     ("IMAGE", "Image", "An image sequence data-block, for the Image Editor or the compositor's Image node"),
     ("NONE", "Nothing", "Only write the files"),
 )
-# Guide-cache guide name -> the Scene.tempera property holding its weight.
-WEIGHT_PROPERTIES = {"FULL": "weight_full", "LDE": "weight_lde", "LSE": "weight_lse",
-                     "LDDE": "weight_ldde", "LD12E": "weight_ld12e"}
+# Guide-cache guide name -> the Scene.tempera property holding its weight
+# (one per light-path guide of the native table).
+WEIGHT_PROPERTIES = {g["name"]: "weight_" + g["name"].lower() for g in limits.LIGHT_PATH_GUIDES}
 
 
-def _weight(guide, label, description):
-    return FloatProperty(name=label, description=description, min=0.0, soft_max=4.0,
-                         default=limits.DEFAULT_GUIDE_WEIGHTS[guide])
+def _weight(guide):
+    return FloatProperty(name=guide["label"], min=0.0, soft_max=4.0, default=guide["weight"],
+                         description=f"Weight of {guide['help']} ({guide['expression']})")
 
 
 def _keep_patch_size_odd(self, _context):
@@ -92,7 +96,7 @@ class TemperaSettings(PropertyGroup):
     seed: IntProperty(
         name="Seed",
         description="Random seed of the synthesis: the same seed and inputs give the same frames",
-        default=0,
+        default=limits.SEED_DEFAULT,
         min=0,
     )
     patch_size: IntProperty(
@@ -212,16 +216,12 @@ class TemperaSettings(PropertyGroup):
         default=0,
         min=0,
     )
-    weight_full: _weight("FULL", "Full GI", "Weight of the whole render (all light paths, L.*E)")
-    weight_lde: _weight("LDE", "Direct Diffuse", "Weight of direct diffuse light (LDE): shading and shadows")
-    weight_lse: _weight("LSE", "Direct Specular", "Weight of direct specular light (LSE): highlights")
-    weight_ldde: _weight("LDDE", "Diffuse Interreflection",
-                         "Weight of diffuse interreflections (L.*DDE): colour bleeding, soft fill")
-    weight_ld12e: _weight("LD12E", "First Two Diffuse Bounces",
-                          "Weight of the first two diffuse bounces (LD{1,2}E)")
-    usage: EnumProperty(name="Patch Usage", items=USAGE_ITEMS, default="budget",
+    for _guide in limits.LIGHT_PATH_GUIDES:
+        __annotations__[WEIGHT_PROPERTIES[_guide["name"]]] = _weight(_guide)
+    del _guide
+    usage: EnumProperty(name="Patch Usage", items=USAGE_ITEMS, default=limits.ENGINE_OPTIONS["usage"]["default"],
                         description="How evenly the exemplar's patches are used")
-    quality: EnumProperty(name="Quality", items=QUALITY_ITEMS, default="final",
+    quality: EnumProperty(name="Quality", items=QUALITY_ITEMS, default=limits.DEFAULT_QUALITY,
                           description="Solver effort per frame")
     temporal_weight: FloatProperty(
         name="Temporal Coherence",

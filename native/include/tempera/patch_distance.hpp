@@ -27,6 +27,8 @@ struct FeatureImage {
   // Writes channels of `image` into feature slots [first, first + image.channels)
   // scaled by `scale` (sqrt of the weight).
   void set_channels(int first, const ImageView& image, float scale);
+  // The same with one scale per channel of `image`.
+  void set_channels(int first, const ImageView& image, const std::vector<float>& scales);
 };
 
 // What a patch comparison needs: the two feature images, the patch radius and,
@@ -45,6 +47,9 @@ struct PatchSpace {
   // tensor's): the smallest rotation that aligns the two directions is used,
   // so there is no branch cut (Bénard et al. 2013, §3.1).
   bool axial = true;
+  // Optional weight per patch pixel, (2 radius + 1)^2 row-major, mean 1: a
+  // Gaussian window (Bénard et al. 2013, eq. 1). Null = every pixel weighs 1.
+  const float* window = nullptr;
 
   bool rotated() const { return source_angle || target_angle; }
   // Rotation from target offsets to source offsets: phi = a_src(p) - a_tgt(q).

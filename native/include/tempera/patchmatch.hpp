@@ -1,37 +1,34 @@
 #pragma once
-// Nearest-neighbour fields and PatchMatch (Barnes et al. 2009): propagation and
-// random search, parallel over fixed bands of rows. Pixels outside a band are
-// read from a snapshot taken at the start of each iteration, so the result
-// depends on the seed only, never on the thread count or schedule.
+// PatchMatch (Barnes et al. 2009) over offset fields: propagation, random
+// search, candidates injected by the method (Bénard's ribbons) and, for video
+// exemplars, the same match one frame earlier and later. Parallel over fixed
+// bands of rows; pixels outside a band are read from a snapshot taken at the
+// start of each iteration, so the result depends on the seed only, never on
+// the thread count or schedule.
 #include <cstdint>
 #include <vector>
 
+#include "tempera/energy_term.hpp"
+#include "tempera/offset_field.hpp"
 #include "tempera/patch_distance.hpp"
 
 namespace tempera {
-
-// For each target pixel: the center of its source patch and their distance.
-struct Nnf {
-  int width = 0;
-  int height = 0;
-  std::vector<std::int32_t> x, y;
-  std::vector<float> dist;
-
-  Nnf() = default;
-  Nnf(int w, int h) : width(w), height(h), x(std::size_t(w) * h), y(std::size_t(w) * h), dist(std::size_t(w) * h) {}
-  std::size_t index(int tx, int ty) const { return std::size_t(ty) * width + tx; }
-};
 
 // Which matches are allowed.
 struct SearchConstraints {
   std::vector<std::uint8_t> source_valid;   // per source pixel: may be a patch center
   std::vector<std::uint8_t> target_active;  // per target pixel: is synthesized
+  // Optional: target pixels whose matches neighbours may adopt (propagation,
+  // coherence): the active ones plus hard-constrained pixels with a fixed
+  // match. Empty = target_active.
+  std::vector<std::uint8_t> target_matched;
   // Optional segment labels: a target pixel only matches sources with its label.
   std::vector<std::int32_t> source_segment, target_segment;
-  // Optional extra cost per source center (occurrence penalty).
-  std::vector<float> source_penalty;
+  // Extra cost per source center (usage terms); empty = none.
+  std::vector<float> source_cost;
   // Valid source centers (indices), per segment label; filled by finalize().
   std::vector<std::vector<std::int32_t>> valid_by_segment;
+  const SourceLayout* layout = nullptr;  // for the frame links of video exemplars
 
   // Builds valid_by_segment; throws ValueError if a target segment has no source.
   void finalize();
@@ -40,9 +37,16 @@ struct SearchConstraints {
   bool allowed(std::size_t source_index, int segment) const {
     return source_valid[source_index] && segment_of_source(source_index) == segment;
   }
-  float penalty(std::size_t source_index) const {
-    return source_penalty.empty() ? 0.0f : source_penalty[source_index];
-  }
+  const std::vector<std::uint8_t>& matched() const { return target_matched.empty() ? target_active : target_matched; }
+  float cost(std::size_t source_index) const { return source_cost.empty() ? 0.0f : source_cost[source_index]; }
+};
+
+// Extra candidates per target pixel (compressed rows: the candidates of
+// target i are [begin[i], begin[i + 1])), tried after propagation.
+struct CandidateList {
+  std::vector<std::uint32_t> begin;  // target pixels + 1 entries
+  std::vector<std::int32_t> x, y;    // atlas positions
+  bool empty() const { return x.empty(); }
 };
 
 struct PatchMatchParams {
@@ -51,24 +55,28 @@ struct PatchMatchParams {
   int threads = 0;
   int band_rows = 32;
   int random_tries_per_scale = 1;
+  const CandidateList* candidates = nullptr;
+  // Terms that read the field (EnergyTerm::reads_field), with their context.
+  std::vector<const EnergyTerm*> field_terms;
+  const LevelContext* context = nullptr;
 };
 
 // Random valid source for every active target pixel, with distances.
-void random_nnf(const PatchSpace& space, const SearchConstraints& constraints, Nnf& nnf,
-                std::uint64_t seed, int threads);
+void random_field(const PatchSpace& space, const SearchConstraints& constraints, OffsetField& field,
+                  std::uint64_t seed, int threads);
 
-// Recomputes nnf.dist for the current features (e.g. after voting changed B').
-void refresh_distances(const PatchSpace& space, const SearchConstraints& constraints, Nnf& nnf,
+// Recomputes field.dist for the current features (e.g. after voting changed B').
+void refresh_distances(const PatchSpace& space, const SearchConstraints& constraints, OffsetField& field,
                        int threads);
 
-// Improves `nnf` in place; only ever accepts better matches.
-void patchmatch(const PatchSpace& space, const SearchConstraints& constraints, Nnf& nnf,
-                const PatchMatchParams& params, std::uint64_t stream);
+// Moves matches that the constraints forbid (masked out, another segment)
+// to a valid source chosen deterministically from the position, and zeroes
+// inactive targets.
+void legalize_field(const PatchSpace& space, const SearchConstraints& constraints, OffsetField& field);
 
-// NNF of a level twice as large (rotation-aware): children inherit the parent
-// match shifted by their offset within the parent pixel.
-Nnf upsample_nnf(const Nnf& coarse, const PatchSpace& fine_space, const SearchConstraints& fine_constraints,
-                 int fine_width, int fine_height);
+// Improves `field` in place; only ever accepts cheaper matches.
+void patchmatch(const PatchSpace& space, const SearchConstraints& constraints, OffsetField& field,
+                const PatchMatchParams& params, std::uint64_t stream);
 
 // Source position proposed for target q by a neighbour q + d whose match is
 // (nx, ny): the neighbour's source shifted back by d, rotated into source space.

@@ -1,37 +1,36 @@
 #pragma once
 // The synthesis engine: guided texture optimization (EM over a coarse-to-fine
-// pyramid, PatchMatch for the E-step, voting for the M-step) with selectable
-// patch-usage control and rotation-aware patches. Every method in Tempera is
-// this engine with its own guide layers and options.
+// pyramid, PatchMatch for the E-step, voting for the M-step). synthesize() is
+// the whole solve in one call; methods that need more (warm starts per frame,
+// sweeps over a shot, constraints that change per level) drive the Solver
+// (solver.hpp) level by level. See docs/engine.md.
 #include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
 
+#include "tempera/energy_term.hpp"
 #include "tempera/guide_stack.hpp"
+#include "tempera/offset_field.hpp"
 #include "tempera/patch_usage.hpp"
 #include "tempera/patchmatch.hpp"
+#include "tempera/source_set.hpp"
+#include "tempera/synthesis_options.hpp"
 
 namespace tempera {
 
-struct SynthesisOptions {
-  int patch_size = 5;        // odd, >= 3
-  int levels = 0;            // 0: as many as keep the coarsest side >= 4 patches
-  int em_iterations = 6;     // search+vote iterations per level
-  int pm_iterations = 2;     // PatchMatch sweeps per search (measured: 4 gains < 1% energy)
-  PatchUsage usage = PatchUsage::Budget;
-  float style_weight = 1.0f;    // weight of the A'/B' term against the guides
-  float penalty_weight = 1.0f;  // lambda of the occurrence penalty
-  // Fraction of the weighted guide variance kept by PCA compression of the
-  // guide channels (1 = exact, no compression; off when weight maps are used).
-  double guide_variance = 0.999;
-  // Orientations are axial (mod pi, e.g. stroke directions) rather than
-  // directed (mod 2 pi).
-  bool axial_orientation = true;
-  double budget_coverage = 0.95;
-  int budget_max_rounds = 16;
-  std::uint64_t seed = 1;
-  int threads = 0;  // 0: all cores
+// Hard constraints (Bénard et al. 2013 §4.1: painted keyframe pixels): target
+// pixels whose value is given. They are never searched or voted, and the
+// patches of their neighbours see their values, so what is synthesized next
+// to them continues them.
+struct FixedPixels {
+  ImageView mask;    // target size, 1 channel, > 0.5 = fixed
+  ImageView values;  // target size, the style's channels: B' there
+  // Optional, target size, 3 channels: exemplar index (0 = `style`, k = the
+  // k-th of `exemplars` + 1), x, y in that exemplar's pixels. With it the
+  // fixed pixels also vote for their neighbours, as their matches.
+  ImageView matches;
+  bool empty() const { return mask.empty(); }
 };
 
 struct SynthesisInput {
@@ -43,6 +42,18 @@ struct SynthesisInput {
   // Optional, 1 channel per guide layer (or empty): per-target-pixel weight map.
   std::vector<ImageView> target_weight_maps;
   int target_width = 0, target_height = 0;  // needed only when there are no guides
+  // `style` as a frame of a video exemplar (see Exemplar::sequence).
+  int sequence = -1, time = 0;
+  // Further exemplars of the source set besides `style`: painted keyframes,
+  // the other frames of a video exemplar. Their guides pair with the layers of
+  // `guides` in order.
+  std::vector<Exemplar> exemplars;
+  // Optional B' at the start of the coarsest level (Color Me Noisy's
+  // reference animation frame), target size, the style's channels.
+  ImageView reference;
+  FixedPixels fixed;
+  // Method terms (energy_term.hpp) besides the usage term of the options.
+  EnergyTerms terms;
 };
 
 struct LevelStats {
@@ -51,16 +62,26 @@ struct LevelStats {
   double search_seconds = 0, usage_seconds = 0, vote_seconds = 0;
   int usage_rounds = 0;
   double reversed_coverage = 0;  // fraction of targets placed by reversed retrieval (last iteration)
+  double source_coverage = 0;    // fraction of valid source patches used at the end
+};
+
+// A match in an exemplar's own pixels.
+struct ExemplarMatch {
+  int exemplar = 0;  // 0 = `style`, k = exemplars[k - 1]
+  float x = 0, y = 0;
 };
 
 struct SynthesisResult {
-  Image image;  // B'
-  Nnf nnf;      // final source position per target pixel
+  Image image;          // B'
+  OffsetField field;    // final match per target pixel, in `layout`'s atlas
+  SourceLayout layout;  // the finest level's atlas of the exemplars
   std::vector<LevelStats> levels;  // coarsest first
   double seconds = 0;
   double source_coverage = 0;  // fraction of source patches used at the finest level
   int guide_channels = 0;        // guide channels matched (after compression)
   double kept_guide_variance = 1;
+
+  ExemplarMatch match(int x, int y) const;
 };
 
 // Called after every search and vote with the overall progress in [0, 1];

@@ -1,0 +1,52 @@
+"""Stylizing Animation by Example (Bénard et al. 2013): a whole shot at once,
+coarse to fine with forward and backward sweeps along the rendered motion, so
+the paint stays on the surfaces (native/src/tcia.cpp, docs/engine.md).
+
+Painted keyframes, lines and layers are still to come (issue 12).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from . import _native
+
+TciaOptions = _native.TciaOptions
+
+
+def options(**values) -> "TciaOptions":
+    """TciaOptions from keywords: its own (temporal_weight, coherence_weight,
+    coherence_max, sweep_pairs) and engine options (SynthesisOptions names,
+    from the method's defaults: 9 x 9 Gaussian window, centre output,
+    histogram usage, 4 levels)."""
+    own = {row["name"] for row in TciaOptions.table()}
+    opts = TciaOptions(**{k: v for k, v in values.items() if k in own})
+    engine = _native.tcia_defaults()
+    for name, value in values.items():
+        if name in own:
+            continue
+        if not hasattr(engine, name):
+            raise TypeError(f"unknown option '{name}' of the coherent method")
+        setattr(engine, name, value)
+    engine.validate()
+    opts.synthesis = engine
+    return opts
+
+
+def _image(a):
+    a = np.ascontiguousarray(a, dtype=np.float32)
+    return a[:, :, None] if a.ndim == 2 else a
+
+
+def stylize_shot(style, guides, frames, *, progress=None, **values):
+    """The stylized frames of a shot.
+
+    style   the painting Ŝ, (H, W, C)
+    guides  [(name, exemplar guide S (H, W, c), weight), ...]
+    frames  per frame a dict: guides (the frame's B_g in the same order),
+            velocity_backward, velocity_forward ((h, w, 2), pixels, x right,
+            y down), occlusion_backward, occlusion_forward ((h, w) χ−, χ+)
+    """
+    g = [(str(n), _image(s), float(w)) for n, s, w in guides]
+    f = [{k: ([_image(x) for x in v] if k == "guides" else _image(v)) for k, v in d.items()} for d in frames]
+    report = None if progress is None else (lambda x: progress(x) is not False)
+    return _native.stylize_shot(_image(style), g, f, options(**values), report)

@@ -1,0 +1,82 @@
+#pragma once
+// Stylizing Animation by Example (Bénard et al. 2013, "TCIA") as a method on
+// the engine: a whole shot solved coarse to fine, with at each level one
+// forward and one backward sweep through time (§3.3, Fig. 7). Each frame's
+// offset field M_t starts from the advected field of the frame before (in
+// sweep order) randomly merged, per pixel, with the frame's own previous
+// solution (the coarser level's, upsampled, or the forward sweep's), taking
+// the unoccluded one where χ says so. Each visit runs PatchMatch on the
+// frame with
+//  - the input term (guides of the frame against the exemplar's, eq. 4) and
+//    the output term (B' against Ŝ, eq. 3) of the engine, in a Gaussian
+//    window (eq. 1, 9 x 9, sigma 3);
+//  - the temporal term g_tc (eq. 6, 7): the previous frame's result advected
+//    along V- (forward) or V+ (backward) as a guide paired with Ŝ, weighted
+//    by χ- or χ+;
+//  - spatial coherence (eq. 5) and the usage histogram (eq. 8);
+// and "warps, not blends": each pixel copies its source pixel (output
+// centre). Painted keys, lines and layers are still to come (issue 12).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "tempera/image.hpp"
+#include "tempera/option_table.hpp"
+#include "tempera/synthesis.hpp"
+
+namespace tempera {
+
+struct ShotFrame {
+  std::vector<ImageView> guides;                   // B_g per guide layer, in the exemplar's order
+  ImageView velocity_backward, velocity_forward;   // V-, V+: 2 channels, pixels, x right, y down
+  ImageView occlusion_backward, occlusion_forward; // χ-, χ+: 1 channel, 1 = visible in the neighbour frame
+};
+
+struct Shot {
+  ImageView style;                      // Ŝ
+  std::vector<std::string> guide_names;
+  std::vector<ImageView> style_guides;  // S per guide layer
+  std::vector<float> guide_weights;     // w_in per guide layer
+  std::vector<ShotFrame> frames;
+};
+
+struct TciaOptions {
+  float temporal_weight = 1.0f;    // w_tc
+  float coherence_weight = 0.05f;  // w_sc per window pixel: "small" (§3.2)
+  float coherence_max = 3.0f;      // r_max in pixels (the paper gives none)
+  int sweep_pairs = 1;             // forward + backward sweeps per level (the paper: 1)
+  SynthesisOptions synthesis;      // tcia_defaults()
+};
+
+inline const auto& tcia_option_table() {
+  using T = TciaOptions;
+  static const auto table = std::make_tuple(
+      field(&T::temporal_weight, "temporal_weight", "temporal",
+            "w_tc: pull towards the neighbour frame's paint along the motion; 1 typical", 0, 1e6),
+      field(&T::coherence_weight, "coherence_weight", "coherence",
+            "w_sc: preference for large coherent pieces of the exemplar; 0.05 typical", 0, 1e6),
+      field(&T::coherence_max, "coherence_max", "coherence-max", "r_max of spatial coherence, in pixels (3)", 0,
+            1e6),
+      field(&T::sweep_pairs, "sweep_pairs", "sweeps", "forward+backward sweep pairs per level (1)", 1, 100));
+  return table;
+}
+
+// The engine options of the method: 9 x 9 patches in a Gaussian window of
+// sigma 3, output centre (a warp), usage histogram, 4 levels, one search of
+// 4 PatchMatch iterations per visit, exact guides.
+SynthesisOptions tcia_defaults();
+inline TciaOptions default_tcia_options() {
+  TciaOptions o;
+  o.synthesis = tcia_defaults();
+  return o;
+}
+
+// `image` at width x height by nearest pick (velocities: no blending across
+// motion boundaries), values scaled by `scale`.
+Image pick_resize(const ImageView& image, int width, int height, float scale = 1.0f);
+
+// The stylized frames of the shot, in order. progress(fraction) returning
+// false cancels (CancelledError).
+std::vector<Image> stylize_shot(const Shot& shot, const TciaOptions& options, const ProgressCallback& progress = {});
+
+}  // namespace tempera

@@ -1,0 +1,59 @@
+// Fluidymation's uniformity term (Platkevič et al. 2021, §3, Omega): usage
+// counted over patch footprints rather than centres. Each exemplar pixel
+// counts how many output patches cover it; a patch costs more the more its
+// own footprint is covered already, relative to fair use.
+#include <algorithm>
+
+#include "tempera/patch_usage.hpp"
+
+namespace tempera {
+namespace {
+
+// Sum over the (2r+1)^2 window around each pixel of a width x height grid.
+std::vector<float> box_sum(const std::vector<float>& in, int width, int height, int r) {
+  std::vector<float> tmp(in.size(), 0.0f), out(in.size(), 0.0f);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      float s = 0;
+      for (int i = std::max(0, x - r); i <= std::min(width - 1, x + r); ++i) s += in[std::size_t(y) * width + i];
+      tmp[std::size_t(y) * width + x] = s;
+    }
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      float s = 0;
+      for (int j = std::max(0, y - r); j <= std::min(height - 1, y + r); ++j) s += tmp[std::size_t(j) * width + x];
+      out[std::size_t(y) * width + x] = s;
+    }
+  return out;
+}
+
+class FootprintUsage final : public EnergyTerm {
+ public:
+  explicit FootprintUsage(float weight) : weight_(weight) {}
+  const char* name() const override { return "footprint"; }
+  void add_source_costs(const LevelContext& c, const OffsetField& field, std::vector<float>& cost,
+                        TermState&) const override {
+    const int sw = c.space->source->width, sh = c.space->source->height, r = c.space->radius;
+    // Coverage of each exemplar pixel by used footprints, then the coverage
+    // a candidate centre's own footprint would land on.
+    const std::vector<float> covered = box_sum(usage_counts(field, *c.constraints, sw), sw, sh, r);
+    const std::vector<float> crowd = box_sum(covered, sw, sh, r);
+    const UsageScale scale = usage_scale(field, *c.constraints);
+    if (!scale.valid) return;
+    const float area = float((2 * r + 1) * (2 * r + 1));
+    // Fair coverage of a pixel is omega * area; a footprint sums area pixels.
+    const float fair = scale.fair * area * area;
+    for (std::size_t p = 0; p < cost.size(); ++p) cost[p] += weight_ * scale.typical * crowd[p] / fair;
+  }
+
+ private:
+  float weight_;
+};
+
+}  // namespace
+
+std::shared_ptr<const EnergyTerm> make_footprint_usage(float weight) {
+  return std::make_shared<FootprintUsage>(weight);
+}
+
+}  // namespace tempera

@@ -1,0 +1,138 @@
+#include "tempera/noisy.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "tempera/error.hpp"
+#include "tempera/pyramid.hpp"
+#include "tempera/rng.hpp"
+#include "tempera/solver.hpp"
+
+namespace tempera {
+namespace {
+
+constexpr double kRatio = 0.85;  // the paper's sampling-rate ratio between levels
+
+}  // namespace
+
+SynthesisOptions noisy_defaults() {
+  SynthesisOptions o;
+  o.patch_size = 7;
+  o.em_iterations = 4;   // "4 iterations of search and vote" per level (§4)
+  o.pm_iterations = 2;   // "8 PatchMatch iterations at each pyramid level": 2 per search x 4 searches
+  o.usage = PatchUsage::None;
+  o.output = OutputMode::Mode;  // "the mode of colours" (§3.2)
+  o.level_ratio = kRatio;
+  o.guide_variance = 1.0;
+  return o;
+}
+
+int noisy_levels(float noise) {
+  if (!(noise > 1.0f)) return 1;
+  return 1 + int(std::ceil(std::log(double(noise)) / std::log(1.0 / kRatio) - 1e-9));
+}
+
+std::vector<float> noisy_box_widths(float noise) {
+  const int m = noisy_levels(noise);
+  std::vector<float> widths(std::size_t(m), 1.0f);
+  for (int l = 1; l < m; ++l) widths[std::size_t(l)] = float(std::pow(double(noise), double(l) / (m - 1)));
+  return widths;
+}
+
+std::uint64_t noisy_frame_seed(std::uint64_t seed, int frame) { return mix64(seed ^ mix64(std::uint64_t(std::int64_t(frame)) + 0x6E6F697379ull)); }
+
+Image deform_exemplar(const ImageView& style, const NoisyOptions& o, int frame) {
+  if (!o.deform) return Image::copy_of(style);
+  const float scale = float(std::sqrt(double(style.pixel_count()) / 1e6));
+  const MlsLattice lattice = random_lattice(style.width, style.height, o.lattice_spacing * scale, o.shift_min * scale,
+                                            o.shift_max * scale, noisy_frame_seed(o.synthesis.seed, frame));
+  return warp_by_map(style, mls_backward_map(lattice, style.width, style.height).view());
+}
+
+namespace {
+
+void validate(const ImageView& style, const ImageView& reference, const NoisyOptions& o, const ImageView& map) {
+  require_nonempty(style, "exemplar");
+  require_nonempty(reference, "reference frame");
+  if (style.channels != reference.channels)
+    throw ValueError(concat("the reference frame has ", reference.channels, " channels but the exemplar has ",
+                            style.channels));
+  if (!std::isfinite(o.noise) || o.noise < 0 || o.noise > 64)
+    throw ValueError(concat("noise (the low-pass width f) must be in [0, 64] pixels, got ", o.noise));
+  if (!map.empty()) {
+    if (map.channels != 1) throw ValueError("the noise map must have 1 channel");
+    require_same_size(map, "noise map", reference, "reference frame");
+    require_finite(map, "noise map");
+  }
+}
+
+}  // namespace
+
+Image noisy_frame(const ImageView& style, const ImageView& reference, int frame, const NoisyOptions& o,
+                  const ImageView& noise_map, const ProgressCallback& progress) {
+  validate(style, reference, o, noise_map);
+  // With a map, f_p = f * map(p): the map says where the noise goes (1 =
+  // the slider's amount, 0 = R as it is).
+  const float f = noise_map.empty() ? o.noise : o.noise * std::max(0.0f, *std::max_element(noise_map.data, noise_map.data + noise_map.size()));
+  if (!(f > 1.0f)) return Image::copy_of(reference);  // no noise anywhere: R itself
+  const Image exemplar = deform_exemplar(style, o, frame);
+  SynthesisInput in;
+  in.style = exemplar.view();
+  in.target_width = reference.width;
+  in.target_height = reference.height;
+  in.reference = reference;
+  // Eq. 2 as a guide pair: the low-passed exemplar against the low-passed R.
+  const Image low_s = box_blur(exemplar.view(), f), low_r = box_blur(reference, f);
+  if (o.consistency > 0) in.guides.add("low_frequencies", low_s.view(), low_r.view(), o.consistency);
+  SynthesisOptions opt = o.synthesis;
+  opt.level_ratio = kRatio;
+  opt.levels = noisy_levels(f);
+  opt.level_box_widths = noisy_box_widths(f);
+  opt.seed = noisy_frame_seed(o.synthesis.seed, frame);
+  // The local noise map: per level, pixels whose f_p is below that level's
+  // f_bar are held at R (blurred and downsampled like it).
+  std::vector<Image> reference_levels;
+  if (!noise_map.empty()) reference_levels = build_pyramid(reference, opt.levels, kRatio, opt.level_box_widths);
+  const Solver solver(in, opt);
+  const std::vector<float>& widths = opt.level_box_widths;
+  LevelResult r;
+  for (int l = solver.coarsest(); l >= 0; --l) {
+    Image mask;
+    LevelStart start;
+    OffsetField up;
+    if (l < solver.coarsest()) {
+      up = solver.resample(r.field, l + 1, l);
+      start.field = &up;
+    }
+    Image joining;
+    if (!noise_map.empty()) {
+      // f_p at this level's size (area-averaged).
+      const Image fp = resize_area(noise_map, solver.target_width(l), solver.target_height(l));
+      const Image& held = reference_levels[std::size_t(l)];
+      mask = Image(fp.width(), fp.height(), 1);
+      for (std::size_t i = 0; i < fp.pixel_count(); ++i) {
+        const float fpi = o.noise * fp.data()[i];
+        mask.data()[i] = (fpi < 1.0f || widths[std::size_t(l)] > fpi + 1e-6f) ? 1.0f : 0.0f;
+      }
+      start.fixed_mask = &mask;
+      start.fixed_values = &held;
+      // Pixels that join here start from R (their field is a placeholder);
+      // the others from the B' voted from the upsampled field.
+      if (l < solver.coarsest()) {
+        joining = Image(fp.width(), fp.height(), 1);
+        for (std::size_t i = 0; i < fp.pixel_count(); ++i) {
+          const float fpi = o.noise * fp.data()[i];
+          joining.data()[i] = fpi >= 1.0f && widths[std::size_t(l)] <= fpi + 1e-6f &&
+                              widths[std::size_t(l) + 1] > fpi + 1e-6f;
+        }
+        start.image = &held;
+        start.image_mask = &joining;
+      }
+    }
+    const double done = double(solver.coarsest() - l) / solver.levels();
+    r = solver.solve_level(l, start, [&](double x) { return !progress || progress(done + x / solver.levels()); });
+  }
+  return std::move(r.image);
+}
+
+}  // namespace tempera

@@ -1,0 +1,195 @@
+#include "tempera/tcia.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "tempera/error.hpp"
+#include "tempera/motion.hpp"
+#include "tempera/rng.hpp"
+#include "tempera/solver.hpp"
+
+namespace tempera {
+
+SynthesisOptions tcia_defaults() {
+  SynthesisOptions o;
+  o.patch_size = 9;
+  o.window_sigma = 3.0f;
+  o.output = OutputMode::Centre;
+  o.usage = PatchUsage::Histogram;
+  o.levels = 4;
+  o.em_iterations = 1;
+  o.pm_iterations = 4;  // "3 or 4 full iterations" of parallel PatchMatch (§3.3)
+  o.guide_variance = 1.0;
+  return o;
+}
+
+Image pick_resize(const ImageView& image, int width, int height, float scale) {
+  Image out(width, height, image.channels);
+  for (int y = 0; y < height; ++y) {
+    const int sy = std::min(image.height - 1, int((y + 0.5) * image.height / height));
+    for (int x = 0; x < width; ++x) {
+      const int sx = std::min(image.width - 1, int((x + 0.5) * image.width / width));
+      for (int c = 0; c < image.channels; ++c) out.at(x, y, c) = scale * image.at(sx, sy, c);
+    }
+  }
+  return out;
+}
+
+namespace {
+
+void validate(const Shot& shot, const TciaOptions& o) {
+  require_nonempty(shot.style, "style");
+  if (shot.frames.empty()) throw ValueError("the shot has no frames");
+  const std::size_t layers = shot.style_guides.size();
+  if (shot.guide_names.size() != layers || shot.guide_weights.size() != layers)
+    throw ValueError("each exemplar guide needs a name and a weight");
+  for (std::size_t t = 0; t < shot.frames.size(); ++t) {
+    const ShotFrame& f = shot.frames[t];
+    if (f.guides.size() != layers)
+      throw ValueError(concat("frame ", t, " has ", f.guides.size(), " guides for ", layers, " exemplar guides"));
+    for (const ImageView* v : {&f.velocity_backward, &f.velocity_forward})
+      if (v->channels != 2) throw ValueError(concat("frame ", t, ": velocities must have 2 channels"));
+    for (const ImageView* v : {&f.occlusion_backward, &f.occlusion_forward})
+      if (v->channels != 1) throw ValueError(concat("frame ", t, ": occlusions must have 1 channel"));
+  }
+  validate_fields(o, tcia_option_table());
+  validate(o.synthesis);
+}
+
+// Per frame and level: what the sweeps keep.
+struct FrameState {
+  std::optional<OffsetField> field;
+  Image image;
+};
+
+class Sweeper {
+ public:
+  Sweeper(const Shot& shot, const TciaOptions& o) : shot_(shot), o_(o) {}
+
+  std::vector<Image> run(const ProgressCallback& progress) {
+    const int frames = int(shot_.frames.size());
+    const int levels = make_solver(0, false)->levels();
+    std::vector<FrameState> coarse, here(frames);
+    const double visits = double(levels) * 2 * o_.sweep_pairs * frames;
+    double done = 0;
+    auto report = [&] {
+      if (progress && !progress(++done / visits)) throw CancelledError("stylization cancelled");
+    };
+    for (int l = levels - 1; l >= 0; --l) {
+      for (int pair = 0; pair < o_.sweep_pairs; ++pair) {
+        for (int t = 0; t < frames; ++t, report()) visit(l, t, +1, pair, coarse, here);
+        for (int t = frames - 1; t >= 0; --t, report()) visit(l, t, -1, pair, coarse, here);
+      }
+      coarse = std::move(here);
+      here.assign(frames, {});
+    }
+    std::vector<Image> out;
+    for (auto& s : coarse) out.push_back(std::move(s.image));
+    return out;
+  }
+
+ private:
+  // The solver of frame t, with the temporal guide when `temporal` (its
+  // target is given per level; the input's is a placeholder).
+  std::unique_ptr<Solver> make_solver(int t, bool temporal, int direction = +1) const {
+    const ShotFrame& f = shot_.frames[std::size_t(t)];
+    placeholder_ = Image(f.guides.empty() ? shot_.style.width : f.guides[0].width,
+                         f.guides.empty() ? shot_.style.height : f.guides[0].height, shot_.style.channels);
+    SynthesisInput in;
+    in.style = shot_.style;
+    for (std::size_t g = 0; g < shot_.style_guides.size(); ++g)
+      in.guides.add(shot_.guide_names[g], shot_.style_guides[g], f.guides[g], shot_.guide_weights[g]);
+    if (in.guides.empty()) {
+      in.target_width = placeholder_.width();
+      in.target_height = placeholder_.height();
+    }
+    if (temporal && o_.temporal_weight > 0) {
+      in.target_weight_maps.assign(in.guides.layers().size(), ImageView{});
+      in.guides.add("temporal", shot_.style, placeholder_.view(), o_.temporal_weight);
+      in.target_weight_maps.push_back(direction > 0 ? f.occlusion_backward : f.occlusion_forward);
+    }
+    if (o_.coherence_weight > 0) in.terms.push_back(make_spatial_coherence(o_.coherence_weight, o_.coherence_max));
+    SynthesisOptions opt = o_.synthesis;
+    opt.seed = mix64(o_.synthesis.seed ^ mix64(std::uint64_t(t) + 0x7C1Aull));
+    return std::make_unique<Solver>(in, opt);
+  }
+
+  // Frame t's V (backward for forward sweeps, minus V+ for backward ones, so
+  // that "p came from p - V" holds either way) and χ at level size.
+  Image level_velocity(int t, int direction, int w, int h) const {
+    const ShotFrame& f = shot_.frames[std::size_t(t)];
+    const ImageView& v = direction > 0 ? f.velocity_backward : f.velocity_forward;
+    return pick_resize(v, w, h, float(direction > 0 ? 1 : -1) * float(w) / float(v.width));
+  }
+  Image level_visibility(int t, int direction, int w, int h) const {
+    const ShotFrame& f = shot_.frames[std::size_t(t)];
+    return pick_resize(direction > 0 ? f.occlusion_backward : f.occlusion_forward, w, h);
+  }
+
+  void visit(int l, int t, int direction, int pair, const std::vector<FrameState>& coarse,
+             std::vector<FrameState>& here) {
+    const int frames = int(shot_.frames.size()), from = t - direction;
+    // The neighbour in sweep order, solved at this level already (forward
+    // sweeps fill the frames in order, backward ones re-solve them in reverse).
+    const bool neighbour_in_sweep = from >= 0 && from < frames && here[std::size_t(from)].field.has_value();
+    const auto solver = make_solver(t, neighbour_in_sweep, direction);
+    const int w = solver->target_width(l), h = solver->target_height(l);
+    FrameState& state = here[std::size_t(t)];
+    // The frame's own previous solution: this level's (an earlier sweep) or
+    // the coarser level's, upsampled.
+    std::optional<OffsetField> own;
+    if (state.field) own = *state.field;
+    else if (!coarse.empty() && coarse[std::size_t(t)].field) own = solver->resample(*coarse[std::size_t(t)].field, l + 1, l);
+    std::optional<OffsetField> advected;
+    Image visible, temporal_target;
+    if (neighbour_in_sweep) {
+      const Image v = level_velocity(t, direction, w, h);
+      visible = level_visibility(t, direction, w, h);
+      advected = solver->advect(*here[std::size_t(from)].field, l, v.view());
+      temporal_target = warp_backward(here[std::size_t(from)].image.view(), v.view());
+    }
+    LevelStart start;
+    OffsetField merged;
+    if (advected && own) {
+      merged = *own;
+      Rng rng(o_.synthesis.seed, mix64(std::uint64_t(l) * 7919 + std::uint64_t(t) * 131 + std::uint64_t(direction + 1) +
+                                       std::uint64_t(pair) * 1000003ull));
+      for (std::size_t i = 0; i < merged.x.size(); ++i) {
+        // Fig. 7's random merge; where the neighbour does not see p, p's own.
+        if (visible.data()[i] > 0.5f && rng.below(2) == 0) {
+          merged.x[i] = advected->x[i], merged.y[i] = advected->y[i];
+          merged.rx[i] = advected->rx[i], merged.ry[i] = advected->ry[i];
+        }
+      }
+      start.field = &merged;
+    } else if (advected) {
+      // The coarsest level's first visit of a frame: disoccluded pixels get
+      // a random source (legalize_field relocates out-of-range positions).
+      merged = *advected;
+      for (std::size_t i = 0; i < merged.x.size(); ++i)
+        if (visible.data()[i] <= 0.5f) merged.x[i] = -1;
+      start.field = &merged;
+    } else if (own) {
+      start.field = &*own;
+    }
+    if (neighbour_in_sweep && o_.temporal_weight > 0)
+      start.guide_targets.emplace_back(int(shot_.style_guides.size()), &temporal_target);
+    LevelResult r = solver->solve_level(l, start);
+    state.field = std::move(r.field);
+    state.image = std::move(r.image);
+  }
+
+  const Shot& shot_;
+  const TciaOptions& o_;
+  mutable Image placeholder_;  // full-size stand-in target of the temporal guide
+};
+
+}  // namespace
+
+std::vector<Image> stylize_shot(const Shot& shot, const TciaOptions& options, const ProgressCallback& progress) {
+  validate(shot, options);
+  return Sweeper(shot, options).run(progress);
+}
+
+}  // namespace tempera

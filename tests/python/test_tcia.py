@@ -1,0 +1,46 @@
+"""tempera.tcia: Bénard et al. 2013's sweeps from Python."""
+import numpy as np
+import pytest
+
+from tempera import tcia, temporal
+
+
+def shot(frames=5, w=48, h=32, speed=2):
+    rng = np.random.default_rng(2)
+    style = rng.random((48, 64, 3)).astype(np.float32)
+    uv_s = np.stack(np.meshgrid(np.arange(64) / 64, np.arange(48) / 48), -1).astype(np.float32)
+    out = []
+    for t in range(frames):
+        xs, ys = np.meshgrid((np.arange(w) - speed * t + 12) / 64, (np.arange(h) + 8) / 48)
+        v = np.zeros((h, w, 2), np.float32)
+        v[..., 0] = speed
+        chi_m, chi_p = np.ones((h, w), np.float32), np.ones((h, w), np.float32)
+        chi_m[:, :speed], chi_p[:, -speed:] = 0, 0
+        out.append(dict(guides=[np.stack([xs, ys], -1).astype(np.float32)], velocity_backward=v, velocity_forward=v,
+                        occlusion_backward=chi_m, occlusion_forward=chi_p))
+    return style, [("uv", uv_s, 4.0)], out
+
+
+def test_shot_is_coherent_and_reports_progress():
+    style, guides, frames = shot()
+    seen = []
+    out = tcia.stylize_shot(style, guides, frames, levels=3, patch_size=7, threads=2, progress=seen.append)
+    assert len(out) == 5 and out[0].shape == (32, 48, 3)
+    assert seen and seen[-1] == pytest.approx(1.0) and seen == sorted(seen)
+    flick = np.mean([temporal.flicker(out[t - 1], out[t], frames[t]["velocity_backward"],
+                                      frames[t]["occlusion_backward"]) for t in range(1, 5)])
+    assert flick < 0.01
+
+
+def test_cancel_and_bad_options():
+    style, guides, frames = shot(frames=2)
+    import tempera
+
+    with pytest.raises(tempera.Cancelled):
+        tcia.stylize_shot(style, guides, frames, levels=2, progress=lambda f: False)
+    with pytest.raises(TypeError, match="sparkle"):
+        tcia.stylize_shot(style, guides, frames, sparkle=1)
+    with pytest.raises(ValueError, match="velocity_forward"):
+        bad = [dict(frames[0])]
+        del bad[0]["velocity_forward"]
+        tcia.stylize_shot(style, guides, bad)
