@@ -286,6 +286,8 @@ def trace_lpe(
     caustics_reflective: bool = True,
     caustics_refractive: bool = True,
     filter_glossy: float = 0.0,
+    pixel_filter: str = "box",
+    filter_width: float = 1.0,
 ):
     """Render one linear radiance image per light path expression.
 
@@ -297,7 +299,9 @@ def trace_lpe(
     so do the per-kind limits (``diffuse_bounces`` ...; transparent surfaces
     count separately). ``caustics_reflective``/``caustics_refractive`` False
     drop glossy/refractive lobes after a diffuse bounce, as Cycles' options do;
-    ``filter_glossy`` is Cycles' Filter Glossy (0: off).
+    ``filter_glossy`` is Cycles' Filter Glossy (0: off); ``pixel_filter``
+    (``"box"``, ``"gaussian"``, ``"blackman_harris"``) and ``filter_width``
+    (pixels) are Cycles' Film > Pixel Filter (default: the pixel itself).
     ``progress(fraction)`` returning False cancels (raises ``tempera.Cancelled``).
 
     Returns ``(images, alpha)``: a list of float32 (H, W, 3) arrays in the
@@ -318,4 +322,5 @@ def trace_lpe(
                              transparent_bounces=int(transparent_bounces),
                              caustics_reflective=bool(caustics_reflective),
                              caustics_refractive=bool(caustics_refractive),
-                             filter_glossy=float(filter_glossy))
+                             filter_glossy=float(filter_glossy), pixel_filter=str(pixel_filter),
+                             filter_width=float(filter_width))

@@ -71,7 +71,7 @@ void bind_tracer(py::module_& m) {
       [](const Scene& scene, const std::vector<std::string>& expressions, int samples, std::uint64_t seed,
          int threads, int max_bounces, std::function<bool(double)> progress, int diffuse_bounces, int glossy_bounces,
          int transmission_bounces, int transparent_bounces, bool caustics_reflective, bool caustics_refractive,
-         float filter_glossy) {
+         float filter_glossy, const std::string& pixel_filter, float filter_width) {
         TraceOptions options;
         options.samples = samples;
         options.seed = seed;
@@ -84,6 +84,11 @@ void bind_tracer(py::module_& m) {
         options.caustics_reflective = caustics_reflective;
         options.caustics_refractive = caustics_refractive;
         options.filter_glossy = filter_glossy;
+        if (pixel_filter == "box") options.pixel_filter = TraceOptions::PixelFilter::box;
+        else if (pixel_filter == "gaussian") options.pixel_filter = TraceOptions::PixelFilter::gaussian;
+        else if (pixel_filter == "blackman_harris") options.pixel_filter = TraceOptions::PixelFilter::blackman_harris;
+        else throw ValueError(concat("pixel_filter must be 'box', 'gaussian' or 'blackman_harris', got '", pixel_filter, "'"));
+        options.filter_width = filter_width;
         TraceProgress callback = py_bridge::with_gil([&](double fraction) {
           return progress ? progress(fraction) : true;
         });
@@ -102,7 +107,7 @@ void bind_tracer(py::module_& m) {
       py::arg("max_bounces") = 8, py::arg("progress") = nullptr, py::arg("diffuse_bounces") = 1024,
       py::arg("glossy_bounces") = 1024, py::arg("transmission_bounces") = 1024, py::arg("transparent_bounces") = 1024,
       py::arg("caustics_reflective") = true, py::arg("caustics_refractive") = true, py::arg("filter_glossy") = 0.0f,
-      kTraceDoc);
+      py::arg("pixel_filter") = "box", py::arg("filter_width") = 1.0f, kTraceDoc);
   m.def(
       "check_lpe", [](const std::string& expression) { compile_lpe(expression); }, py::arg("expression"),
       "Raise ValueError (with the 0-based position) if the light path expression is malformed.");

@@ -149,13 +149,16 @@ def _light_visibility(obj):
 
 
 def path_settings(scene):
-    """The scene's Cycles light path settings as trace_lpe keywords."""
+    """The scene's Cycles settings that shape the tracer's paths and pixels
+    (Light Paths, Film > Pixel Filter) as trace_lpe keywords."""
     c = scene.cycles
     return {"max_bounces": int(c.max_bounces), "diffuse_bounces": int(c.diffuse_bounces),
             "glossy_bounces": int(c.glossy_bounces), "transmission_bounces": int(c.transmission_bounces),
             "transparent_bounces": int(c.transparent_max_bounces),
             "caustics_reflective": bool(c.caustics_reflective), "caustics_refractive": bool(c.caustics_refractive),
-            "filter_glossy": float(c.blur_glossy)}
+            "filter_glossy": float(c.blur_glossy),
+            "pixel_filter": {"BOX": "box", "GAUSSIAN": "gaussian"}.get(c.pixel_filter_type, "blackman_harris"),
+            "filter_width": float(c.filter_width)}
 
 
 def _rendered_objects(view_layer, warnings):

@@ -31,6 +31,13 @@ struct TraceOptions {
   // pdf p (the smallest so far), glossy lobes get a microfacet alpha of at
   // least sqrt(1 - p * (1 / filter_glossy)) / 2 where that is below 1.
   float filter_glossy = 0;
+  // Cycles' pixel filter (Film > Pixel Filter): camera rays are spread over
+  // the filter's footprint, importance-sampled per axis as Cycles does: a box
+  // of filter_width pixels, a Gaussian over 3 and a Blackman-Harris window
+  // over 2 filter widths (Cycles' footprints). The default, a box of width 1,
+  // is the pixel itself.
+  enum class PixelFilter { box, gaussian, blackman_harris } pixel_filter = PixelFilter::box;
+  float filter_width = 1;
 };
 
 struct TraceResult {

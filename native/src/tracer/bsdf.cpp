@@ -6,6 +6,7 @@
 namespace tempera::tracer {
 namespace {
 
+
 Float3 schlick(Float3 f0, float cos_theta) {
   const float m = 1 - std::clamp(cos_theta, 0.0f, 1.0f);
   const float m5 = m * m * m * m * m;
@@ -87,6 +88,14 @@ void add_lobe(ShadingPoint& s, const Lobe& lobe) {
   if (s.count < kMaxLobes && max_component(lobe.weight) > 0) s.lobes[s.count++] = lobe;
 }
 
+// Cycles 3.x's Principled Fresnel: the dielectric Fresnel of `eta`, remapped
+// so that it starts at f0 (the specular colour) at normal incidence.
+Float3 principled_fresnel(const Lobe& l, float cos_theta) {
+  const float normal = fresnel_dielectric(1, l.eta);
+  const float t = (fresnel_dielectric(cos_theta, l.eta) - normal) / (1 - normal);
+  return l.f0 + (Float3{1, 1, 1} - l.f0) * t;
+}
+
 // A reflection of `roughness`: a mirror below kSingularRoughness, else microfacet.
 Lobe reflection_lobe(Float3 weight, float roughness, bool beckmann, FresnelMode fresnel, Float3 f0) {
   Lobe l;
@@ -110,8 +119,11 @@ void add_principled(ShadingPoint& s, Float3 weight, Float3 base, float metallic,
   diffuse.a = roughness;
   diffuse.weight = weight * base * ((1 - metallic) * (1 - transmission));
   add_lobe(s, diffuse);
-  add_lobe(s, reflection_lobe(weight * (1 - (1 - metallic) * transmission), roughness, false, FresnelMode::schlick,
-                              f0));
+  Lobe specular_lobe = reflection_lobe(weight * (1 - (1 - metallic) * transmission), roughness, false,
+                                       FresnelMode::principled, f0);
+  // Cycles derives the specular lobe's IOR from Specular (0.5 -> 1.5).
+  specular_lobe.eta = 2 / (1 - std::sqrt(std::clamp(0.08f * specular, 0.0f, 0.99f))) - 1;
+  add_lobe(s, specular_lobe);
   Lobe glass;
   glass.kind = LobeKind::dielectric;
   glass.weight = weight * base * ((1 - metallic) * transmission);
@@ -131,8 +143,10 @@ void add_closure(const Scene& scene, ShadingPoint& s, const Closure& c, const Su
                      closure_roughness(scene, c, at), c.transmission, c.ior);
       if (c.clearcoat > 0) {
         const float r = std::clamp(c.clearcoat_roughness, 0.0f, 1.0f);
-        add_lobe(s, reflection_lobe(weight * (0.25f * c.clearcoat), r, false, FresnelMode::schlick,
-                                    {0.04f, 0.04f, 0.04f}));
+        Lobe coat = reflection_lobe(weight * (0.25f * c.clearcoat), r, false, FresnelMode::principled,
+                                    {0.04f, 0.04f, 0.04f});
+        coat.eta = 1.5f;
+        add_lobe(s, coat);
       }
       break;
     }
@@ -197,6 +211,7 @@ void add_closure(const Scene& scene, ShadingPoint& s, const Closure& c, const Su
 
 float lobe_energy(const ShadingPoint& s, const Lobe& l) {
   if (l.fresnel == FresnelMode::schlick) return luminance(l.weight * schlick(l.f0, dot(s.n, s.wo)));
+  if (l.fresnel == FresnelMode::principled) return luminance(l.weight * principled_fresnel(l, dot(s.n, s.wo)));
   return luminance(l.weight);
 }
 
@@ -385,6 +400,7 @@ LobeValue evaluate_lobe(const ShadingPoint& s, const Lobe& l, Float3 wi) {
   }
   Float3 f = l.weight * (d * g / (4 * cos_o));
   if (l.fresnel == FresnelMode::schlick) f *= schlick(l.f0, dot(wi, h));
+  else if (l.fresnel == FresnelMode::principled) f *= principled_fresnel(l, dot(wi, h));
   else if (l.fresnel == FresnelMode::dielectric) f = f * fresnel_dielectric(dot(wi, h), l.eta);
   return {f, d * cos_h / (4 * dot(s.wo, h))};
 }
@@ -434,6 +450,7 @@ bool sample(const ShadingPoint& s, Rng& rng, Scatter& out) {
     if (dot(s.ng, mirror) <= 0) return false;
     Float3 w = l.weight / l.pick;
     if (l.fresnel == FresnelMode::schlick) w *= schlick(l.f0, cos_o);
+    else if (l.fresnel == FresnelMode::principled) w *= principled_fresnel(l, cos_o);
     out = {LpeEvent::S, &l, mirror, w, 0, false};
     return true;
   }

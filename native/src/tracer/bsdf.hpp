@@ -22,7 +22,8 @@ constexpr int kMaxLobes = 16;
 enum class LobeKind {
   lambert, oren_nayar, principled_diffuse, translucent, microfacet, microfacet_transmission, mirror, dielectric
 };
-enum class FresnelMode { none, schlick, dielectric };
+// principled: Cycles 3.x's Principled Fresnel, f0 + (1 - f0) (F(cos, eta) - F(1, eta)) / (1 - F(1, eta)).
+enum class FresnelMode { none, schlick, dielectric, principled };
 
 struct Lobe {
   LobeKind kind = LobeKind::lambert;
