@@ -66,7 +66,7 @@ struct Factor {
 // reflections S, refraction T; transparent is no event (the path goes on).
 struct Closure {
   enum class Type {
-    principled,   // Principled BSDF (v1 model: Disney diffuse + GGX with Schlick Fresnel + smooth glass)
+    principled,   // Principled BSDF (Cycles 3.x v1: Disney diffuse, GGX with its Fresnel, smooth glass, clearcoat)
     diffuse,      // Lambert, or Oren-Nayar with a roughness
     glossy,       // microfacet reflection tinted by color, no Fresnel (Glossy, Anisotropic)
     glass,        // smooth dielectric: Fresnel reflection S + refraction T, both tinted
