@@ -538,3 +538,53 @@ TEST(Tracer, FilterGlossyBlursMirrorsAfterADiffuseBounce) {
   o.filter_glossy = 1;
   EXPECT_GT(mean(trace_lpe(s, {"LS+DE"}, o).images[0]), 0.0);
 }
+
+TEST(Tracer, SameResultForAnyThreadCountWithClosuresMapsAndFilters) {
+  // Mixed closures with a Fresnel factor, a transparent sheet, rough glass,
+  // a soft point light, an environment map, Filter Glossy and Cycles' pixel filter.
+  Scene s = sun_scene(0.9f);
+  Closure d = closure(Closure::Type::diffuse, {0.6f, 0.5f, 0.4f}, 0.3f);
+  Closure g = closure(Closure::Type::glossy, {1, 1, 1}, 0.2f);
+  Factor f;
+  f.kind = Factor::Kind::fresnel;
+  f.value = 1.5f;
+  d.factors = {f};
+  d.factors[0].invert = true;
+  g.factors = {f};
+  Closure glass = closure(Closure::Type::glass, {1, 1, 1}, 0.2f);
+  s.materials = {of({d, g}), of({glass}), of({closure(Closure::Type::transparent, {0.5f, 0.5f, 0.5f})})};
+  add_floor(s, 100, 0);
+  s.triangle_materials = {0, 0, 0, 0};  // the sun scene's floor and this one
+  add_sphere(s, {0, 0, 0.5f}, 0.5f, 1, 12, 24);
+  add_quad(s, {-1, -1, 1.5f}, {1, -1, 1.5f}, {1, 1, 1.5f}, {-1, 1, 1.5f}, 2);
+  Light point;
+  point.type = Light::Type::point;
+  point.position = {1, 1, 3};
+  point.radius = 0.5f;
+  point.intensity = {20, 20, 20};
+  s.lights.push_back(point);
+  Image map(16, 8, 4);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 16; ++x)
+      for (int c = 0; c < 3; ++c) map.at(x, y, c) = 0.1f * float(x % 4 + y);
+  s.textures = {map};
+  s.world_map = 0;
+  s.world_radiance = {1, 1, 1};
+  TraceOptions one = options(8), two = options(8);
+  for (TraceOptions* o : {&one, &two}) {
+    o->seed = 11;
+    o->filter_glossy = 1;
+    o->pixel_filter = TraceOptions::PixelFilter::blackman_harris;
+    o->filter_width = 1.5f;
+  }
+  one.threads = 1;
+  two.threads = 2;
+  const std::vector<std::string> expressions = {"L.*E", "LDE", "LSE", "L.*TE"};
+  const TraceResult a = trace_lpe(s, expressions, one);
+  const TraceResult b = trace_lpe(s, expressions, two);
+  for (std::size_t k = 0; k < expressions.size(); ++k) {
+    EXPECT_EQ(std::memcmp(a.images[k].data(), b.images[k].data(), a.images[k].pixel_count() * 3 * sizeof(float)),
+              0) << expressions[k];
+    EXPECT_GT(mean(a.images[k]), 0.0) << expressions[k];
+  }
+}
