@@ -53,7 +53,7 @@ const char* kStylizeHelpText =
     "  --weights LIST          light-path guide weights (default @WEIGHTS@);\n"
     "                          guides not listed keep their default, 0 leaves a guide out\n"
     "  --temporal W            weight of the temporal guide: the previous stylized frame\n"
-    "                          advected along the motion (default 0.5; 0 = frames independent)\n"
+    "                          advected along the motion (default 0 = frames independent; 0.5 typical)\n"
     "  --quality Q             final (default) | preview (about 5x faster, for trying settings)\n"
     "  --usage MODE            none | penalty | uniform | budget (default budget)\n"
     "  --patch-size N          odd patch width (default 5)\n"

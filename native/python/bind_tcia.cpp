@@ -26,8 +26,8 @@ void bind_tcia(py::module_& m) {
   m.def("tcia_defaults", &tcia_defaults, "The engine options of the coherent method.");
   m.def(
       "stylize_shot",
-      [](const FloatArray& style, const py::list& guides, const py::list& frames, const TciaOptions& options,
-         const std::function<bool(double)>& progress) {
+      [](const FloatArray& style, const py::list& guides, const py::list& frames, const py::list& keys,
+         const TciaOptions& options, const std::function<bool(double)>& progress) {
         std::vector<FloatArray> keep;
         Shot shot;
         shot.style = py_bridge::view_of(style, "style");
@@ -51,6 +51,14 @@ void bind_tcia(py::module_& m) {
           f.occlusion_forward = keep_view(d["occlusion_forward"], what + " occlusion_forward", keep);
           shot.frames.push_back(std::move(f));
         }
+        for (const auto& item : keys) {
+          const auto t = item.cast<py::tuple>();
+          ShotKey key;
+          key.frame = t[0].cast<int>();
+          key.painting = keep_view(t[1], concat("the painting of key ", key.frame), keep);
+          if (!t[2].is_none()) key.mask = keep_view(t[2], concat("the mask of key ", key.frame), keep);
+          shot.keys.push_back(key);
+        }
         ProgressCallback callback = py_bridge::with_gil([&](double f) { return progress ? progress(f) : true; });
         std::vector<Image> out;
         {
@@ -61,6 +69,7 @@ void bind_tcia(py::module_& m) {
         for (auto& image : out) result.append(py_bridge::to_numpy(std::move(image)));
         return result;
       },
-      py::arg("style"), py::arg("guides"), py::arg("frames"), py::arg("options"), py::arg("progress") = nullptr,
+      py::arg("style"), py::arg("guides"), py::arg("frames"), py::arg("keys"), py::arg("options"),
+      py::arg("progress") = nullptr,
       "A whole shot with Bénard et al. 2013's sweeps; use tempera.tcia.stylize_shot.");
 }

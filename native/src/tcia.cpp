@@ -38,6 +38,17 @@ Image pick_resize(const ImageView& image, int width, int height, float scale) {
 
 namespace {
 
+// `image` with `m` pixels of edge-replicated border on each side.
+Image pad(const ImageView& image, int m) {
+  Image out(image.width + 2 * m, image.height + 2 * m, image.channels);
+  for (int y = 0; y < out.height(); ++y)
+    for (int x = 0; x < out.width(); ++x) {
+      const float* p = image.pixel(std::clamp(x - m, 0, image.width - 1), std::clamp(y - m, 0, image.height - 1));
+      std::copy_n(p, image.channels, out.pixel(x, y));
+    }
+  return out;
+}
+
 void validate(const Shot& shot, const TciaOptions& o) {
   require_nonempty(shot.style, "style");
   if (shot.frames.empty()) throw ValueError("the shot has no frames");
@@ -52,6 +63,16 @@ void validate(const Shot& shot, const TciaOptions& o) {
       if (v->channels != 2) throw ValueError(concat("frame ", t, ": velocities must have 2 channels"));
     for (const ImageView* v : {&f.occlusion_backward, &f.occlusion_forward})
       if (v->channels != 1) throw ValueError(concat("frame ", t, ": occlusions must have 1 channel"));
+  }
+  int last = -1;
+  for (const ShotKey& k : shot.keys) {
+    if (k.frame <= last || k.frame >= int(shot.frames.size()))
+      throw ValueError(concat("keyframe ", k.frame, " is outside the shot or out of order"));
+    last = k.frame;
+    require_nonempty(k.painting, concat("the painting of keyframe ", k.frame));
+    if (k.painting.channels != shot.style.channels)
+      throw ValueError(concat("the painting of keyframe ", k.frame, " has ", k.painting.channels,
+                              " channels, the style ", shot.style.channels));
   }
   validate_fields(o, tcia_option_table());
   validate(o.synthesis);
@@ -109,6 +130,40 @@ class Sweeper {
       in.guides.add("temporal", shot_.style, placeholder_.view(), o_.temporal_weight);
       in.target_weight_maps.push_back(direction > 0 ? f.occlusion_backward : f.occlusion_forward);
     }
+    // Keys: extra exemplars (the painting over its frame's guides) and, at
+    // their own frame, the painted pixels fixed to the painting. A key is
+    // padded by the patch margin (edge pixels repeated, not copyable), so
+    // that its border pixels can be patch centres: in-betweens can then copy
+    // a key right up to the frame's edge.
+    const int m = o_.synthesis.patch_size / 2;
+    keys_.clear();
+    keys_.reserve(shot_.keys.size());
+    for (std::size_t k = 0; k < shot_.keys.size(); ++k) {
+      const ShotKey& key = shot_.keys[k];
+      PaddedKey& pk = keys_.emplace_back();
+      pk.painting = pad(key.painting, m);
+      for (const ImageView& g : shot_.frames[std::size_t(key.frame)].guides) pk.guides.push_back(pad(g, m));
+      pk.mask = Image(pk.painting.width(), pk.painting.height(), 1);
+      for (int y = 0; y < key.painting.height; ++y)
+        for (int x = 0; x < key.painting.width; ++x)
+          pk.mask.at(x + m, y + m, 0) = key.mask.empty() ? 1.0f : key.mask.at(x, y, 0);
+      Exemplar e;
+      e.style = pk.painting.view();
+      for (const Image& g : pk.guides) e.guides.push_back(g.view());
+      if (temporal && o_.temporal_weight > 0) e.guides.push_back(pk.painting.view());
+      e.mask = pk.mask.view();
+      in.exemplars.push_back(e);
+      if (key.frame == t) {
+        key_mask_ = key.mask.empty() ? Image(key.painting.width, key.painting.height, 1, 1.0f) : Image::copy_of(key.mask);
+        key_matches_ = Image(key.painting.width, key.painting.height, 3);
+        for (int y = 0; y < key.painting.height; ++y)
+          for (int x = 0; x < key.painting.width; ++x) {
+            float* match = key_matches_.pixel(x, y);
+            match[0] = float(k + 1), match[1] = float(x + m), match[2] = float(y + m);
+          }
+        in.fixed = FixedPixels{key_mask_.view(), key.painting, key_matches_.view()};
+      }
+    }
     if (o_.coherence_weight > 0) in.terms.push_back(make_spatial_coherence(o_.coherence_weight, o_.coherence_max));
     SynthesisOptions opt = o_.synthesis;
     opt.seed = mix64(o_.synthesis.seed ^ mix64(std::uint64_t(t) + 0x7C1Aull));
@@ -155,9 +210,10 @@ class Sweeper {
       merged = *own;
       Rng rng(o_.synthesis.seed, mix64(std::uint64_t(l) * 7919 + std::uint64_t(t) * 131 + std::uint64_t(direction + 1) +
                                        std::uint64_t(pair) * 1000003ull));
+      const std::uint64_t share = std::uint64_t(advected_share(t, direction) * 4294967296.0);
       for (std::size_t i = 0; i < merged.x.size(); ++i) {
         // Fig. 7's random merge; where the neighbour does not see p, p's own.
-        if (visible.data()[i] > 0.5f && rng.below(2) == 0) {
+        if (visible.data()[i] > 0.5f && (rng.next() >> 32) < share) {
           merged.x[i] = advected->x[i], merged.y[i] = advected->y[i];
           merged.rx[i] = advected->rx[i], merged.ry[i] = advected->ry[i];
         }
@@ -183,6 +239,27 @@ class Sweeper {
   const Shot& shot_;
   const TciaOptions& o_;
   mutable Image placeholder_;  // full-size stand-in target of the temporal guide
+  mutable Image key_mask_, key_matches_;  // the fixed pixels of a key frame
+  struct PaddedKey {
+    Image painting, mask;
+    std::vector<Image> guides;
+  };
+  mutable std::vector<PaddedKey> keys_;  // the keys as exemplars of the solver being built
+
+  // Probability that the merge takes the advected neighbour at frame t: 1/2,
+  // or between keys t_l < t < t_n, (t_n - t) / (t_n - t_l) forward and
+  // (t - t_l) / (t_n - t_l) backward, so each key's influence fades with
+  // distance (§4.1).
+  double advected_share(int t, int direction) const {
+    int before = -1, after = -1;
+    for (const ShotKey& k : shot_.keys) {
+      if (k.frame < t) before = k.frame;
+      if (k.frame > t && after < 0) after = k.frame;
+    }
+    if (before < 0 || after < 0) return 0.5;
+    const double span = after - before;
+    return direction > 0 ? (after - t) / span : (t - before) / span;
+  }
 };
 
 }  // namespace

@@ -139,3 +139,42 @@ TEST(Tcia, BadShotsNameTheProblem) {
   bad.frames.clear();
   EXPECT_THROW(stylize_shot(bad, fast()), ValueError);
 }
+
+TEST(Tcia, KeysComeOutAsPaintedAndTheInBetweensFollowThem) {
+  TranslatingShot s(8, 56, 40, 2.0f);
+  // Keys at the first and last frame: the frame painted in a warmer palette.
+  std::vector<Image> paintings;
+  for (int k : {0, 7}) {
+    Image p(56, 40, 3);
+    for (int y = 0; y < 40; ++y)
+      for (int x = 0; x < 56; ++x) {
+        const int sx = std::clamp(int(std::lround(x - 2.0f * k + 20)), 0, 79), sy = y + 8;
+        p.at(x, y, 0) = std::min(1.0f, s.style.at(sx, sy, 0) + 0.4f);
+        p.at(x, y, 1) = s.style.at(sx, sy, 1);
+        p.at(x, y, 2) = 0.5f * s.style.at(sx, sy, 2);
+      }
+    paintings.push_back(std::move(p));
+  }
+  s.shot.keys = {{0, paintings[0].view(), {}}, {7, paintings[1].view(), {}}};
+  const std::vector<Image> out = stylize_shot(s.shot, fast());
+  for (int i : {0, 1}) {
+    const Image& key = paintings[std::size_t(i)];
+    const Image& frame = out[std::size_t(i == 0 ? 0 : 7)];
+    for (std::size_t p = 0; p < key.pixel_count() * 3; ++p) ASSERT_NEAR(frame.data()[p], key.data()[p], 1.0f / 255);
+  }
+  // The in-betweens are painted like the keys (warm), not like the style.
+  double red = 0, blue = 0;
+  for (int t = 2; t <= 5; ++t)
+    for (std::size_t p = 0; p < out[t].pixel_count(); ++p) red += out[t].data()[3 * p], blue += out[t].data()[3 * p + 2];
+  EXPECT_GT(red, 2 * blue);
+  // No pop into or out of a key: flicker there within 1.5x the median.
+  std::vector<double> f;
+  for (std::size_t t = 1; t < out.size(); ++t)
+    f.push_back(flicker(out[t - 1].view(), out[t].view(), s.v_minus[t].view(), s.chi_minus[t].view()));
+  { std::string all; for (double v : f) all += std::to_string(v) + " "; RecordProperty("flicker", all); }
+  std::vector<double> sorted = f;
+  std::sort(sorted.begin(), sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  EXPECT_LE(f.front(), 1.5 * median + 1e-4);
+  EXPECT_LE(f.back(), 1.5 * median + 1e-4);
+}

@@ -44,3 +44,12 @@ def test_cancel_and_bad_options():
         bad = [dict(frames[0])]
         del bad[0]["velocity_forward"]
         tcia.stylize_shot(style, guides, bad)
+
+
+def test_a_key_comes_out_as_painted():
+    style, guides, frames = shot(frames=4)
+    painting = np.random.default_rng(5).random((32, 48, 3)).astype(np.float32)
+    mask = np.zeros((32, 48), np.float32)
+    mask[8:24, 10:30] = 1
+    out = tcia.stylize_shot(style, guides, frames, keys=[(2, painting, mask)], levels=3, patch_size=7, threads=2)
+    np.testing.assert_allclose(out[2][8:24, 10:30], painting[8:24, 10:30], atol=1 / 255)

@@ -227,7 +227,7 @@ class TemperaSettings(PropertyGroup):
         name="Temporal Coherence",
         description="Pull of the previous stylized frame, moved along the rendered motion: higher values "
         "flicker less but let the paint stick and smear; 0 stylizes each frame on its own",
-        default=limits.DEFAULT_TEMPORAL_WEIGHT,
+        default=limits.PANEL_TEMPORAL_WEIGHT,
         min=0.0,
         soft_max=2.0,
     )

@@ -86,9 +86,10 @@ void parse_guide_weights(const std::string& text, std::vector<std::pair<std::str
 struct StylitOptions {
   // Light-path guide weights in matching order; a weight <= 0 leaves the guide out.
   std::vector<std::pair<std::string, float>> weights = default_guide_weights();
-  // Pull towards the advected previous frame; 0 = frames independent. 0.5 is
-  // measured on the demo: flicker 0.030 -> 0.011 with the stroke detail kept.
-  float temporal_weight = 0.5f;
+  // Pull towards the advected previous frame; 0 = frames independent, so a
+  // farm can split the shot anywhere. The panel starts artists at 0.5
+  // (settings.PANEL_TEMPORAL_WEIGHT).
+  float temporal_weight = 0.0f;
   Quality quality = Quality::Final;
   // Engine options. usage, patch_size, seed, threads (and anything else) are
   // taken as they are, except that the quality preset sets the iteration counts.

@@ -15,7 +15,9 @@
 //    by χ- or χ+;
 //  - spatial coherence (eq. 5) and the usage histogram (eq. 8);
 // and "warps, not blends": each pixel copies its source pixel (output
-// centre). Painted keys, lines and layers are still to come (issue 12).
+// centre). Painted keys (§4.1) are hard constraints and extra exemplars, and
+// the random merge leans toward the nearer key. Lines (eq. 9), ribbons, the
+// time-derivative terms (eq. 10) and layers are still to come (issue 12).
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -32,12 +34,22 @@ struct ShotFrame {
   ImageView occlusion_backward, occlusion_forward; // χ-, χ+: 1 channel, 1 = visible in the neighbour frame
 };
 
+// A painted keyframe (§4.1): the frame's painting, optionally only where
+// `mask` > 0.5 (a partial key). It is a hard constraint at its frame and an
+// extra exemplar (with the frame's guides) for every frame.
+struct ShotKey {
+  int frame = 0;       // index into Shot::frames
+  ImageView painting;  // the frame's size, the style's channels
+  ImageView mask;      // optional, 1 channel
+};
+
 struct Shot {
   ImageView style;                      // Ŝ
   std::vector<std::string> guide_names;
   std::vector<ImageView> style_guides;  // S per guide layer
   std::vector<float> guide_weights;     // w_in per guide layer
   std::vector<ShotFrame> frames;
+  std::vector<ShotKey> keys;            // in frame order
 };
 
 struct TciaOptions {
