@@ -163,7 +163,8 @@ def test_alpha_matches_cycles_for_other_cameras(kind, size, fit, shift, tmp_path
     assert 0.1 < cycles.mean() < 0.95 and iou >= 0.99
 
 
-@pytest.mark.parametrize("light", ["POINT", "SUN", pytest.param("AREA", marks=_CYCLES_4_XFAIL), "SPOT"])
+@pytest.mark.parametrize("light", ["POINT", "SUN", pytest.param("AREA", marks=_CYCLES_4_XFAIL),
+                                   pytest.param("SPOT", marks=_CYCLES_4_XFAIL)])
 def test_light_power_matches_cycles(light, tmp_path):
     """A diffuse floor under each light type: the unit conversions of scene_units."""
     scene = lpe_scene.build_scene(f"LPE {light}", SIZE, light=light, diffuse_only=True, objects=False)
@@ -434,6 +435,8 @@ def _surface_tree(name):
     return material, tree, tree.nodes["Material Output"].inputs["Surface"]
 
 
+@pytest.mark.xfail(CYCLES_4_LIGHTS, strict=True, reason="Principled v2 (Blender 4) exports other closures "
+                   "than this test's v1 expectations (docs/lpe_guides.md)")
 def test_materials_become_cycles_closures():
     from tempera.blender.scene_export import convert_material
 

@@ -28,6 +28,16 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "scenes"))
 import lpe_gallery  # noqa: E402
 
+import bpy  # noqa: E402
+
+# The tracer follows Cycles 3.x, which renders the guides in Debian's Blender
+# 3.4, where every scene must pass. Cycles 4.0 changed its lights (spheres, no
+# spot cosine, new area sampling) and the Principled BSDF (v2), and the
+# tracer does not model those yet: in blender.org 4.2, 4.5 and 5.0 most scenes
+# disagree (docs/lpe_guides.md, issue 17 open). Not strict: some scenes agree.
+pytestmark = pytest.mark.xfail(bpy.app.version >= (4, 0, 0), strict=False,
+                               reason="the tracer models Cycles 3.x lights and Principled v1")
+
 SAMPLES = int(os.environ.get("GALLERY_SAMPLES", 128))  # Cycles and the tracer alike (override to study noise)
 MEAN_TOLERANCE = 0.05
 CORRELATION_TOLERANCE = 0.98
