@@ -6,8 +6,8 @@ sphere under one light, seen from the front with background above the wall.
     scene = build_scene("LPE", size=(96, 72), sphere="metal", light="POINT")
 
 sphere: "metal" (rough gold), "mirror" (perfect mirror), "diffuse" (a Diffuse
-BSDF) or None; diffuse_only=True makes the floor, wall and cube plain Diffuse
-BSDFs (no glossy lobe: with a diffuse sphere, Cycles' DiffInd with caustics
+BSDF) or None; diffuse_only=True makes the floor, wall and cube (and a metal
+sphere, not a mirror) plain Diffuse BSDFs (no glossy lobe: with a diffuse sphere, Cycles' DiffInd with caustics
 off is exactly L.*DDE); objects=False leaves only the floor (light power checks).
 """
 import math
@@ -93,7 +93,8 @@ def build_scene(name="LPE", size=(96, 72), sphere="metal", light="POINT", diffus
                         "diffuse": ((0.2, 0.3, 0.7), {"Specular": 0.0})}[kind]
             _object(scene, "Sphere",
                     lambda bm: bmesh.ops.create_uvsphere(bm, u_segments=48, v_segments=24, radius=0.55),
-                    _material("Sphere", settings[0], diffuse_only or kind == "diffuse", **settings[1]),
+                    _material("Sphere", settings[0], (diffuse_only and kind != "mirror") or kind == "diffuse",
+                              **settings[1]),
                     location=SPHERE_CENTRE, smooth=True)
 
     kind, power, location, target, extra = LIGHTS[light]

@@ -35,6 +35,34 @@ void validate_material(const Material& m, const std::string& what) {
   }
 }
 
+void validate_texture_ref(const TextureRef& t, std::size_t textures, const std::string& what) {
+  if (!t.valid()) return;
+  require(std::size_t(t.image) < textures, what, " uses texture ", t.image, " but there are ", textures, " textures");
+  for (float f : t.uv) require(std::isfinite(f), what, " has a non-finite UV transform");
+  require(t.channel >= 0 && t.channel <= 4, what, " channel must be in [0, 4]");
+}
+
+void validate_closures(const Material& m, std::size_t textures, const std::string& what) {
+  for (std::size_t i = 0; i < m.closures.size(); ++i) {
+    const Closure& c = m.closures[i];
+    const std::string name = concat(what, " closure ", i);
+    require_finite3(c.weight, name + " weight");
+    require_finite3(c.color, name + " color");
+    for (float f : {c.roughness, c.ior, c.metallic, c.specular, c.transmission})
+      require(std::isfinite(f), name + " has a non-finite parameter");
+    require(c.ior > 0, name + " ior must be positive");
+    validate_texture_ref(c.color_texture, textures, name + " color_texture");
+    validate_texture_ref(c.roughness_texture, textures, name + " roughness_texture");
+    for (const Factor& f : c.factors) {
+      require(std::isfinite(f.value), name + " has a non-finite factor");
+      if (f.kind == Factor::Kind::texture) {
+        require(f.texture.valid(), name + " has a texture factor without a texture");
+        validate_texture_ref(f.texture, textures, name + " factor");
+      }
+    }
+  }
+}
+
 void validate_light(const Light& l, const std::string& what) {
   switch (l.type) {
     case Light::Type::spot:
@@ -118,15 +146,27 @@ void validate_scene(const Scene& s) {
     require(std::isfinite(s.uvs[i][0]) && std::isfinite(s.uvs[i][1]), "uv ", i / 3, ",", i % 3, " is not finite");
   for (std::size_t i = 0; i < s.materials.size(); ++i) validate_material(s.materials[i], concat("material ", i));
   for (std::size_t i = 0; i < s.lights.size(); ++i) validate_light(s.lights[i], concat("light ", i));
+  for (std::size_t i = 0; i < s.materials.size(); ++i)
+    validate_closures(s.materials[i], s.textures.size(), concat("material ", i));
+  for (std::size_t i = 0; i < s.textures.size(); ++i) {
+    require(!s.textures[i].empty() && s.textures[i].channels() == 4, "texture ", i, " must be (H, W, 4)");
+    require_finite(s.textures[i].view(), concat("texture ", i));
+  }
   require_finite3(s.world_radiance, "world radiance");
+  require(s.world_map < 0 || std::size_t(s.world_map) < s.textures.size(), "world map ", s.world_map,
+          " is not a texture");
+  for (float f : s.world_rotation) require(std::isfinite(f), "world rotation is not finite");
+  require(s.triangle_visibility.empty() || s.triangle_visibility.size() == s.triangles.size(),
+          "triangle_visibility has ", s.triangle_visibility.size(), " entries for ", s.triangles.size(), " triangles");
   validate_camera(s.camera);
 }
 
-Float3 base_color_at(const Material& m, float u, float v) {
-  const Image& tex = m.base_color_texture;
-  if (tex.empty()) return m.base_color;
-  const int w = tex.width(), h = tex.height();
-  // Texel centres at half-integers; v runs bottom-up while rows run top-down.
+namespace {
+
+// Bilinear, repeating lookup of any channel count; v runs bottom-up while rows run top-down.
+template <int N>
+std::array<float, N> bilinear(const Image& tex, float u, float v) {
+  const int w = tex.width(), h = tex.height(), c = tex.channels();
   // Wrapping first keeps the texel indices small whatever the UVs.
   u -= std::floor(u);
   v -= std::floor(v);
@@ -136,12 +176,41 @@ Float3 base_color_at(const Material& m, float u, float v) {
   auto wrap = [](int i, int n) { return ((i % n) + n) % n; };
   const int x0 = wrap(int(x0f), w), x1 = wrap(int(x0f) + 1, w);
   const int y0 = wrap(int(y0f), h), y1 = wrap(int(y0f) + 1, h);
-  auto texel = [&](int x, int y) {
-    const float* p = tex.pixel(x, y);
-    return Float3{p[0], p[1], p[2]};
-  };
-  return (texel(x0, y0) * (1 - ax) + texel(x1, y0) * ax) * (1 - ay) +
-         (texel(x0, y1) * (1 - ax) + texel(x1, y1) * ax) * ay;
+  std::array<float, N> out{};
+  const float* p00 = tex.pixel(x0, y0);
+  const float* p10 = tex.pixel(x1, y0);
+  const float* p01 = tex.pixel(x0, y1);
+  const float* p11 = tex.pixel(x1, y1);
+  for (int k = 0; k < N && k < c; ++k)
+    out[k] = (p00[k] * (1 - ax) + p10[k] * ax) * (1 - ay) + (p01[k] * (1 - ax) + p11[k] * ax) * ay;
+  return out;
+}
+
+std::array<float, 2> mapped_uv(const TextureRef& r, float u, float v) {
+  return {r.uv[0] * u + r.uv[1] * v + r.uv[2], r.uv[3] * u + r.uv[4] * v + r.uv[5]};
+}
+
+}  // namespace
+
+std::array<float, 4> sample_texture(const Image& image, float u, float v) { return bilinear<4>(image, u, v); }
+
+Float3 texture_rgb(const Scene& scene, const TextureRef& ref, float u, float v) {
+  const auto uv = mapped_uv(ref, u, v);
+  const auto t = bilinear<4>(scene.textures[ref.image], uv[0], uv[1]);
+  return {t[0], t[1], t[2]};
+}
+
+float texture_scalar(const Scene& scene, const TextureRef& ref, float u, float v) {
+  const auto uv = mapped_uv(ref, u, v);
+  const auto t = bilinear<4>(scene.textures[ref.image], uv[0], uv[1]);
+  return ref.channel < 4 ? t[ref.channel] : luminance({t[0], t[1], t[2]});
+}
+
+Float3 base_color_at(const Material& m, float u, float v) {
+  const Image& tex = m.base_color_texture;
+  if (tex.empty()) return m.base_color;
+  const auto t = bilinear<3>(tex, u, v);
+  return {t[0], t[1], t[2]};
 }
 
 }  // namespace tempera

@@ -104,3 +104,45 @@ def test_progress_can_cancel():
     done = []
     tempera.trace_lpe(plane_scene(), ["LDE"], samples=1, progress=done.append)
     assert done[-1] == 1.0
+
+
+def test_closures_mix_as_cycles_mix_shader():
+    """A material of closures (the exporter's format): a Mix Shader at 0.25
+    of two Diffuse BSDFs is their weighted albedo; no glossy lobe at all."""
+    scene = plane_scene()
+    scene["materials"] = [{"closures": [
+        {"type": "diffuse", "color": [0.8, 0.8, 0.8], "factors": [{"kind": "constant", "value": 0.25,
+                                                                    "invert": True}]},
+        {"type": "diffuse", "color": [0.2, 0.2, 0.2], "factors": [{"kind": "constant", "value": 0.25}]},
+    ]}]
+    (lde, lse), _ = tempera.trace_lpe(scene, ["LDE", "LSE"], samples=16)
+    expected = (0.75 * 0.8 + 0.25 * 0.2) / math.pi * 2.0
+    np.testing.assert_allclose(lde.mean(), expected, rtol=1e-3)
+    assert lse.max() == 0
+
+
+def test_closure_keys_are_checked():
+    scene = plane_scene()
+    scene["materials"] = [{"closures": [{"type": "diffuse", "colour": [1, 0, 0]}]}]
+    with pytest.raises(ValueError, match="scene material 0 closure 0: unknown keys 'colour'"):
+        tempera.trace_lpe(scene, ["LDE"], samples=1)
+    scene["materials"] = [{"closures": [{"type": "velvet"}]}]
+    with pytest.raises(ValueError, match="type must be one of"):
+        tempera.trace_lpe(scene, ["LDE"], samples=1)
+
+
+def test_typed_scene_is_the_dict_scene():
+    """scene_from_dict gives the bound classes, field by field; tracing either is the same."""
+    from tempera import _native
+    from tempera.lpe import scene_from_dict
+
+    typed = scene_from_dict(plane_scene())
+    assert isinstance(typed, _native.Scene) and typed.camera.width == 16
+    assert typed.lights[0].type == _native.Light.Type.sun and typed.lights[0].irradiance == (2.0, 2.0, 2.0)
+    np.testing.assert_array_equal(typed.triangles, [[0, 1, 2], [0, 2, 3]])
+    a, _ = tempera.trace_lpe(typed, ["LDE"], samples=4)
+    b, _ = tempera.trace_lpe(plane_scene(), ["LDE"], samples=4)
+    np.testing.assert_array_equal(a[0], b[0])
+    light = _native.Light()
+    with pytest.raises(ValueError, match="must have 3 values"):
+        light.position = (1.0, 2.0)

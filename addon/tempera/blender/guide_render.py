@@ -28,7 +28,7 @@ from . import compat
 from ..frames import MAX_FRAME, check_frame
 from ..lpe import check_lpe, trace_lpe
 from ..stylize import tonemap
-from .scene_export import SceneExportError, evaluated_depsgraph, export_scene
+from .scene_export import SceneExportError, evaluated_depsgraph, export_scene, path_settings
 
 
 class GuideRenderError(RuntimeError):
@@ -191,16 +191,18 @@ def check_params(params):
         raise ValueError(f"orientation_aov must be a string, got {params['orientation_aov']!r}")
 
 
-def trace_lpe_guides(scene, layer, frame, size, params):
+def trace_lpe_guides(scene, layer, frame, size, params, paths=None):
     """({guide name: (H, W, 3) radiance}, warnings) of the frame's light path
     expressions, traced on the scene as the view layer evaluates it at
-    `frame`, with the Cycles scene's bounce limit."""
+    `frame`, with the light path settings `paths` (scene_export.path_settings
+    of the user's scene, taken before render_guides changes any; by default
+    the scene's current ones): bounce limits and caustics options."""
     try:
         scene_dict, warnings = export_scene(scene, evaluated_depsgraph(scene, layer, frame), size)
     except SceneExportError as exc:
         raise GuideRenderError(str(exc)) from None
     images, _alpha = trace_lpe(scene_dict, params["lpe"], samples=params["lpe_samples"], seed=params["seed"],
-                               max_bounces=scene.cycles.max_bounces)
+                               **(paths or path_settings(scene)))
     return {guide_cache.lpe_guide(e): image for e, image in zip(params["lpe"], images)}, warnings
 
 
@@ -317,7 +319,8 @@ def scene_fingerprint(scene, frame):
         "camera": scene.camera.name, "resolution": effective_resolution(scene),
         "view_layer": guide_view_layer(scene).name, "world": _world_fingerprint(scene.world),
         "bounces": [scene.cycles.max_bounces, scene.cycles.diffuse_bounces, scene.cycles.glossy_bounces,
-                    scene.cycles.transmission_bounces],
+                    scene.cycles.transmission_bounces, scene.cycles.transparent_max_bounces,
+                    scene.cycles.caustics_reflective, scene.cycles.caustics_refractive, scene.cycles.blur_glossy],
         "pixel_aspect": [render.pixel_aspect_x, render.pixel_aspect_y],
         "film": [scene.cycles.film_exposure, scene.cycles.pixel_filter_type, scene.cycles.filter_width],
         "camera_data": _camera_fingerprint(scene.camera.data),
@@ -481,6 +484,7 @@ def render_guides(scene, frames, out_dir, params=None, progress=None):
     manifest = guide_cache.read_manifest(out_dir, warn) or {}
     if manifest.get("params") != params:
         manifest = {}  # other parameters: no cached frame can be current
+    paths = path_settings(scene)  # the user's, before the Cycles guides change them
     with shown_in_window(scene), guide_render_settings(scene):
         keys = {f: guide_cache.frame_key(params, scene_fingerprint(scene, f)) for f in frames}
         todo = [f for f in frames if not guide_cache.is_frame_current(out_dir, manifest, f, keys[f])]
@@ -491,7 +495,7 @@ def render_guides(scene, frames, out_dir, params=None, progress=None):
             out_dir.mkdir(parents=True, exist_ok=True)
             with _work_folder(out_dir) as tmp:
                 report["warnings"] += _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress,
-                                                     warn)
+                                                     warn, paths)
         report["rendered"] = todo
     return report
 
@@ -557,7 +561,7 @@ def uses_freestyle(scene, layer):
     return scene.render.use_freestyle and layer.use_freestyle and drawing
 
 
-def _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress, warn=None):
+def _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress, warn=None, paths=None):
     layer = guide_view_layer(scene)
     masks = assign_pass_indices(scene, params["masks"])
     main_passes = {**MAIN_PASSES, "Freestyle": "RGBA"} if uses_freestyle(scene, layer) else dict(MAIN_PASSES)
@@ -613,7 +617,7 @@ def _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress, 
         height, width = main["Combined"].shape[:2]
         if params["lpe"]:
             step(i, f"tracing the light path expressions of frame {frame}")
-            traced, frame_warnings = trace_lpe_guides(scene, layer, frame, (width, height), params)
+            traced, frame_warnings = trace_lpe_guides(scene, layer, frame, (width, height), params, paths)
             frame_data.update(traced)
             warnings.extend(w for w in frame_warnings if w not in warnings)
         guide_cache.write_frame(out_dir, frame, frame_data)

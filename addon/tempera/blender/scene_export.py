@@ -5,7 +5,8 @@
 
 Geometry comes from the depsgraph (modifiers applied, instances expanded,
 world transforms) as triangles with per-corner split normals and UVs;
-materials are reduced to the tracer's Principled-like model; lights, world
+materials become Cycles' closures by a small interpreter of the shader nodes
+(tempera.blender.shader_nodes); lights, world
 and camera are converted to physical units with tempera.scene_units so that
 the tracer's buffers match Cycles pixel for pixel. Whatever the tracer cannot
 represent is approximated and named in `warnings` (docs/lpe_guides.md lists
@@ -16,14 +17,13 @@ import numpy as np
 
 from .. import scene_units
 from . import compat
+from .shader_nodes import DEFAULT_GREY, ImageCache, ShaderInterpreter
 
 GEOMETRY_TYPES = {"MESH", "CURVE", "SURFACE", "META", "FONT"}
-FALLBACK_GREY = (0.8, 0.8, 0.8)
-# Principled BSDF (Blender 3.4) inputs the tracer models, and its parameter names.
-PRINCIPLED_INPUTS = {"Metallic": "metallic", "Specular": "specular", "Roughness": "roughness",
-                     "Transmission": "transmission", "IOR": "ior"}
-# Principled inputs the tracer ignores, and the value at which ignoring them changes nothing.
-PRINCIPLED_IGNORED = {"Subsurface": 0.0, "Sheen": 0.0, "Clearcoat": 0.0, "Anisotropic": 0.0, "Alpha": 1.0}
+FALLBACK_GREY = DEFAULT_GREY  # Cycles' default surface: a diffuse BSDF of 0.8 grey
+# Ray visibility bits of the tracer (scene.hpp), from Blender's object properties.
+VISIBILITY_BITS = (("visible_camera", 1), ("visible_diffuse", 2), ("visible_glossy", 4),
+                   ("visible_transmission", 8), ("visible_shadow", 16))
 
 
 class SceneExportError(ValueError):
@@ -52,8 +52,10 @@ def export_scene(scene, depsgraph, size):
     seen by the scene's camera at `size` = (width, height) pixels."""
     warnings = []
     rendered = _rendered_objects(depsgraph.view_layer, warnings)
-    materials = _Materials(warnings)
-    geometry = {"vertices": [], "triangles": [], "triangle_materials": [], "normals": [], "uvs": []}
+    images = ImageCache()
+    materials = _Materials(warnings, images)
+    geometry = {"vertices": [], "triangles": [], "triangle_materials": [], "normals": [], "uvs": [],
+                "visibility": []}
     lights = []
     meshes = {}  # evaluated object and data -> its triangles in object space: instances share them
     offset = 0
@@ -66,7 +68,9 @@ def export_scene(scene, depsgraph, size):
             continue
         matrix = np.array(instance.matrix_world, np.float64)
         if obj.type == "LIGHT":
-            lights.append(_light(obj, matrix, warnings))
+            light = _light(obj, matrix, warnings)
+            light.update(_light_visibility(owner))
+            lights.append(light)
             continue
         if obj.type not in GEOMETRY_TYPES:
             continue
@@ -86,19 +90,76 @@ def export_scene(scene, depsgraph, size):
         geometry["triangle_materials"].append(mats)
         geometry["normals"].append(n.reshape(-1, 3, 3))
         geometry["uvs"].append(uvs)
+        geometry["visibility"].append(np.full(len(tris), _visibility(owner), np.int32))
         offset += len(verts)
+    textures = []
+    world = _world(scene.world, warnings, images, textures)
+    world_visibility = _world_visibility(scene.world)
+    if world_visibility != 31:
+        world["visibility"] = world_visibility
+    material_list = [_index_textures(m, textures) for m in (materials.list or [default_surface()])]
+    visibility = _stack(geometry["visibility"], (0,), np.int32)
     out = {
         "vertices": _stack(geometry["vertices"], (0, 3), np.float32),
         "triangles": _stack(geometry["triangles"], (0, 3), np.int32),
         "triangle_materials": _stack(geometry["triangle_materials"], (0,), np.int32),
         "normals": _stack(geometry["normals"], (0, 3, 3), np.float32),
         "uvs": _stack(geometry["uvs"], (0, 3, 2), np.float32),
-        "materials": materials.list or [_default_material()],
+        "materials": material_list,
         "lights": lights,
-        "world": {"radiance": _world_radiance(scene.world, warnings)},
+        "world": world,
+        "textures": textures,
         "camera": export_camera(scene, depsgraph, size),
     }
+    if (visibility != 31).any():
+        out["triangle_visibility"] = visibility
     return out, warnings
+
+
+def _visibility(obj):
+    """Ray visibility bits of an object (Object Properties > Visibility > Ray Visibility)."""
+    bits = 0
+    for prop, bit in VISIBILITY_BITS:
+        if getattr(obj, prop, True):
+            bits |= bit
+    return bits
+
+
+def _world_visibility(world):
+    """Ray visibility bits of the world (World > Settings > Ray Visibility)."""
+    settings = getattr(world, "cycles_visibility", None) if world is not None else None
+    if settings is None:
+        return 31
+    bits = 16
+    for prop, bit in (("camera", 1), ("diffuse", 2), ("glossy", 4), ("transmission", 8)):
+        if getattr(settings, prop, True):
+            bits |= bit
+    return bits
+
+
+def _light_visibility(obj):
+    """A light object's ray visibility (which bounces it lights) and shadow casting."""
+    out = {"visibility": _visibility(obj) | 16}
+    light = obj.data
+    cycles = getattr(light, "cycles", None)
+    cast = getattr(cycles, "cast_shadow", None) if cycles is not None else None
+    if cast is None:
+        cast = getattr(light, "use_shadow", True)
+    out["cast_shadow"] = bool(cast)
+    return out
+
+
+def path_settings(scene):
+    """The scene's Cycles settings that shape the tracer's paths and pixels
+    (Light Paths, Film > Pixel Filter) as trace_lpe keywords."""
+    c = scene.cycles
+    return {"max_bounces": int(c.max_bounces), "diffuse_bounces": int(c.diffuse_bounces),
+            "glossy_bounces": int(c.glossy_bounces), "transmission_bounces": int(c.transmission_bounces),
+            "transparent_bounces": int(c.transparent_max_bounces),
+            "caustics_reflective": bool(c.caustics_reflective), "caustics_refractive": bool(c.caustics_refractive),
+            "filter_glossy": float(c.blur_glossy),
+            "pixel_filter": {"BOX": "box", "GAUSSIAN": "gaussian"}.get(c.pixel_filter_type, "blackman_harris"),
+            "filter_width": float(c.filter_width)}
 
 
 def _rendered_objects(view_layer, warnings):
@@ -202,143 +263,86 @@ def _get(collection, attribute, shape, dtype):
 
 # --------------------------------------------------------------------------- materials
 
-def _default_material():
-    return {"base_color": np.array(FALLBACK_GREY, np.float32), "metallic": 0.0, "specular": 0.0,
-            "roughness": 0.5, "transmission": 0.0, "ior": 1.45, "emission": np.zeros(3, np.float32)}
+def default_surface():
+    """Cycles' default surface (empty or missing material slots): diffuse 0.8 grey."""
+    return {"base_color": np.array(FALLBACK_GREY, np.float32),
+            "closures": [{"type": "diffuse", "color": np.array(FALLBACK_GREY, np.float32)}]}
 
 
 class _Materials:
     """Blender materials -> the tracer's material list, each converted once."""
 
-    def __init__(self, warnings):
+    def __init__(self, warnings, images=None):
         self.list, self._index, self._warnings = [], {}, warnings
+        self._images = images if images is not None else ImageCache()
 
     def index(self, material):
         key = material.name if material is not None else None
         if key not in self._index:
             self._index[key] = len(self.list)
-            self.list.append(convert_material(material, self._warnings))
+            self.list.append(convert_material(material, self._warnings, self._images))
         return self._index[key]
 
 
-def convert_material(material, warnings):
-    """The tracer's material for a Blender material (None: Cycles' default grey).
+def convert_material(material, warnings, images=None):
+    """The tracer's material (a list of Cycles closures) for a Blender material.
 
-    Materials without nodes render in Cycles as a diffuse BSDF of their
-    viewport colour, which the tracer represents exactly. With nodes, the
-    shader feeding the Material Output's Surface must be a Principled BSDF
-    (or a plain Diffuse BSDF or Emission); anything else is approximated by
-    a diffuse surface of the material's viewport colour, with a warning.
+    None (an empty slot, or an object without material) is Cycles' default
+    surface, diffuse 0.8 grey. A material without nodes renders in Cycles as
+    a diffuse BSDF of its viewport colour. With nodes, the tree feeding the
+    Cycles Material Output's Surface is interpreted (shader_nodes); nothing
+    plugged in renders black, as in Cycles.
     """
-    out = _default_material()
     if material is None:
-        return out
-    out["base_color"] = np.array(material.diffuse_color[:3], np.float32)
+        return default_surface()
+    color = np.array(material.diffuse_color[:3], np.float32)
     if not material.use_nodes or material.node_tree is None:
-        return out
+        return {"base_color": color, "closures": [{"type": "diffuse", "color": color}]}
     owner = f"Material '{material.name}'"
     output = material.node_tree.get_output_node("CYCLES")
-    shader = _linked_node(output.inputs["Surface"]) if output is not None else None
-    kind = shader.bl_idname if shader is not None else None
-    if kind == "ShaderNodeBsdfPrincipled":
-        _principled(shader, owner, out, warnings)
-    elif kind == "ShaderNodeBsdfDiffuse":
-        _base_color(shader.inputs["Color"], owner, warnings, out)
-    elif kind == "ShaderNodeEmission":
-        out["base_color"] = np.zeros(3, np.float32)
-        out["emission"] = _unlinked(shader.inputs["Color"], owner, warnings)[:3] * \
-            _unlinked(shader.inputs["Strength"], owner, warnings)
+    if output is None:
+        warnings.append(f"{owner}: no active Material Output; it renders black.")
+        closures = []
     else:
-        what = f"a {shader.name} node" if shader is not None else "nothing"
-        warnings.append(f"{owner}: its surface is {what}, not a Principled BSDF; the light-path "
-                        "tracer approximates it by a diffuse surface of the material's Viewport Display colour.")
-    if output is not None:
+        interpreter = ShaderInterpreter(owner, warnings, images if images is not None else ImageCache())
+        closures = interpreter.closures(output.inputs["Surface"])
         if output.inputs["Volume"].is_linked or output.inputs["Displacement"].is_linked:
             warnings.append(f"{owner}: volume and displacement are ignored by the light-path tracer.")
-    out["base_color"] = np.asarray(out["base_color"], np.float32)
-    out["emission"] = np.asarray(out["emission"], np.float32)
-    return out
+    if not closures:  # a surface that neither scatters nor emits: black
+        closures = [{"type": "diffuse", "color": np.zeros(3, np.float32)}]
+    return {"base_color": color, "closures": closures}
 
 
-def _principled(node, owner, out, warnings):
-    inputs = node.inputs
-    _base_color(inputs["Base Color"], owner, warnings, out)
-    for socket, key in PRINCIPLED_INPUTS.items():
-        out[key] = float(_unlinked(compat.principled_socket(node, socket), owner, warnings))
-    emission = _unlinked(compat.principled_socket(node, "Emission"), owner, warnings)[:3] * float(
-        _unlinked(inputs["Emission Strength"], owner, warnings))
-    out["emission"] = np.asarray(emission, np.float32)
-    ignored = [s for s, neutral in PRINCIPLED_IGNORED.items()
-               if _ignored_socket_used(node, s, neutral)]
-    if ignored:
-        warnings.append(f"{owner}: Principled {', '.join(ignored)} not modelled by the light-path "
-                        "tracer (ignored).")
-    if inputs["Normal"].is_linked:
-        warnings.append(f"{owner}: the normal map is ignored by the light-path tracer.")
+def _index_textures(material, textures):
+    """Replaces the texel arrays of a material's closures by indices into `textures`."""
+    def ref(t):
+        for i, existing in enumerate(textures):
+            if existing is t["texels"]:
+                break
+        else:
+            textures.append(t["texels"])
+            i = len(textures) - 1
+        out = {"image": i, "uv": np.array(t["uv"], np.float32)}
+        if "channel" in t:
+            out["channel"] = int(t["channel"])
+        return out
 
-
-def _ignored_socket_used(node, name, neutral):
-    try:
-        socket = compat.principled_socket(node, name)
-    except KeyError:  # a socket this Blender's Principled BSDF does not have
-        return False
-    return socket.is_linked or abs(float(socket.default_value) - neutral) > 1e-6
-
-
-def _linked_node(socket):
-    """The node plugged into `socket`, through reroutes (None if unlinked or muted)."""
-    while socket.is_linked:
-        node = socket.links[0].from_node
-        if node.mute:
-            return None
-        if node.bl_idname != "NodeReroute":
-            return node
-        socket = node.inputs[0]
-    return None
-
-
-def _unlinked(socket, owner, warnings):
-    """The socket's own value; a link into it is not followed (warned).
-    `owner` names the material or world in the warning."""
-    if socket.is_linked:
-        warnings.append(f"{owner}: '{socket.name}' is driven by nodes the light-path "
-                        "tracer does not evaluate; its unlinked value is used.")
-    value = socket.default_value
-    return np.array(value[:], np.float64) if hasattr(value, "__len__") else float(value)
-
-
-def _base_color(socket, owner, warnings, out):
-    """Sets the base colour from a colour input: its value, or the pixels of
-    an Image Texture node plugged into it (as base_color_texture)."""
-    node = _linked_node(socket)
-    if node is not None and node.bl_idname == "ShaderNodeTexImage" and node.image is not None:
-        texture = _image_texture(node.image, owner, warnings)
-        if texture is not None:
-            out["base_color_texture"] = texture
-            return
-    out["base_color"] = np.array(_unlinked(socket, owner, warnings)[:3], np.float32)
-
-
-def _image_texture(image, owner, warnings):
-    """Linear float32 (H, W, 3) pixels, row 0 at the top (the tracer's convention;
-    Blender stores rows bottom-up), or None if the image has none. Byte images in the sRGB colour space are
-    decoded to linear; float images already hold linear values."""
-    width, height = image.size
-    if width == 0 or height == 0:
-        warnings.append(f"{owner}: image '{image.name}' has no pixels (missing file?); the socket's "
-                        "own colour is used.")
-        return None
-    flat = np.empty(width * height * image.channels, np.float32)
-    image.pixels.foreach_get(flat)
-    pixels = flat.reshape(height, width, image.channels)[::-1]
-    rgb = pixels[:, :, :3] if image.channels >= 3 else np.repeat(pixels[:, :, :1], 3, axis=2)
-    space = image.colorspace_settings.name
-    if not image.is_float and space == "sRGB":
-        rgb = scene_units.srgb_to_linear(rgb)
-    elif space not in ("sRGB", "Linear", "Non-Color", "Raw"):
-        warnings.append(f"{owner}: image '{image.name}' is in colour space '{space}', "
-                        "which the light-path tracer reads as is.")
-    return np.ascontiguousarray(rgb, np.float32)
+    closures = []
+    for c in material.get("closures", []):
+        c = dict(c)
+        for key in ("color_texture", "roughness_texture"):
+            if key in c:
+                c[key] = ref(c[key])
+        factors = []
+        for f in c.get("factors", []):
+            f = dict(f)
+            if "texture" in f:
+                f["texture"] = ref(f["texture"])
+            factors.append(f)
+        if "factors" in c:
+            c["factors"] = factors
+        closures.append(c)
+    return dict(material, closures=closures)
 
 
 # --------------------------------------------------------------------------- lights and world
@@ -348,12 +352,13 @@ def _light(obj, matrix, warnings):
     light = obj.data
     position = matrix[:3, 3]
     z_axis = matrix[:3, 2] / np.linalg.norm(matrix[:3, 2])  # Blender lights shine down their local -Z
-    if light.use_nodes:
-        warnings.append(f"Light '{obj.name}': light node trees are ignored by the light-path tracer "
-                        "(colour x power is used).")
+    tint = _light_node_tint(obj, warnings)
     if light.type in ("POINT", "SPOT"):
+        # Cycles 4.0 made soft point and spot lights spheres; before, disks facing the shaded point.
+        import bpy  # noqa: PLC0415  (the version decides the shape)
         out = {"type": "point", "position": position, "radius": float(light.shadow_soft_size),
-               "intensity": scene_units.point_intensity(light.energy, light.color)}
+               "intensity": scene_units.point_intensity(light.energy, light.color),
+               "soft_shape": "sphere" if bpy.app.version >= (4, 0, 0) else "disk"}
         if light.type == "SPOT":
             out.update(type="spot", direction=-z_axis, spot_half_angle=float(light.spot_size) / 2,
                        spot_blend=float(light.spot_blend))
@@ -374,27 +379,117 @@ def _light(obj, matrix, warnings):
                             "(it emits over the full hemisphere).")
     else:
         raise SceneExportError(f"Light '{obj.name}' has an unknown type {light.type!r}")
+    for key in ("intensity", "irradiance", "radiance"):
+        if key in out:
+            out[key] = np.asarray(out[key], np.float64) * tint
     return {k: (np.asarray(v, np.float32) if isinstance(v, np.ndarray) else v) for k, v in out.items()}
 
 
-def _world_radiance(world, warnings):
-    """Constant radiance of the world: a Background node's colour x strength
-    (or the world colour without nodes, as Cycles renders it); black without a world."""
+def _light_node_tint(obj, warnings):
+    """The factor a light's node tree puts on its colour x power: Cycles
+    multiplies them by the Emission node plugged into the Light Output
+    (colour x strength; 1 without nodes). Only constant trees are modelled."""
+    light = obj.data
+    if not light.use_nodes or light.node_tree is None:
+        return np.ones(3)
+    owner = f"Light '{obj.name}'"
+    output = light.node_tree.get_output_node("CYCLES")
+    if output is None:
+        return np.ones(3)
+    interpreter = ShaderInterpreter(owner, warnings, ImageCache())
+    closures = interpreter.closures(output.inputs["Surface"])
+    if not closures:
+        return np.zeros(3) if output.inputs["Surface"].is_linked else np.ones(3)
+    tint = np.zeros(3)
+    for c in closures:
+        if c["type"] != "emission" or c.get("factors") or "color" not in c:
+            warnings.append(f"{owner}: its node tree varies (textures, mixes) and is not modelled; its constant "
+                            "part is used.")
+            continue
+        tint += np.asarray(c["color"], np.float64) * np.asarray(c["weight"], np.float64)
+    return tint
+
+
+def _world(world, warnings, images, textures):
+    """The world of the scene dict: a constant radiance (Background colour x
+    strength, or the world colour without nodes), or an equirectangular
+    Environment Texture (index into `textures`) times the strength, turned by
+    the Mapping node in front of it. No world is black."""
+    black = {"radiance": np.zeros(3, np.float32)}
     if world is None:
-        return np.zeros(3, np.float32)
+        return black
     if not world.use_nodes or world.node_tree is None:
-        return np.array(world.color[:3], np.float32)
+        return {"radiance": np.array(world.color[:3], np.float32)}
+    owner = f"World '{world.name}'"
     output = world.node_tree.get_output_node("CYCLES")
-    node = _linked_node(output.inputs["Surface"]) if output is not None else None
+    if output is None:
+        return black
+    interpreter = ShaderInterpreter(owner, warnings, images)
+    src = interpreter.source(output.inputs["Surface"], ())
+    node = src[0].node if src is not None and src[0] != "default" else None
     if node is None:
-        return np.zeros(3, np.float32)
+        return black
     if node.bl_idname != "ShaderNodeBackground":
-        warnings.append(f"World '{world.name}': its surface is a {node.name} node, not a Background; the "
-                        "light-path tracer uses a black world.")
-        return np.zeros(3, np.float32)
-    color = node.inputs["Color"]
-    if color.is_linked:
-        warnings.append(f"World '{world.name}': the background colour is driven by nodes (e.g. an HDRI or "
-                        "sky); the light-path tracer uses the node's constant colour instead.")
-    strength = _unlinked(node.inputs["Strength"], f"World '{world.name}'", warnings)
-    return np.array(color.default_value[:3], np.float32) * np.float32(strength)
+        # Mixes of backgrounds (e.g. a Light Path trick): their constant emission.
+        closures = interpreter.closures(output.inputs["Surface"])
+        warnings.append(f"{owner}: its surface is a {node.name} node, not a Background; the light-path tracer "
+                        "uses the constant colours of the backgrounds it mixes.")
+        radiance = np.zeros(3)
+        for c in closures:
+            if c["type"] == "emission" and not c.get("factors") and "color" in c:
+                radiance += np.asarray(c["color"]) * np.asarray(c["weight"])
+        return {"radiance": radiance.astype(np.float32)}
+    ctx = src[1]
+    strength = interpreter.constant_scalar(node.inputs["Strength"], ctx, "the background Strength")
+    color_src = interpreter.source(node.inputs["Color"], ctx)
+    texture = color_src[0].node if color_src is not None and color_src[0] != "default" else None
+    if texture is not None and texture.bl_idname == "ShaderNodeTexEnvironment":
+        return _environment(texture, color_src[1], strength, interpreter, images, textures, owner, warnings)
+    color = interpreter.color(node.inputs["Color"], ctx)
+    if color.texels is not None:
+        warnings.append(f"{owner}: the background colour comes from an image not used as an Environment "
+                        "Texture; its mean colour is used.")
+        rgb = color.texels[:, :, :3].reshape(-1, 3).mean(axis=0)
+    else:
+        rgb = np.asarray(color.const, np.float64)[:3]
+    return {"radiance": (rgb * strength).astype(np.float32)}
+
+
+def _environment(node, ctx, strength, interpreter, images, textures, owner, warnings):
+    """An Environment Texture node as the world map."""
+    if node.image is None:
+        warnings.append(f"{owner}: Environment Texture '{node.name}' has no image; black is used.")
+        return {"radiance": np.zeros(3, np.float32)}
+    if node.projection != "EQUIRECTANGULAR":
+        warnings.append(f"{owner}: Environment Texture '{node.name}' projection {node.projection} is read as "
+                        "equirectangular.")
+    texels = images.pixels(node.image, owner, warnings)
+    if texels is None:
+        return {"radiance": np.zeros(3, np.float32)}
+    rotation = np.eye(3)
+    vec = interpreter.source(node.inputs["Vector"], ctx)
+    if vec is not None and vec[0] != "default":
+        mapping = vec[0].node
+        if mapping.bl_idname == "ShaderNodeMapping":
+            rot = np.array(mapping.inputs["Rotation"].default_value[:3], np.float64)
+            scale = np.array(mapping.inputs["Scale"].default_value[:3], np.float64)
+            if np.abs(scale - 1).max() > 1e-6:
+                warnings.append(f"{owner}: Mapping '{mapping.name}' scale is ignored for the environment.")
+            rotation = euler_xyz(rot)
+            if mapping.vector_type == "TEXTURE":
+                rotation = rotation.T
+        elif not (mapping.bl_idname == "ShaderNodeTexCoord" and vec[0].name in ("Generated", "Object")):
+            warnings.append(f"{owner}: environment coordinates from '{mapping.name}' are not modelled; the view "
+                            "direction is used.")
+    textures.append(texels)
+    return {"radiance": np.full(3, strength, np.float32), "map": len(textures) - 1,
+            "rotation": rotation.astype(np.float32)}
+
+
+def euler_xyz(angles):
+    """Blender's XYZ Euler rotation matrix (X first, then Y, then Z)."""
+    x, y, z = angles
+    rx = np.array([[1, 0, 0], [0, np.cos(x), -np.sin(x)], [0, np.sin(x), np.cos(x)]])
+    ry = np.array([[np.cos(y), 0, np.sin(y)], [0, 1, 0], [-np.sin(y), 0, np.cos(y)]])
+    rz = np.array([[np.cos(z), -np.sin(z), 0], [np.sin(z), np.cos(z), 0], [0, 0, 1]])
+    return rz @ ry @ rx

@@ -20,6 +20,24 @@ struct TraceOptions {
   // Indirect bounces as Cycles counts them: 0 gives direct light only (one
   // scattering event per path), 8 allows paths of up to nine.
   int max_bounces = 8;
+  // Cycles' per-kind limits (Light Paths > Max Bounces), counted the same
+  // way; a path ends once any count exceeds its limit. Transparent surfaces
+  // are passed without a bounce, up to transparent_bounces of them.
+  int diffuse_bounces = 1024, glossy_bounces = 1024, transmission_bounces = 1024, transparent_bounces = 1024;
+  // Cycles' caustics options: false drops glossy (reflective) or refractive
+  // lobes at a vertex reached by a diffuse bounce, so those paths do not exist.
+  bool caustics_reflective = true, caustics_refractive = true;
+  // Cycles' Filter Glossy (Blender's blur_glossy; 0: off): after a bounce of
+  // pdf p (the smallest so far), glossy lobes get a microfacet alpha of at
+  // least sqrt(1 - p * (1 / filter_glossy)) / 2 where that is below 1.
+  float filter_glossy = 0;
+  // Cycles' pixel filter (Film > Pixel Filter): camera rays are spread over
+  // the filter's footprint, importance-sampled per axis as Cycles does: a box
+  // of filter_width pixels, a Gaussian over 3 and a Blackman-Harris window
+  // over 2 filter widths (Cycles' footprints). The default, a box of width 1,
+  // is the pixel itself.
+  enum class PixelFilter { box, gaussian, blackman_harris } pixel_filter = PixelFilter::box;
+  float filter_width = 1;
 };
 
 struct TraceResult {

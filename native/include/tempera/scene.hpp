@@ -33,6 +33,66 @@ inline Float3 normalize(Float3 a) { return a / length(a); }
 inline float max_component(Float3 a) { return std::fmax(a.x, std::fmax(a.y, a.z)); }
 inline float luminance(Float3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
+// A texture lookup: image `image` of Scene::textures (RGBA, row 0 at the top,
+// v = 1), read bilinearly with repeat at the UV
+//   (u', v') = (uv[0] u + uv[1] v + uv[2], uv[3] u + uv[4] v + uv[5])
+// (the exporter folds Blender's Mapping node into this). Scalars read one
+// channel: 0..3 = R, G, B, A, 4 = luminance (Blender's colour-to-float).
+struct TextureRef {
+  int image = -1;  // -1: no texture
+  std::array<float, 6> uv{1, 0, 0, 0, 1, 0};
+  int channel = 4;
+  bool valid() const { return image >= 0; }
+};
+
+// One factor of a closure's weight; a closure is weighted by the product of
+// its factors (a Mix Shader multiplies the closures of its first shader by
+// 1 - fac and those of its second by fac, each clamped to [0, 1]).
+struct Factor {
+  enum class Kind {
+    constant,       // value
+    texture,        // the texture's scalar
+    fresnel,        // Fresnel node: dielectric Fresnel of IOR `value` (inverted on back faces)
+    layer_fresnel,  // Layer Weight's Fresnel output, blend `value`
+    layer_facing,   // Layer Weight's Facing output, blend `value`
+  } kind = Kind::constant;
+  float value = 1;
+  TextureRef texture;
+  bool invert = false;  // the factor is 1 - x
+};
+
+// One BSDF, emission or transparency term of a Cycles shader, as Blender's
+// shader nodes produce them. Events: diffuse and translucent are D, glossy and
+// reflections S, refraction T; transparent is no event (the path goes on).
+struct Closure {
+  enum class Type {
+    principled,   // Principled BSDF (Cycles 3.x v1: Disney diffuse, GGX with its Fresnel, smooth glass, clearcoat)
+    diffuse,      // Lambert, or Oren-Nayar with a roughness
+    glossy,       // microfacet reflection tinted by color, no Fresnel (Glossy, Anisotropic)
+    glass,        // smooth dielectric: Fresnel reflection S + refraction T, both tinted
+    refraction,   // smooth refraction only, tinted, no Fresnel
+    translucent,  // Lambert through the surface
+    transparent,  // straight through, tinted (transparent bounces)
+    emission,     // radiance color x weight, both sides
+  } type = Type::diffuse;
+  enum class Distribution { ggx, beckmann, sharp } distribution = Distribution::ggx;
+  Float3 weight{1, 1, 1};  // constant part of the weight (e.g. emission strength)
+  std::vector<Factor> factors;
+  Float3 color{0.8f, 0.8f, 0.8f};
+  TextureRef color_texture;  // replaces color (rgb)
+  float roughness = 0;       // Blender's: alpha = roughness^2, below 0.01 singular; Diffuse: Oren-Nayar sigma
+  TextureRef roughness_texture;  // replaces roughness (its channel)
+  float ior = 1.45f;
+  // Principled only:
+  float metallic = 0, specular = 0.5f, transmission = 0;
+  float subsurface = 0;  // mixes subsurface_color into the diffuse colour (scattering itself not traced)
+  Float3 subsurface_color{0.8f, 0.8f, 0.8f};
+  float clearcoat = 0, clearcoat_roughness = 0.03f;  // a GGX lobe, F0 0.04, weight 0.25 clearcoat
+};
+
+// A surface. With `closures` empty it is the single Principled closure given
+// by the fields below (the original scene format); otherwise the closures
+// are used and only `closures` matters.
 struct Material {
   Float3 base_color{0.8f, 0.8f, 0.8f};
   float metallic = 0;
@@ -45,6 +105,7 @@ struct Material {
   // Sampled bilinearly with repeat; UV (0,0) is the bottom-left corner, so
   // image row 0 is v = 1 (as Blender shows images).
   Image base_color_texture;
+  std::vector<Closure> closures;
 };
 
 struct Light {
@@ -61,6 +122,19 @@ struct Light {
   Float3 center, axis_u, axis_v, normal;  // area: unit axes; emits along +normal only
   float size_u = 1, size_v = 1;           // area: full extents (disk: diameters)
   Float3 radiance;        // area: W/m^2/sr
+  // point, spot: how the radius is sampled: a disk facing the shaded point
+  // (Cycles up to 3.6) or a sphere (Cycles 4.0 on); radiance I / (pi r^2) either way.
+  enum class SoftShape { disk, sphere } soft_shape = SoftShape::disk;
+  // Which bounces see the light (Blender's ray visibility of the light
+  // object): bits of Visibility; cast_shadow false: not occluded.
+  unsigned visibility = 0xFFu;
+  bool cast_shadow = true;
+};
+
+// Ray visibility bits (objects and lights), as Blender's Ray Visibility panel.
+enum Visibility : unsigned {
+  kVisibleCamera = 1u, kVisibleDiffuse = 2u, kVisibleGlossy = 4u, kVisibleTransmission = 8u, kVisibleShadow = 16u,
+  kVisibleAll = 31u,
 };
 
 // Camera projection. The camera looks down its local -Z with +Y up; the
@@ -97,7 +171,19 @@ struct Scene {
   std::vector<std::array<float, 2>> uvs;         // optional: 3 per triangle (per corner)
   std::vector<Material> materials;
   std::vector<Light> lights;
-  Float3 world_radiance;  // constant, W/m^2/sr
+  Float3 world_radiance;  // constant, W/m^2/sr; multiplies world_map if there is one
+  // Optional equirectangular environment (Blender's Environment Texture):
+  // an index into textures. A world direction d is turned into the map's
+  // frame by world_rotation (row-major 3x3 M, d' = M d: the rotation of a
+  // Point-type Mapping node in front of the texture), then read at
+  // u = 0.5 - atan2(y', x') / (2 pi), v = 0.5 + asin(z') / pi.
+  int world_map = -1;
+  std::array<float, 9> world_rotation{1, 0, 0, 0, 1, 0, 0, 0, 1};
+  // Which rays see the world (bits of Visibility: Blender's World > Ray Visibility).
+  unsigned world_visibility = kVisibleAll;
+  std::vector<Image> textures;  // RGBA float images referenced by TextureRef and world_map
+  // Optional per-triangle ray visibility (bits of Visibility); empty: all visible.
+  std::vector<std::uint8_t> triangle_visibility;
   Camera camera;
 };
 
@@ -107,5 +193,10 @@ void validate_scene(const Scene& scene);
 
 // Base colour at a surface point: the texture (bilinear, repeat) if any.
 Float3 base_color_at(const Material& material, float u, float v);
+
+// Bilinear, repeating lookup of an RGBA image at (u, v), v = 1 at row 0.
+std::array<float, 4> sample_texture(const Image& image, float u, float v);
+Float3 texture_rgb(const Scene& scene, const TextureRef& ref, float u, float v);
+float texture_scalar(const Scene& scene, const TextureRef& ref, float u, float v);
 
 }  // namespace tempera

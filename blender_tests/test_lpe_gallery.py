@@ -1,0 +1,202 @@
+"""The validation gallery (scenes/lpe_gallery.py): every scene rendered by
+Cycles with its Light Path passes and traced by Tempera at matched settings
+(same bounce limits, caustics off as in the guide cache), compared buffer
+by buffer after a small blur:
+
+    FULL  = Combined             vs  L.*E
+    LDE   = DiffDir x DiffCol    vs  LDE
+    LSE   = GlossDir x GlossCol  vs  LSE
+    LDDE  = DiffInd x DiffCol    vs  L.*DDE
+
+over the pixels Cycles sees only geometry in (alpha > 0.99: silhouette
+pixels also hold the world in the tracer's L.*E, not in Cycles' transparent
+film). Figures:
+* mean error: |mean(tracer) - mean(Cycles)| / mean(Cycles) of the luminance,
+  at most MEAN_TOLERANCE = 5 %;
+* correlation: Pearson's correlation of the blurred luminance images, at
+  least CORRELATION_TOLERANCE = 0.98 (light in the right places).
+A buffer Cycles leaves (nearly) empty, below 0.2 % of FULL's mean, must be as
+empty in the tracer (its mean below 2 % of FULL's) and is not correlated.
+"""
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "scenes"))
+import lpe_gallery  # noqa: E402
+
+import bpy  # noqa: E402
+
+# The tracer follows Cycles 3.x, which renders the guides in Debian's Blender
+# 3.4, where every scene must pass. Cycles 4.0 changed its lights (spheres, no
+# spot cosine, new area sampling) and the Principled BSDF (v2), and the
+# tracer does not model those yet: in blender.org 4.2, 4.5 and 5.0 most scenes
+# disagree (docs/lpe_guides.md, issue 17 open). Not strict: some scenes agree.
+pytestmark = pytest.mark.xfail(bpy.app.version >= (4, 0, 0), strict=False,
+                               reason="the tracer models Cycles 3.x lights and Principled v1")
+
+SAMPLES = int(os.environ.get("GALLERY_SAMPLES", 128))  # Cycles and the tracer alike (override to study noise)
+MEAN_TOLERANCE = 0.05
+CORRELATION_TOLERANCE = 0.98
+BLUR = 2  # box radius in pixels: 5 x 5
+BUFFERS = {"FULL": "L.*E", "LDE": "LDE", "LSE": "LSE", "LDDE": "L.*DDE"}
+PASSES = {"Combined": "RGBA", "DiffDir": "RGB", "DiffInd": "RGB", "DiffCol": "RGB", "GlossDir": "RGB",
+          "GlossCol": "RGB"}
+LUMINANCE = np.array([0.2126, 0.7152, 0.0722], np.float32)
+# Measured and not understood, so reported but not asserted (docs/lpe_guides.md, "Limitations"):
+KNOWN_DEVIATIONS = {
+    ("glass", "LSE"): "Cycles' reflections of lights in sharp glass converge about 10 % brighter than the "
+                      "tracer's (256 to 1024 samples; a mirror sphere agrees within 0.3 %)",
+    ("world_visibility", "LSE"): "a world invisible to glossy rays still reaches glossy lobes in Cycles 3.4 "
+                                 "through light sampling (about 12 % of its visible LSE); the tracer leaves it "
+                                 "out entirely",
+}
+
+
+def box_blur(image, radius=BLUR):
+    """Mean over (2r + 1)^2 pixels, edges clamped."""
+    out = image.astype(np.float64)
+    for axis in (0, 1):
+        padded = np.pad(out, [(radius, radius) if a == axis else (0, 0) for a in range(out.ndim)], mode="edge")
+        c = np.cumsum(padded, axis=axis)
+        c = np.concatenate([np.zeros_like(np.take(c, [0], axis=axis)), c], axis=axis)
+        n = out.shape[axis]
+        out = (np.take(c, range(2 * radius + 1, n + 2 * radius + 1), axis=axis) -
+               np.take(c, range(0, n), axis=axis)) / (2 * radius + 1)
+    return out
+
+
+def masked_blur(image, mask):
+    """Box blur of `image` over the pixels of `mask` only (background pixels,
+    which the tracer's L.*E fills with the world and Cycles' transparent film
+    leaves at 0, do not bleed in)."""
+    m = mask.astype(np.float64)
+    weight = box_blur(m)
+    return np.where(weight > 0, box_blur(image * m) / np.maximum(weight, 1e-12), 0)
+
+
+def compare(traced, reference, mask, full_mean):
+    """(mean error, correlation, reference mean, traced mean) of luminance over `mask`;
+    correlation is None for a buffer Cycles leaves empty."""
+    t, r = traced @ LUMINANCE, reference @ LUMINANCE
+    t_mean, r_mean = float(t[mask].mean()), float(r[mask].mean())
+    if r_mean < 0.002 * full_mean:
+        return None, None, r_mean, t_mean
+    bt, br = masked_blur(t, mask)[mask], masked_blur(r, mask)[mask]
+    # A constant image (e.g. the tracer's all black) has no correlation: 0, which fails.
+    correlation = float(np.corrcoef(bt, br)[0, 1]) if bt.std() > 0 and br.std() > 0 else 0.0
+    return abs(t_mean - r_mean) / r_mean, correlation, r_mean, t_mean
+
+
+def cycles_buffers(scene, tmp, samples=SAMPLES):
+    """Cycles' buffers of the scene, with the guide cache's render settings."""
+    from tempera.blender import guide_render
+
+    layer = scene.view_layers[0]
+    guide_render._configure(scene, layer, samples, PASSES, 0)
+    path = guide_render._render(scene, Path(tmp) / f"{scene.name}.exr", 1)
+    p = guide_render._read_passes(path, layer.name, PASSES)
+    rgb = {k: v[:, :, :3] for k, v in p.items()}
+    return {"FULL": rgb["Combined"], "LDE": rgb["DiffDir"] * rgb["DiffCol"],
+            "LSE": rgb["GlossDir"] * rgb["GlossCol"], "LDDE": rgb["DiffInd"] * rgb["DiffCol"],
+            "alpha": p["Combined"][:, :, 3]}
+
+
+def traced_buffers(scene, samples=SAMPLES):
+    """The tracer's buffers at the scene's current settings (after
+    cycles_buffers: caustics off, as Cycles rendered)."""
+    from tempera.blender.scene_export import evaluated_depsgraph, export_scene, path_settings
+    from tempera.lpe import trace_lpe
+
+    size = (scene.render.resolution_x, scene.render.resolution_y)
+    scene_dict, warnings = export_scene(scene, evaluated_depsgraph(scene, scene.view_layers[0], 1), size)
+    images, alpha = trace_lpe(scene_dict, list(BUFFERS.values()), samples=samples, **path_settings(scene))
+    return dict(zip(BUFFERS, images), alpha=alpha), warnings
+
+
+def gallery_figures(cycles, traced):
+    mask = cycles["alpha"] > 0.99
+    full_mean = float((cycles["FULL"] @ LUMINANCE)[mask].mean())
+    return {b: compare(traced[b], cycles[b], mask, full_mean) for b in BUFFERS}, full_mean
+
+
+@pytest.mark.parametrize("key", list(lpe_gallery.SCENES))
+def test_gallery_scene_matches_cycles(key, tmp_path):
+    scene = lpe_gallery.build(key)
+    try:
+        cycles = cycles_buffers(scene, tmp_path)
+        traced, warnings = traced_buffers(scene)
+    finally:
+        lpe_gallery.remove(scene)
+    figures, full_mean = gallery_figures(cycles, traced)
+    failures = []
+    for buffer, (error, correlation, r_mean, t_mean) in figures.items():
+        if error is None:
+            print(f"{key} {buffer}: empty in Cycles ({r_mean:.4g}), tracer {t_mean:.4g}")
+            if t_mean > 0.02 * full_mean:
+                failures.append(f"{buffer}: Cycles empty, tracer mean {t_mean:.4g}")
+            continue
+        print(f"{key} {buffer}: mean error {error:.4f}, correlation {correlation:.4f} "
+              f"(Cycles {r_mean:.4g}, tracer {t_mean:.4g})")
+        if (key, buffer) in KNOWN_DEVIATIONS:
+            print(f"{key} {buffer}: known deviation, not asserted: {KNOWN_DEVIATIONS[key, buffer]}")
+            continue
+        if not (error <= MEAN_TOLERANCE and correlation >= CORRELATION_TOLERANCE):
+            failures.append(f"{buffer}: mean error {error:.4f}, correlation {correlation:.4f}")
+    print(f"{key} warnings: {warnings}")
+    assert not failures, f"{key}: " + "; ".join(failures)
+
+
+def test_gallery_figures_catch_a_wrong_material(tmp_path):
+    """The figures are not lenient: the Mix Shader sphere traced as what the
+    exporter used to make of it (a diffuse surface of a viewport white) fails them."""
+    from tempera.blender.scene_export import evaluated_depsgraph, export_scene, path_settings
+    from tempera.lpe import trace_lpe
+
+    scene = lpe_gallery.build("mix_glossy_diffuse")
+    try:
+        cycles = cycles_buffers(scene, tmp_path)
+        size = (scene.render.resolution_x, scene.render.resolution_y)
+        scene_dict, _ = export_scene(scene, evaluated_depsgraph(scene, scene.view_layers[0], 1), size)
+        mixed = [i for i, m in enumerate(scene_dict["materials"]) if len(m["closures"]) == 2]
+        assert len(mixed) == 1  # the sphere's Mix Shader: a diffuse and a glossy closure
+        scene_dict["materials"][mixed[0]] = {"base_color": np.full(3, 0.8, np.float32)}
+        images, _ = trace_lpe(scene_dict, list(BUFFERS.values()), samples=SAMPLES, **path_settings(scene))
+    finally:
+        lpe_gallery.remove(scene)
+    figures, _ = gallery_figures(cycles, dict(zip(BUFFERS, images)))
+    failing = [b for b, (e, c, _, _) in figures.items()
+               if e is not None and not (e <= MEAN_TOLERANCE and c >= CORRELATION_TOLERANCE)]
+    print(f"wrong material: failing buffers {failing}")
+    assert {"FULL", "LDE"} <= set(failing)
+
+
+def test_pixel_filter_matches_cycles_per_pixel(tmp_path):
+    """Cycles' Blackman-Harris pixel filter (its default, width 1.5, spread
+    over 3 pixels): the tracer with the scene's filter agrees pixel by pixel
+    (RMS, relative to the mean) far better than with a box of one pixel."""
+    from tempera.blender.scene_export import evaluated_depsgraph, export_scene, path_settings
+    from tempera.lpe import trace_lpe
+
+    scene = lpe_gallery.build("spot")  # sharp shadow edges and the cone's rim
+    try:
+        cycles = cycles_buffers(scene, tmp_path, samples=256)
+        size = (scene.render.resolution_x, scene.render.resolution_y)
+        scene_dict, _ = export_scene(scene, evaluated_depsgraph(scene, scene.view_layers[0], 1), size)
+        settings = path_settings(scene)
+        assert (settings["pixel_filter"], settings["filter_width"]) == ("blackman_harris", 1.5)
+        (filtered,), _ = trace_lpe(scene_dict, ["LDE"], samples=256, **settings)
+        (boxed,), _ = trace_lpe(scene_dict, ["LDE"], samples=256, **dict(settings, pixel_filter="box",
+                                                                         filter_width=1.0))
+    finally:
+        lpe_gallery.remove(scene)
+    reference = cycles["LDE"] @ LUMINANCE
+
+    def rms(image):
+        return float(np.sqrt(np.mean((image @ LUMINANCE - reference) ** 2)) / reference.mean())
+
+    print(f"pixel filter: RMS {rms(filtered):.4f} with Cycles' filter, {rms(boxed):.4f} with a box")
+    assert rms(filtered) <= 0.02 and rms(boxed) >= 2 * rms(filtered)
