@@ -28,7 +28,7 @@ KIT_SOURCES := scenes/exemplar_kit.py scenes/scene_kit.py addon/tempera/exemplar
                addon/tempera/blender/guide_render.py addon/tempera/guide_cache.py
 DEMO_OUT ?= out/demo
 
-.PHONY: all deps build kit addon-zip wheel extension test demo bench bench-tracer sanitize clean
+.PHONY: all deps build kit addon-zip wheel extension test demo bench bench-tracer sanitize fuzz clean
 
 all: build
 
@@ -77,11 +77,21 @@ bench: build
 bench-tracer: build
 	PYTHONPATH=addon $(PYTHON) bench/bench_tracer.py --size 1024 --samples 64 --json docs/bench_tracer_1024.json
 
-sanitize: deps
-	cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DTEMPERA_SANITIZE=ON \
+build-asan/CMakeCache.txt:
+	cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DTEMPERA_SANITIZE=ON -DTEMPERA_BUILD_PYTHON=OFF \
 	      -DTEMPERA_PYTHON_PACKAGE_DIR=$(CURDIR)/build-asan/python/tempera
-	cmake --build build-asan -j $(JOBS) --target tempera_tests
+
+sanitize: deps build-asan/CMakeCache.txt
+	cmake --build build-asan -j $(JOBS) --target tempera_tests tempera_fuzz
 	cd build-asan && ctest --output-on-failure
+
+# The fuzz harness under AddressSanitizer and UBSan for FUZZ_SECONDS (CI runs it after make test).
+FUZZ_SECONDS ?= 60
+fuzz: deps build-asan/CMakeCache.txt
+	cmake --build build-asan -j $(JOBS) --target tempera_fuzz
+	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
+	LSAN_OPTIONS=suppressions=$(CURDIR)/tests/fuzz/lsan.supp \
+	    build-asan/tests/fuzz/tempera_fuzz --seconds $(FUZZ_SECONDS)
 
 clean:
 	rm -rf $(BUILD) build-asan dist addon/tempera/_native*.so

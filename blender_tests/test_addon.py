@@ -10,8 +10,10 @@ import pytest
 import tempera
 from conftest import ADDON, INSTALL, disable, enable, is_enabled, registered_tempera_classes
 
-EXPECTED_CLASSES = ["TEMPERA_OT_render_guides", "TEMPERA_OT_stylize", "TEMPERA_PT_output", "TemperaPreferences",
+EXPECTED_CLASSES = ["TEMPERA_OT_choose_painting", "TEMPERA_OT_painting_template", "TEMPERA_OT_register_painting",
+                    "TEMPERA_OT_render_guides", "TEMPERA_OT_stylize", "TEMPERA_PT_output", "TemperaPreferences",
                     "TemperaSettings"]
+
 
 
 def test_addon_is_enabled_from_the_installed_zip():
@@ -164,25 +166,36 @@ class _Recorder:
     def _sub(self, *args, **kwargs):
         return _Recorder(self.calls)
 
+    def template_icon(self, icon_value=0, scale=1.0):
+        self.calls.append(("template_icon", icon_value))
+
     row = column = box = split = column_flow = _sub
 
 
-def test_output_panel_draws_version_and_settings():
+def test_output_panel_draws_settings_with_the_frames_by_the_buttons():
     calls = []
     fake = type("FakePanel", (), {"layout": _Recorder(calls)})()
     bpy.types.TEMPERA_PT_output.draw(fake, bpy.context)
     props = [name for kind, name in calls if kind == "prop"]
     labels = [text for kind, text in calls if kind == "label"]
-    assert props == ["exemplar_source", "weight_full", "weight_lde", "weight_lse", "weight_ldde", "weight_ld12e",
-                     "quality", "usage", "temporal_weight", "patch_size", "seed",
+    assert props == ["guide_frame_range", "exemplar_source", "weight_full", "weight_lde", "weight_lse",
+                     "weight_ldde", "weight_ld12e", "quality", "usage", "temporal_weight", "patch_size", "seed",
                      "output_dir", "output_format", "make_video", "load_result",
-                     "guide_dir", "guide_frame_range", "guide_samples",
+                     "guide_dir", "guide_samples",
                      "guide_occlusion_epsilon", "guide_line_d_max", "guide_masks",
                      "guide_orientation_aov", "guide_lpe"]
-    assert f"Version {tempera.__version__}" in labels
     assert {"Exemplar", "Light Path Guides", "Synthesis", "Output", "Guides"} <= set(labels)
     assert [name for kind, name in calls if kind == "operator"] == [
-        "tempera.render_guides", "tempera.stylize", "tempera.stylize"]
+        "tempera.stylize", "tempera.stylize", "tempera.render_guides", "tempera.painting_template",
+        "tempera.register_painting"]
+    # The frame range sits with the stylize buttons: right after them, before any box.
+    order = [(kind, name) for kind, name in calls if kind in ("operator", "prop")]
+    assert order[3] == ("prop", "guide_frame_range")
+    # The version is in the panel's header.
+    header = []
+    bpy.types.TEMPERA_PT_output.draw_header_preset(type("FakePanel", (), {"layout": _Recorder(header)})(),
+                                                   bpy.context)
+    assert header == [("label", f"v{tempera.__version__}")]
     # LPE Samples only matter, and only show, once there are expressions.
     settings = bpy.context.scene.tempera
     settings.guide_lpe = "LDE"

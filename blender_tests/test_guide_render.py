@@ -229,14 +229,17 @@ def test_no_camera_is_refused(rendered, tmp_path):
 
 
 def test_settings_come_back_when_rendering_fails(rendered, tmp_path):
-    """An error (here: a progress callback cancelling after the first frame's
-    renders) leaves the scene, the window and the temporary folder as they were."""
+    """An error (here: a progress callback cancelling once the first frame is
+    written) leaves the scene, the window and the temporary folders as they
+    were, and keeps the frame finished before it (issue 18)."""
     from tempera.blender.guide_render import render_guides
 
     scene = rendered["scene"]
     scene.frame_set(1)
     before = scene_dump(scene)
-    temp_dirs = set(Path(tempfile.gettempdir()).glob("tempera-guides-*"))
+    private_tmp = tmp_path / "systmp"  # this test's own system temporary folder (others share /tmp)
+    private_tmp.mkdir()
+    saved_tempdir, tempfile.tempdir = tempfile.tempdir, str(private_tmp)
 
     class Cancel(Exception):
         pass
@@ -245,13 +248,16 @@ def test_settings_come_back_when_rendering_fails(rendered, tmp_path):
         if done == 1:
             raise Cancel()
 
-    with pytest.raises(Cancel):
-        render_guides(scene, (2, 3), tmp_path / "cache", {"samples": 2, "ld12e_samples": 2}, progress=cancel)
+    try:
+        with pytest.raises(Cancel):
+            render_guides(scene, (2, 3), tmp_path / "cache", {"samples": 2, "ld12e_samples": 2}, progress=cancel)
+    finally:
+        tempfile.tempdir = saved_tempdir
     after = scene_dump(scene)
     assert [k for k in before if before[k] != after.get(k)] == []
     assert bpy.context.window.scene.name == rendered["window_scene"]
-    assert set(Path(tempfile.gettempdir()).glob("tempera-guides-*")) == temp_dirs
-    assert not list((tmp_path / "cache").glob("*.exr"))  # frames are written after all renders
+    assert list(private_tmp.iterdir()) == []
+    assert sorted(p.name for p in (tmp_path / "cache").iterdir()) == ["frame_0002.exr", "manifest.json"]
 
 
 def test_workbench_scene_gets_cycles_guides_and_keeps_its_engine(rendered, tmp_path):

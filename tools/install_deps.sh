@@ -27,6 +27,7 @@ PACKAGES=(
   libx11-6 libxi6 libxxf86vm1 libxfixes3 libxrender1 libxkbcommon0 libsm6 \
   libgl1 libegl1        # X11/GL libraries blender.org's bpy (4.2, 4.5, 5.0) loads, even headless
   nodejs                # tests of the Flamenco job type (farm/flamenco/tempera.js)
+  xvfb xdotool imagemagick  # docs/make_panel_screenshots.py: the real panel in a window on a virtual display
 )
 
 HERE="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"

@@ -48,6 +48,7 @@ def _load_native():
 _native = _load_native()
 Cancelled, image_info, read_image, write_image = (
     _native.Cancelled, _native.image_info, _native.read_image, _native.write_image)
+max_image_pixels, set_max_image_pixels = _native.max_image_pixels, _native.set_max_image_pixels
 
 # Python API on top of the native module; public entry points are listed in __all__.
 from .contact_sheet import contact_sheet
@@ -60,7 +61,9 @@ __all__ = [
     "check_lpe",
     "contact_sheet",
     "image_info",
+    "max_image_pixels",
     "read_image",
+    "set_max_image_pixels",
     "synthesize",
     "SynthesisOptions",
     "trace_lpe",

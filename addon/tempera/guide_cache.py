@@ -19,11 +19,14 @@ discontinuities. The Blender side is tempera.blender.guide_render.
 """
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
 import re
+import secrets
 import tempfile
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -137,23 +140,66 @@ def frame_key(params, fingerprint):
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-def read_manifest(cache_dir):
-    """The manifest dict, or None if the folder has none (or an unreadable one,
-    which a rerun then overwrites)."""
+def _manifest_problem(manifest):
+    """What makes a parsed manifest unusable, or None."""
+    if not isinstance(manifest, dict):
+        return f"it holds a {type(manifest).__name__}, not an object"
+    frames = manifest.get("frames", {})
+    if not isinstance(frames, dict):
+        return "its 'frames' is not an object"
+    for number, entry in frames.items():
+        if not (isinstance(number, str) and number.isdigit() and isinstance(entry, dict)
+                and isinstance(entry.get("key"), str)):
+            return f"its entry for frame {number!r} is malformed"
+    if not isinstance(manifest.get("params", {}), dict):
+        return "its 'params' is not an object"
+    return None
+
+
+def read_manifest(cache_dir, on_warning=None, set_aside=True):
+    """The manifest dict, or None if the folder has none (or one of another
+    format version, which a rerun then overwrites).
+
+    A damaged manifest (not JSON, not UTF-8, the wrong structure) is renamed
+    aside to manifest.json.corrupt-<random> and None is returned, so that the
+    frames are rendered again instead of the run being blocked; the warning
+    naming both files goes to `on_warning(text)` (default: warnings.warn).
+    set_aside=False only returns None (for readers such as a panel's status
+    line, which must not move files)."""
+    path = Path(cache_dir) / MANIFEST_NAME
     try:
-        with open(Path(cache_dir) / MANIFEST_NAME, encoding="utf-8") as f:
+        with open(path, encoding="utf-8") as f:
             manifest = json.load(f)
-    except (FileNotFoundError, json.JSONDecodeError):
+        problem = _manifest_problem(manifest)
+    except FileNotFoundError:
         return None
-    return manifest if manifest.get("format") == FORMAT_VERSION else None
+    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as exc:
+        problem = f"it is not valid JSON ({exc})"
+    if problem is None:
+        return manifest if manifest.get("format") == FORMAT_VERSION else None
+    if not set_aside:
+        return None
+    aside = path.with_name(f"{MANIFEST_NAME}.corrupt-{secrets.token_hex(4)}")
+    try:
+        os.replace(path, aside)
+        where = f"set aside as {aside.name}"
+    except OSError as exc:
+        where = f"left in place ({exc.strerror})"
+    text = f"the guide cache manifest {path} is damaged: {problem}; {where}, its frames are rendered again"
+    (on_warning or (lambda t: warnings.warn(t, stacklevel=3)))(text)
+    return None
 
 
 def write_manifest(cache_dir, manifest):
-    """Writes manifest.json atomically (temporary file, then rename)."""
+    """Writes manifest.json atomically (temporary file with a random name,
+    then rename), readable by all like the frames (mode 0666 minus umask)."""
     cache_dir = Path(cache_dir)
     cache_dir.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=".manifest.", suffix=".partial", dir=cache_dir)
     try:
+        umask = os.umask(0)
+        os.umask(umask)
+        os.fchmod(fd, 0o666 & ~umask)  # mkstemp makes 0600
         with os.fdopen(fd, "w", encoding="utf-8") as f:
             json.dump(dict(manifest, format=FORMAT_VERSION), f, indent=2, sort_keys=True)
         os.replace(tmp, cache_dir / MANIFEST_NAME)
@@ -162,12 +208,71 @@ def write_manifest(cache_dir, manifest):
         raise
 
 
-def is_frame_current(cache_dir, manifest, frame, key):
-    """True if the cache holds frame `frame` rendered with this key."""
+@contextlib.contextmanager
+def manifest_lock(cache_dir):
+    """Holds an exclusive lock on the cache folder (flock on the folder
+    itself, so no lock file is left) so that processes sharing it, e.g.
+    render-farm jobs, merge their frames into the manifest instead of
+    overwriting each other's."""
+    import fcntl
+
+    cache_dir = Path(cache_dir)
+    cache_dir.mkdir(parents=True, exist_ok=True)
+    fd = os.open(cache_dir, os.O_RDONLY | os.O_DIRECTORY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)
+
+
+def update_manifest(cache_dir, update, on_warning=None):
+    """Re-reads the manifest under the lock, calls update(manifest) (a dict,
+    {} if there is none; it changes it in place) and writes it back.
+    Returns the manifest written."""
+    with manifest_lock(cache_dir):
+        manifest = read_manifest(cache_dir, on_warning) or {}
+        update(manifest)
+        write_manifest(cache_dir, manifest)
+        return manifest
+
+
+def file_digest(path):
+    """(size in bytes, SHA-256 hex) of a file, read in 1 MiB chunks."""
+    digest = hashlib.sha256()
+    size = 0
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            digest.update(chunk)
+            size += len(chunk)
+    return size, digest.hexdigest()
+
+
+def frame_entry(cache_dir, frame, key):
+    """The manifest entry of a frame just written: its key, file, and the
+    size and checksum that is_frame_current() checks."""
+    path = frame_path(cache_dir, frame)
+    size, sha256 = file_digest(path)
+    return {"key": key, "file": path.name, "size": size, "sha256": sha256}
+
+
+def is_frame_current(cache_dir, manifest, frame, key, verify=True):
+    """True if the cache holds frame `frame` rendered with this key, intact:
+    the file has the size recorded and (with `verify`) the recorded SHA-256,
+    so a truncated or overwritten EXR is rendered again. verify=False checks
+    the size only (cheap enough for a panel's status line)."""
     if not manifest:
         return False
     entry = manifest.get("frames", {}).get(str(frame))
-    return bool(entry) and entry.get("key") == key and frame_path(cache_dir, frame).is_file()
+    if not entry or entry.get("key") != key:
+        return False
+    path = frame_path(cache_dir, frame)
+    try:
+        if path.stat().st_size != entry.get("size"):
+            return False
+        return not verify or file_digest(path)[1] == entry.get("sha256")
+    except OSError:
+        return False
 
 
 def read_frame(cache_dir, frame, guides=None):

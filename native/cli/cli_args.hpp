@@ -58,7 +58,7 @@ BlenderSetup default_blender_setup();
 
 // Renders `scene`'s guide cache in background Blender with the add-on's
 // renderer; `options` are render-guides options (--frames, --out, ...).
-// Returns Blender's exit status. FileNotFoundError for a missing scene,
+// Returns the exit status: 0, 2 (bad values), 1 (any other failure, said on stderr), 130. FileNotFoundError for a missing scene,
 // Blender or package.
 int render_guides_in_blender(const BlenderSetup& setup, const std::string& scene, const Args& options);
 

@@ -5,12 +5,14 @@
 
 #include <algorithm>
 #include <charconv>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
 
 #include "cli_args.hpp"
 #include "tempera/error.hpp"
+#include "tempera/paths.hpp"
 #include "tempera/process.hpp"
 
 namespace fs = std::filesystem;
@@ -46,6 +48,9 @@ const char* kRenderGuidesHelp =
     "  --addon-path DIR        folder holding the tempera package\n"
     "                          (default: $TEMPERA_ADDON_PATH or this build's addon folder)\n";
 
+volatile std::sig_atomic_t g_interrupted = 0;
+void on_sigint(int) { g_interrupted = 1; }
+
 std::string env_or(const char* name, const std::string& fallback) {
   const char* value = std::getenv(name);
   return value && *value ? value : fallback;
@@ -76,7 +81,25 @@ int render_guides_in_blender(const BlenderSetup& setup, const std::string& scene
   std::vector<std::string> argv = {setup.blender, "-b", "--factory-startup", scene, "--python-exit-code", "1",
                                    "--python-expr", bootstrap, "--", setup.addon};
   argv.insert(argv.end(), options.begin(), options.end());
-  return run_process(argv);
+  const int status = run_process(argv, false, &g_interrupted);
+  // The renderer (render_guides_main.py) prints its own error line and exits
+  // 2 (bad values), 3 (files) or 130 (interrupted); anything else means
+  // Blender failed before or around it (or is not Blender) and said nothing.
+  switch (status) {
+    case 0:
+    case 2:
+    case 130: return status;
+    case 3: return 1;
+    case 127:
+      std::cerr << "tempera: cannot run '" << setup.blender << "' (install Blender or pass --blender PATH)\n";
+      return 1;
+    default:
+      if (g_interrupted) return 130;  // Ctrl-C: Blender's own exit status says nothing more
+      std::cerr << "tempera: Blender ('" << setup.blender << "') exited with status " << status
+                << " while rendering the guides of '" << scene << "'"
+                << (status > 128 ? " (killed by a signal)" : "") << "\n";
+      return 1;
+  }
 }
 
 int run_render_guides(const Args& args) {
@@ -104,7 +127,18 @@ int run_render_guides(const Args& args) {
   if (!fs::is_regular_file(scene, ec)) throw FileNotFoundError(concat("scene file not found: '", scene, "'"));
   if (!has_frames) throw ValueError("--frames is required (e.g. --frames 1-24)");
   if (!has_out) throw ValueError("--out is required (the guide cache folder)");
-  return render_guides_in_blender(setup, scene, forwarded);
+  // Ctrl-C reaches Blender too (same process group); this process waits for
+  // it to stop and says what is kept, instead of dying silently first.
+  struct sigaction action {};
+  action.sa_handler = on_sigint;
+  sigaction(SIGINT, &action, nullptr);
+  const int status = render_guides_in_blender(setup, scene, forwarded);
+  if (g_interrupted) {
+    std::cerr << "tempera render-guides: interrupted; the frames finished so far are in the cache "
+                 "(rerun the same command to render the rest)\n";
+    return 130;
+  }
+  return status;
 }
 
 std::vector<int> parse_frames(const std::string& text) {
@@ -118,9 +152,16 @@ std::vector<int> parse_frames(const std::string& text) {
     const std::size_t dash = part.find('-', 1);
     int first = 0, last = 0;
     const auto read = [&](const std::string& number, int& out) {
-      const auto [ptr, ec] = std::from_chars(number.data(), number.data() + number.size(), out);
+      long long value = 0;
+      const auto [ptr, ec] = std::from_chars(number.data(), number.data() + number.size(), value);
       if (ec != std::errc() || ptr != number.data() + number.size() || number.empty())
         throw ValueError(concat("cannot read '", part, "' in frame range '", text, "'", hint));
+      // Bounded by Blender's frame range: no range is endless, none holds a
+      // frame Blender would render as another (it clamps to its last frame).
+      if (value < 0 || value > kMaxFrame)
+        throw ValueError(concat("frame ", number, " in '", text, "' is outside 0-", kMaxFrame,
+                                " (the frames Blender can render)"));
+      out = int(value);
     };
     read(part.substr(0, dash), first);
     if (dash == std::string::npos) last = first;

@@ -13,6 +13,7 @@
 
 #include "cli_args.hpp"
 #include "tempera/error.hpp"
+#include "tempera/image_io.hpp"
 #include "tempera/process.hpp"
 #include "tempera/stylize_job.hpp"
 
@@ -69,11 +70,15 @@ const char* kStylizeHelpText =
     "  --samples N             Cycles samples of the guide renders (default 16)\n"
     "  --blender PATH          Blender to run (default: $TEMPERA_BLENDER or 'blender')\n"
     "  --addon-path DIR        folder holding the tempera package\n"
+    "  --max-image-pixels N    refuse images declaring more pixels (default 50000000;\n"
+    "                          also $TEMPERA_MAX_IMAGE_PIXELS)\n"
     "\n"
     "Resume: a frame is skipped when its output exists and was made with the same settings,\n"
     "painting and guide files (sizes and modification times); rerun the same command after\n"
     "an interruption. Ctrl-C stops within the current frame; finished frames are kept.\n"
-    "Exit status: 0 done, 1 error, 2 bad usage, 130 interrupted.\n";
+    "Runs sharing one --out (a render farm) each add their frames to the record under a\n"
+    "lock; a damaged record is set aside with a warning and its frames are redone.\n"
+    "Exit status: 0 done, 1 error (files, Blender), 2 bad usage or bad values, 130 interrupted.\n";
 
 // The help, with the guide weights' defaults from the guide table.
 std::string stylize_help() {
@@ -125,6 +130,7 @@ Options parse(const Args& args) {
     else if (flag == "--samples") o.samples = std::to_string(r.number<int>(flag));
     else if (flag == "--blender") o.blender.blender = r.value(flag);
     else if (flag == "--addon-path") o.blender.addon = r.value(flag);
+    else if (flag == "--max-image-pixels") set_max_image_pixels(r.number<std::int64_t>(flag));
     else if (!set_from_flag(o.stylit.synthesis, synthesis_option_table(), flag.substr(2), [&] { return r.value(flag); }))
       throw ValueError(concat("unknown option '", flag, "' (see tempera stylize --help)"));
   }
@@ -148,8 +154,8 @@ void render_guides(const Options& o, const std::string& scene, const std::string
             << "\n";
   const int status = render_guides_in_blender(o.blender, scene, options);
   if (g_interrupted) throw CancelledError("interrupted while rendering guides");
-  if (status != 0)
-    throw IoError(concat("rendering the guides of '", scene, "' failed (Blender exit status ", status, ")"));
+  if (status == 2) throw ValueError(concat("rendering the guides of '", scene, "' failed: bad values (see above)"));
+  if (status != 0) throw IoError(concat("rendering the guides of '", scene, "' failed (see above)"));
 }
 
 std::string clock_text(double seconds) {
@@ -216,7 +222,8 @@ void write_extras(const StylizeJob& job, const Options& o) {
     return;
   }
   const fs::path video = fs::path(o.out) / "stylized.mp4";
-  const std::string pattern = (fs::path(o.out) / "frames" / "frame_%04d.png").string();
+  // ffmpeg reads '%' in the folder as a pattern of its own: doubled, it is a plain '%'.
+  const std::string pattern = printf_escaped((fs::path(o.out) / "frames").string()) + "/frame_%04d.png";
   if (encode_video(pattern, o.frames.front(), o.fps, video.string()))
     std::cout << "video: " << video.string() << "\n";
   else
@@ -265,10 +272,7 @@ int run_stylize(const Args& args) {
     print_summary(results, o.out);
   } catch (const CancelledError&) {
     return interrupted(results);
-  } catch (const ValueError& e) {  // bad data, not bad usage
-    std::cerr << "tempera stylize: error: " << e.what() << "\n";
-    return 1;
-  }
+  }  // ValueError (bad values in the files or options) reaches main(): exit status 2
   return 0;
 }
 

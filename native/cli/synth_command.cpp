@@ -9,6 +9,7 @@
 #include "tempera/error.hpp"
 #include "tempera/image_io.hpp"
 #include "tempera/patch_usage.hpp"
+#include "tempera/paths.hpp"
 #include "tempera/synthesis.hpp"
 
 namespace tempera::cli {
@@ -109,6 +110,11 @@ int run_synth(const Args& args) {
   if (style_path.empty()) throw ValueError("--style is required");
   if (output_path.empty()) throw ValueError("--output is required");
   if (guides.empty()) throw ValueError("at least one --guide SRC TGT pair is required");
+  {  // issue 18: an output that is an input would be destroyed (tempera/paths.hpp)
+    std::vector<std::string> inputs = {style_path, source_mask_path, target_mask_path};
+    for (const auto& g : guides) inputs.insert(inputs.end(), {g.source, g.target});
+    refuse_output_on_inputs(output_path, inputs, "--output");
+  }
 
   const Image style = read_input(style_path);
   std::vector<Image> sources, targets;

@@ -43,6 +43,34 @@ void reject_unknown(const py::dict& d, const std::set<std::string>& a, const std
   if (!unknown.empty()) throw ValueError(concat("unknown ", what, " key(s) ", unknown));
 }
 
+template <typename T> constexpr const char* kind_name() {
+  if constexpr (std::is_same_v<T, std::string>) return "a string";
+  else if constexpr (std::is_same_v<T, bool>) return "True or False";
+  else if constexpr (std::is_integral_v<T>) return "a whole number";
+  else if constexpr (std::is_floating_point_v<T>) return "a number";
+  else if constexpr (std::is_same_v<T, std::vector<int>>) return "a list of whole numbers";
+  else if constexpr (std::is_same_v<T, py::dict>) return "a dict";
+  else return "another type";
+}
+
+// d[key] as T; a value of the wrong type is a ValueError naming the key
+// ("StylizeJob config 'frames' must be a list of whole numbers, got 'x'"),
+// not pybind11's anonymous "Unable to cast Python instance".
+template <typename T>
+T get(const py::dict& d, const char* key, const std::string& what) {
+  const py::object value = d[key];
+  try {
+    if constexpr (std::is_same_v<T, std::string>) {
+      if (!py::isinstance<py::str>(value)) throw py::cast_error("");
+    }
+    return value.cast<T>();
+  } catch (const py::cast_error&) {
+  } catch (const py::error_already_set&) {  // e.g. an int too large for C++
+  }
+  throw ValueError(concat(what, " '", key, "' must be ", kind_name<T>(), ", got ",
+                          std::string(py::repr(value)).substr(0, 80)));
+}
+
 // Named weights replace the defaults of those guides; the others keep theirs.
 void set_weights(StylitOptions& opt, const py::dict& weights) {
   for (const auto& [key, value] : weights) {
@@ -50,15 +78,20 @@ void set_weights(StylitOptions& opt, const py::dict& weights) {
     auto it = std::find_if(opt.weights.begin(), opt.weights.end(), [&](auto& w) { return w.first == name; });
     if (it == opt.weights.end())
       throw ValueError(concat("unknown guide '", name, "' in weights (StyLit guides: ", light_path_guide_names(), ")"));
-    it->second = value.cast<float>();
+    try {
+      it->second = value.cast<float>();
+    } catch (const py::cast_error&) {
+      throw ValueError(concat("weight of '", name, "' must be a number, got ", std::string(py::repr(value)).substr(0, 80)));
+    }
   }
 }
 
 StylitOptions parse_stylit(const py::dict& d) {
   StylitOptions opt;
-  if (d.contains("weights")) set_weights(opt, d["weights"].cast<py::dict>());
-  if (d.contains("temporal_weight")) opt.temporal_weight = d["temporal_weight"].cast<float>();
-  if (d.contains("quality")) opt.quality = parse_quality(d["quality"].cast<std::string>());
+  const std::string what = "option";
+  if (d.contains("weights")) set_weights(opt, get<py::dict>(d, "weights", what));
+  if (d.contains("temporal_weight")) opt.temporal_weight = get<float>(d, "temporal_weight", what);
+  if (d.contains("quality")) opt.quality = parse_quality(get<std::string>(d, "quality", what));
   py::dict engine;
   std::set<std::string> engine_keys;
   for_each_field(synthesis_option_table(), [&](const auto& f) { engine_keys.insert(f.name); });
@@ -75,15 +108,16 @@ StylizeJobConfig parse_job_config(const py::dict& d) {
   for (const char* key : {"style", "exemplar_guides", "guides", "frames", "out"})
     if (!d.contains(key)) throw ValueError(concat("StylizeJob config needs '", key, "'"));
   StylizeJobConfig c;
-  c.style = d["style"].cast<std::string>();
-  c.exemplar_guides = d["exemplar_guides"].cast<std::string>();
-  if (d.contains("exemplar_frame") && !d["exemplar_frame"].is_none()) c.exemplar_frame = d["exemplar_frame"].cast<int>();
-  c.guides = d["guides"].cast<std::string>();
-  c.frames = d["frames"].cast<std::vector<int>>();
-  c.out = d["out"].cast<std::string>();
-  if (d.contains("format")) c.format = d["format"].cast<std::string>();
-  if (d.contains("prefix")) c.prefix = d["prefix"].cast<std::string>();
-  if (d.contains("resume")) c.resume = d["resume"].cast<bool>();
+  const std::string what = "StylizeJob config";
+  c.style = get<std::string>(d, "style", what);
+  c.exemplar_guides = get<std::string>(d, "exemplar_guides", what);
+  if (d.contains("exemplar_frame") && !d["exemplar_frame"].is_none()) c.exemplar_frame = get<int>(d, "exemplar_frame", what);
+  c.guides = get<std::string>(d, "guides", what);
+  c.frames = get<std::vector<int>>(d, "frames", what);
+  c.out = get<std::string>(d, "out", what);
+  if (d.contains("format")) c.format = get<std::string>(d, "format", what);
+  if (d.contains("prefix")) c.prefix = get<std::string>(d, "prefix", what);
+  if (d.contains("resume")) c.resume = get<bool>(d, "resume", what);
   c.stylit = parse_stylit(d);
   return c;
 }

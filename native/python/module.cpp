@@ -68,6 +68,11 @@ void bind_io(py::module_& m) {
       },
       py::arg("path"), py::arg("image"), py::arg("channel_names") = std::vector<std::string>{},
       "Write an (H, W[, C]) array atomically; 8-bit formats are clamped to [0, 1].");
+  m.def(
+      "set_max_image_pixels", [](std::int64_t pixels) { set_max_image_pixels(pixels); }, py::arg("pixels"),
+      "Images declaring more pixels than this are refused (OSError) before their pixels are read; "
+      "default 50 Mpix or $TEMPERA_MAX_IMAGE_PIXELS.");
+  m.def("max_image_pixels", &max_image_pixels, "The current image size limit in pixels.");
 }
 
 }  // namespace

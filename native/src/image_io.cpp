@@ -5,7 +5,15 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
+#include <charconv>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <functional>
+#include <random>
+#include <thread>
 #include <unistd.h>
 
 #include "tempera/error.hpp"
@@ -15,10 +23,54 @@ namespace fs = std::filesystem;
 namespace tempera {
 namespace {
 
+std::int64_t initial_max_image_pixels() {
+  // TEMPERA_MAX_IMAGE_PIXELS raises (or lowers) the cap for every entry point.
+  if (const char* env = std::getenv("TEMPERA_MAX_IMAGE_PIXELS"); env && *env) {
+    std::int64_t value = 0;
+    const auto [end, ec] = std::from_chars(env, env + std::strlen(env), value);
+    if (ec == std::errc() && *end == 0 && value > 0) return value;
+  }
+  return kDefaultMaxImagePixels;
+}
+
+std::atomic<std::int64_t>& pixel_cap() {
+  static std::atomic<std::int64_t> cap{initial_max_image_pixels()};
+  return cap;
+}
+
+// The declared size, checked before any pixel memory is allocated: a few
+// bytes of header can declare gigabytes.
+void check_declared_size(const std::string& path, const OIIO::ImageSpec& spec) {
+  const std::int64_t cap = pixel_cap().load();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
+    throw IoError(concat("image '", path, "' declares an empty size ", spec.width, "x", spec.height, " with ",
+                         spec.nchannels, " channels"));
+  if (std::int64_t(spec.width) * spec.height > cap || spec.nchannels > 4096)
+    throw IoError(concat("image '", path, "' declares ", spec.width, "x", spec.height, " pixels (", spec.nchannels,
+                         " channels), more than the limit of ", cap,
+                         " pixels; raise it with TEMPERA_MAX_IMAGE_PIXELS, --max-image-pixels or "
+                         "tempera.set_max_image_pixels() if the file is real"));
+}
+
+// A random part for temporary names: process IDs repeat across containers.
+std::string random_tag() {
+  static thread_local std::mt19937_64 rng{std::random_device{}() ^
+                                          (std::uint64_t(getpid()) << 32) ^
+                                          std::uint64_t(std::hash<std::thread::id>{}(std::this_thread::get_id()))};
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(rng()));
+  return text;
+}
+
 std::unique_ptr<OIIO::ImageInput> open_input(const std::string& path) {
   std::error_code ec;
-  if (!fs::exists(path, ec)) throw FileNotFoundError(concat("image file not found: '", path, "'"));
-  if (fs::is_directory(path, ec)) throw IoError(concat("'", path, "' is a folder, not an image file"));
+  const fs::file_status status = fs::status(path, ec);
+  if (ec && ec != std::errc::no_such_file_or_directory)  // e.g. a folder on the way that may not be entered
+    throw IoError(concat("cannot read image '", path, "': ", ec.message()));
+  if (!fs::exists(status)) throw FileNotFoundError(concat("image file not found: '", path, "'"));
+  if (fs::is_directory(status)) throw IoError(concat("'", path, "' is a folder, not an image file"));
+  if (access(path.c_str(), R_OK) != 0)
+    throw IoError(concat("cannot read image '", path, "': ", std::strerror(errno)));
   // Keep alpha as stored (straight): guides and exemplars are data, not
   // compositing layers, and must not be premultiplied behind our back.
   OIIO::ImageSpec config;
@@ -28,6 +80,8 @@ std::unique_ptr<OIIO::ImageInput> open_input(const std::string& path) {
     std::string why = OIIO::geterror();
     throw IoError(concat("cannot read image '", path, "': ", why.empty() ? "unknown format" : why));
   }
+  for (int sub = 0; input->seek_subimage(sub, 0); ++sub) check_declared_size(path, input->spec());
+  input->seek_subimage(0, 0);
   return input;
 }
 
@@ -57,6 +111,17 @@ bool is_8bit_format(const std::string& path) {
 }
 
 }  // namespace
+
+std::int64_t max_image_pixels() { return pixel_cap().load(); }
+
+void set_max_image_pixels(std::int64_t pixels) {
+  if (pixels <= 0) throw ValueError(concat("the image size limit must be > 0 pixels, got ", pixels));
+  pixel_cap() = pixels;
+}
+
+std::string temporary_name(const std::string& stem, const std::string& extension) {
+  return concat(".", stem, ".tmp", getpid(), "-", random_tag(), extension);
+}
 
 ImageFileInfo inspect_image(const std::string& path) {
   auto input = open_input(path);
@@ -143,10 +208,7 @@ void write_image(const std::string& path, const ImageView& image,
     throw FileNotFoundError(concat("cannot write '", path, "': folder '",
                                    target.parent_path().string(), "' does not exist"));
   // Same folder (so rename is atomic), same extension (so OIIO picks the format).
-  static std::atomic<int> counter{0};
-  const fs::path temp = target.parent_path() /
-                        concat(".", target.stem().string(), ".tmp", getpid(), "-", counter++,
-                               target.extension().string());
+  const fs::path temp = target.parent_path() / temporary_name(target.stem().string(), target.extension().string());
   auto output = OIIO::ImageOutput::create(temp.string());
   if (!output)
     throw IoError(concat("cannot write '", path, "': no image format for extension '",

@@ -3,6 +3,7 @@
 // so the DFA is tiny and built once per render; tracing only steps through it.
 #include "tempera/lpe.hpp"
 
+#include <algorithm>
 #include <map>
 #include <memory>
 #include <string>
@@ -16,6 +17,13 @@ using EventMask = std::uint8_t;  // bit i: LpeEvent(i)
 constexpr EventMask bit(LpeEvent e) { return EventMask(1u << int(e)); }
 constexpr EventMask kAnyButEye = bit(LpeEvent::L) | bit(LpeEvent::D) | bit(LpeEvent::S) | bit(LpeEvent::T);
 constexpr int kMaxCount = 100;  // bound on {m,n}: keeps the NFA small
+// Bounds that keep any text cheap to reject: the parser and the NFA build
+// recurse once per nesting level, so the depth bounds their stacks; the NFA
+// and DFA state counts bound the memory and time of the subset construction.
+constexpr std::size_t kMaxLength = 1000;
+constexpr int kMaxDepth = 64;        // nested '(' plus stacked repeat operators
+constexpr std::size_t kMaxNfaStates = 5000;
+constexpr std::size_t kMaxDfaStates = 4096;
 
 bool event_of(char c, LpeEvent& out) {
   switch (c) {
@@ -48,6 +56,8 @@ class Parser {
   explicit Parser(std::string_view text) : text_(text) {}
 
   NodePtr parse() {
+    if (text_.size() > kMaxLength)
+      throw ValueError(concat("LPE is ", text_.size(), " characters long; at most ", kMaxLength, " are allowed"));
     NodePtr root = alternation();
     if (pos_ < text_.size()) fail("end of expression");
     return root;
@@ -56,6 +66,11 @@ class Parser {
  private:
   [[noreturn]] void fail(std::string_view expected) const {
     throw ValueError(concat("LPE \"", text_, "\": position ", pos_, ": expected ", expected));
+  }
+  void deeper() {
+    if (++depth_ > kMaxDepth)
+      throw ValueError(concat("LPE \"", text_.substr(0, 40), text_.size() > 40 ? "..." : "", "\": position ", pos_,
+                              ": nested more than ", kMaxDepth, " levels deep (parentheses and repeat operators)"));
   }
   bool at(char c) const { return pos_ < text_.size() && text_[pos_] == c; }
   void expect(char c) {
@@ -83,8 +98,10 @@ class Parser {
   }
 
   NodePtr repetition() {
+    const int depth = depth_;
     NodePtr node = atom();
     while (at('*') || at('+') || at('?') || at('{')) {
+      deeper();  // each stacked operator nests the tree one level deeper
       NodePtr rep = make(Node::Kind::repeat);
       const char op = text_[pos_++];
       if (op == '*') rep->min = 0, rep->max = -1;
@@ -103,6 +120,7 @@ class Parser {
       rep->children.push_back(std::move(node));
       node = std::move(rep);
     }
+    depth_ = depth;
     return node;
   }
 
@@ -144,8 +162,10 @@ class Parser {
       set->events = negated ? EventMask(kAnyButEye & ~listed) : listed;
     } else if (at('(')) {
       ++pos_;
+      deeper();
       NodePtr inner = alternation();
       expect(')');
+      --depth_;
       return inner;
     } else {
       fail("an event, '.', '[' or '('");
@@ -155,7 +175,30 @@ class Parser {
 
   std::string_view text_;
   std::size_t pos_ = 0;
+  int depth_ = 0;
 };
+
+// NFA states nfa.build() would make for `node`, saturating at kMaxNfaStates + 1
+// (computed before building, so huge repeat counts never allocate).
+std::size_t nfa_size(const Node& node) {
+  static constexpr std::size_t cap = kMaxNfaStates + 1;
+  auto sat = [](std::size_t a) { return std::min(a, cap); };
+  switch (node.kind) {
+    case Node::Kind::set: return 2;
+    case Node::Kind::concat:
+    case Node::Kind::alternation: {
+      std::size_t n = node.kind == Node::Kind::alternation ? 2 : 0;
+      for (const auto& child : node.children) n = sat(n + nfa_size(*child));
+      return n;
+    }
+    case Node::Kind::repeat: {
+      const std::size_t child = nfa_size(*node.children[0]);
+      const std::size_t optional = node.max < 0 ? 1 : std::size_t(node.max - node.min);
+      return sat(1 + sat(std::size_t(node.min) * child) + sat(optional * (child + 1)));
+    }
+  }
+  return cap;
+}
 
 // Thompson construction: each fragment has one entry and one exit state.
 class Nfa {
@@ -249,6 +292,10 @@ void close_over_epsilon(const Nfa& nfa, StateSet& set) {
 
 LpeDfa compile_lpe(std::string_view expression, LpeOrder order) {
   const NodePtr root = Parser(expression).parse();
+  if (nfa_size(*root) > kMaxNfaStates)
+    throw ValueError(concat("LPE \"", expression.substr(0, 60), expression.size() > 60 ? "..." : "",
+                            "\" is too large: its repeat counts multiply to more than ", kMaxNfaStates,
+                            " automaton states; use smaller counts"));
   Nfa nfa;
   const Nfa::Fragment whole = nfa.build(*root, order == LpeOrder::eye_to_light);
   const std::size_t n = nfa.states.size();
@@ -260,6 +307,10 @@ LpeDfa compile_lpe(std::string_view expression, LpeOrder order) {
   auto state_of = [&](StateSet set) {
     auto [it, inserted] = index.emplace(set, int(index.size()));
     if (inserted) {
+      if (index.size() > kMaxDfaStates)
+        throw ValueError(concat("LPE \"", expression.substr(0, 60), expression.size() > 60 ? "..." : "",
+                                "\" is too complex: it needs more than ", kMaxDfaStates,
+                                " automaton states (e.g. '.*' followed by a long counted repeat); simplify it"));
       dfa.accepting.push_back(set[whole.out]);
       dfa.next.resize(dfa.next.size() + kLpeEventCount, LpeDfa::kDead);
       pending.push_back(std::move(set));

@@ -28,38 +28,50 @@ Image grayscale(const ImageView& img) {
   return out;
 }
 
-std::vector<float> gaussian_kernel(float sigma) {
-  const int radius = int(std::ceil(3.0f * sigma));
-  std::vector<float> k(2 * radius + 1);
+// The Gaussian's taps out to 3 sigma, clamped to `limit` (the image's extent
+// along the axis minus one): with the border replicated, every tap beyond it
+// reads the edge pixel for every output pixel, so folding its weight into the
+// outermost tap gives exactly the unclamped blur at a bounded cost.
+std::vector<float> gaussian_kernel(float sigma, int limit) {
+  const long full = long(std::ceil(3.0 * double(sigma)));  // sigma <= kMaxSigma: no overflow
+  const int radius = int(std::min<long>(full, std::max(limit, 0)));
+  std::vector<double> k(2 * std::size_t(radius) + 1, 0.0);
   double sum = 0.0;
-  for (int i = -radius; i <= radius; ++i) sum += k[i + radius] = std::exp(-0.5f * float(i * i) / (sigma * sigma));
-  for (float& w : k) w = float(w / sum);
-  return k;
+  for (long i = -full; i <= full; ++i) {
+    const double w = std::exp(-0.5 * double(i) * double(i) / (double(sigma) * sigma));
+    k[std::size_t(std::clamp<long>(i, -radius, radius) + radius)] += w;
+    sum += w;
+  }
+  std::vector<float> out(k.size());
+  for (std::size_t i = 0; i < k.size(); ++i) out[i] = float(k[i] / sum);
+  return out;
 }
 
 // Separable Gaussian blur of all channels in place, replicating the border.
 // Both passes add whole shifted rows, so the inner loops are contiguous.
 void gaussian_blur(Image& img, float sigma) {
   if (sigma <= 0.0f) return;
-  const std::vector<float> k = gaussian_kernel(sigma);
-  const int r = int(k.size() / 2), w = img.width(), h = img.height(), c = img.channels();
+  const int w = img.width(), h = img.height(), c = img.channels();
+  const std::vector<float> kx = gaussian_kernel(sigma, w - 1), ky = gaussian_kernel(sigma, h - 1);
+  const int rx = int(kx.size() / 2), ry = int(ky.size() / 2);
   const std::size_t row = std::size_t(w) * c;
   Image tmp(w, h, c);
   parallel_for(h, 0, [&](int y) {  // horizontal: img -> tmp, via a row padded with its edge pixels
-    std::vector<float> padded((std::size_t(w) + 2 * r) * c);
-    for (int x = -r; x < w + r; ++x) std::copy_n(img.pixel(std::clamp(x, 0, w - 1), y), c, &padded[(x + r) * c]);
+    std::vector<float> padded((std::size_t(w) + 2 * rx) * c);
+    for (int x = -rx; x < w + rx; ++x)
+      std::copy_n(img.pixel(std::clamp(x, 0, w - 1), y), c, &padded[std::size_t(x + rx) * c]);
     float* out = tmp.pixel(0, y);
-    for (int i = 0; i <= 2 * r; ++i) {
+    for (int i = 0; i <= 2 * rx; ++i) {
       const float* in = padded.data() + std::size_t(i) * c;
-      for (std::size_t j = 0; j < row; ++j) out[j] += k[i] * in[j];
+      for (std::size_t j = 0; j < row; ++j) out[j] += kx[i] * in[j];
     }
   });
   parallel_for(h, 0, [&](int y) {  // vertical: tmp -> img
     float* out = img.pixel(0, y);
     std::fill_n(out, row, 0.0f);
-    for (int i = -r; i <= r; ++i) {
+    for (int i = -ry; i <= ry; ++i) {
       const float* in = tmp.pixel(0, std::clamp(y + i, 0, h - 1));
-      for (std::size_t j = 0; j < row; ++j) out[j] += k[i + r] * in[j];
+      for (std::size_t j = 0; j < row; ++j) out[j] += ky[i + ry] * in[j];
     }
   });
 }
@@ -69,8 +81,9 @@ void gaussian_blur(Image& img, float sigma) {
 StructureTensorField structure_tensor(const ImageView& gray, float sigma) {
   require_nonempty(gray, "image");
   require_finite(gray, "image");
-  if (!(sigma >= 0.0f) || !std::isfinite(sigma))
-    throw ValueError(concat("structure tensor sigma must be a finite number >= 0, got ", sigma));
+  if (!(sigma >= 0.0f) || !(sigma <= kMaxStructureTensorSigma))
+    throw ValueError(concat("structure tensor sigma must be from 0 to ", kMaxStructureTensorSigma,
+                            " pixels, got ", sigma));
   const Image g = grayscale(gray);
   const int w = g.width(), h = g.height();
   Image tensor(w, h, 3);

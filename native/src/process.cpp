@@ -1,6 +1,7 @@
 #include "tempera/process.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -11,6 +12,7 @@
 #include <iostream>
 
 #include "tempera/error.hpp"
+#include "tempera/image_io.hpp"
 
 namespace fs = std::filesystem;
 
@@ -29,7 +31,7 @@ std::string find_on_path(const std::string& program) {
   return "";
 }
 
-int run_process(const std::vector<std::string>& argv, bool quiet) {
+int run_process(const std::vector<std::string>& argv, bool quiet, const volatile std::sig_atomic_t* interrupted) {
   std::vector<char*> raw;
   for (const auto& a : argv) raw.push_back(const_cast<char*>(a.c_str()));
   raw.push_back(nullptr);
@@ -45,9 +47,22 @@ int run_process(const std::vector<std::string>& argv, bool quiet) {
     _exit(127);
   }
   int status = 0;
+  bool terminated = false;
   while (waitpid(pid, &status, 0) < 0) {
+    // Interrupted by a signal (EINTR): after Ctrl-C, make sure the child
+    // stops too (Blender ignores a Ctrl-C that comes between two renders).
+    if (interrupted && *interrupted && !terminated) {
+      kill(pid, SIGTERM);
+      terminated = true;
+    }
   }
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+std::string printf_escaped(const std::string& text) {
+  std::string out;
+  for (char c : text) out += c == '%' ? std::string("%%") : std::string(1, c);
+  return out;
 }
 
 bool encode_video(const std::string& pattern, int first_frame, double fps, const std::string& out_path) {
@@ -55,10 +70,8 @@ bool encode_video(const std::string& pattern, int first_frame, double fps, const
   const std::string ffmpeg = find_on_path("ffmpeg");
   if (ffmpeg.empty()) return false;
   const fs::path target(out_path);
-  static std::atomic<int> counter{0};
   // Same folder, so the final rename is atomic; .mp4 so ffmpeg picks the muxer.
-  const fs::path temp = target.parent_path() / concat(".", target.stem().string(), ".tmp", getpid(), "-",
-                                                      counter++, ".mp4");
+  const fs::path temp = target.parent_path() / temporary_name(target.stem().string(), ".mp4");
   const std::vector<std::string> argv = {
       ffmpeg, "-y", "-nostdin", "-loglevel", "error", "-framerate", concat(fps), "-start_number",
       std::to_string(first_frame), "-i", pattern,

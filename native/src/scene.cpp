@@ -1,5 +1,6 @@
 #include "tempera/scene.hpp"
 
+#include <cmath>
 #include <string>
 
 #include "tempera/error.hpp"
@@ -95,6 +96,19 @@ void validate_light(const Light& l, const std::string& what) {
 void validate_camera(const Camera& c) {
   require(c.width > 0 && c.height > 0, "camera size ", c.width, "x", c.height, " is empty");
   for (float f : c.camera_to_world) require(std::isfinite(f), "camera camera_to_world is not finite");
+  {  // A singular rotation/scale part has no ray directions (Embree asserts on them).
+    const auto& m = c.camera_to_world;  // row-major 4x4
+    auto at = [&](int r, int k) { return double(m[4 * r + k]); };
+    const double det = at(0, 0) * (at(1, 1) * at(2, 2) - at(1, 2) * at(2, 1)) -
+                       at(0, 1) * (at(1, 0) * at(2, 2) - at(1, 2) * at(2, 0)) +
+                       at(0, 2) * (at(1, 0) * at(2, 1) - at(1, 1) * at(2, 0));
+    double scale = 1.0;
+    for (int k = 0; k < 3; ++k)
+      scale *= std::sqrt(at(0, k) * at(0, k) + at(1, k) * at(1, k) + at(2, k) * at(2, k));
+    require(scale > 0 && std::abs(det) > 1e-6 * scale,
+            "camera camera_to_world is singular (its 3x3 part has determinant ", det,
+            "): a camera scaled to zero along an axis has no view");
+  }
   for (float f : {c.shift_x, c.shift_y, c.clip_start, c.clip_end})
     require(std::isfinite(f), "camera has a non-finite parameter");
   require(c.clip_start >= 0 && c.clip_end > c.clip_start, "camera needs 0 <= clip_start < clip_end");

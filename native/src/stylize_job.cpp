@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -20,6 +21,7 @@
 #include "tempera/contact_sheet.hpp"
 #include "tempera/error.hpp"
 #include "tempera/image_io.hpp"
+#include "tempera/paths.hpp"
 
 namespace fs = std::filesystem;
 
@@ -27,7 +29,7 @@ namespace tempera {
 namespace {
 
 constexpr const char* kReportName = "tempera_stylize.json";
-constexpr const char* kReportFormat = "tempera-stylize 1";
+constexpr const char* kReportFormat = "tempera-stylize 2";
 constexpr int kSheetMaxWidth = 2000;
 constexpr int kSheetGap = 4;
 
@@ -72,7 +74,12 @@ std::vector<int> cached_frames(const std::string& folder) {
     const std::string name = entry.path().filename().string();
     if (name.size() <= 10 || name.rfind("frame_", 0) != 0 || entry.path().extension() != ".exr") continue;
     const std::string digits = name.substr(6, name.size() - 10);
-    if (!digits.empty() && std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c); })) frames.push_back(std::stoi(digits));
+    if (digits.empty() || !std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c); }))
+      continue;
+    int frame = 0;
+    const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), frame);
+    // A number no frame can have (beyond Blender's last frame) is not a cache frame.
+    if (ec == std::errc() && end == digits.data() + digits.size() && frame <= kMaxFrame) frames.push_back(frame);
   }
   std::sort(frames.begin(), frames.end());
   return frames;
@@ -163,22 +170,36 @@ class LineReader {
 struct ReportEntry {
   std::string key, file;
   double flicker = 0, source_coverage = 0;
+  FileDigest digest;  // of the output file as written: a changed or damaged file is redone
 };
 
-// Reads exactly the format write_report() writes: one frame per line. Any
-// surprise means "no frames done" (they are redone, never wrongly skipped).
-std::map<int, ReportEntry> read_report(const std::string& path) {
-  std::ifstream in(path);
+// Reads exactly the format write_report() writes: one frame per line. A file
+// that is not such a report (damaged, or from another Tempera version) is
+// renamed aside with a warning and counts as "no frames done": its frames
+// are redone, never wrongly skipped, and nothing of it is lost.
+std::map<int, ReportEntry> read_report(const std::string& path, std::vector<std::string>& warnings) {
   std::map<int, ReportEntry> entries;
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return entries;
+  std::ifstream in(path);
   std::string line;
-  if (!std::getline(in, line) || line != "{" || !std::getline(in, line) ||
-      line != concat("  \"format\": ", json_string(kReportFormat), ","))
-    return entries;
+  bool ok = in && std::getline(in, line) && line == "{" && std::getline(in, line) &&
+            line == concat("  \"format\": ", json_string(kReportFormat), ",");
+  bool closed = false;  // the final "}": a truncated record is damaged, not short
   try {
-    while (std::getline(in, line)) {
-      if (line.find("{\"key\": ") == std::string::npos) continue;
+    while (ok && std::getline(in, line)) {
+      if (closed) ok = false;  // text after the end
+      if (line == "}") closed = true;
+      if (line.find("{\"key\": ") == std::string::npos) {
+        if (line.find("\"key\"") != std::string::npos) ok = false;
+        continue;
+      }
       LineReader r(line);
-      const int frame = std::stoi(r.string());
+      const std::string number = r.string();
+      int frame = -1;
+      const auto [end, error] = std::from_chars(number.data(), number.data() + number.size(), frame);
+      if (error != std::errc() || end != number.data() + number.size() || frame < 0 || frame > kMaxFrame)
+        throw ValueError("bad frame number");
       ReportEntry e;
       r.expect(": {\"key\":");
       e.key = r.string();
@@ -188,42 +209,29 @@ std::map<int, ReportEntry> read_report(const std::string& path) {
       e.flicker = r.number();
       r.expect(", \"source_coverage\":");
       e.source_coverage = r.number();
+      r.expect(", \"size\":");
+      e.digest.size = std::int64_t(r.number());
+      r.expect(", \"checksum\":");
+      e.digest.checksum = r.string();
       r.expect("}");
       entries[frame] = e;
     }
   } catch (const std::exception&) {
-    return {};
+    ok = false;
   }
-  return entries;
+  if (ok && closed) return entries;
+  const std::string aside = concat(path, ".corrupt-", temporary_name("", "").substr(5));
+  fs::rename(path, aside, ec);
+  warnings.push_back(concat("the resume record '", path, "' is damaged or from another Tempera version; ",
+                            ec ? "it is ignored" : concat("set aside as '", aside, "'"),
+                            " and its frames are stylized again"));
+  return {};
 }
 
-// Holds an exclusive lock on "<report>.lock" while a process merges its frame
-// into the report, so that jobs sharing an output folder (a render farm's
-// chunks finishing at the same moment) never drop each other's entries.
-class ReportLock {
- public:
-  explicit ReportLock(const std::string& report) {
-    const std::string path = report + ".lock";
-    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (fd_ < 0) throw IoError(concat("cannot open the job report lock '", path, "'"));
-    while (::flock(fd_, LOCK_EX) != 0) {
-      if (errno != EINTR) {
-        ::close(fd_);
-        throw IoError(concat("cannot lock the job report lock '", path, "'"));
-      }
-    }
-  }
-  ~ReportLock() { ::close(fd_); }  // closing releases the lock
-  ReportLock(const ReportLock&) = delete;
-  ReportLock& operator=(const ReportLock&) = delete;
-
- private:
-  int fd_ = -1;
-};
 
 void write_report(const std::string& path, const std::string& settings, const std::map<int, ReportEntry>& entries) {
   const fs::path target(path);
-  const fs::path temp = target.parent_path() / concat(".", target.filename().string(), ".tmp", getpid());
+  const fs::path temp = target.parent_path() / temporary_name(target.filename().string(), "");
   {
     std::ofstream out(temp);
     out << "{\n  \"format\": " << json_string(kReportFormat) << ",\n  \"settings\": " << json_string(settings)
@@ -232,7 +240,8 @@ void write_report(const std::string& path, const std::string& settings, const st
     for (const auto& [frame, e] : entries)
       out << (i++ ? ",\n" : "\n") << "    \"" << frame << "\": {\"key\": " << json_string(e.key)
           << ", \"file\": " << json_string(e.file) << ", \"flicker\": " << json_number(e.flicker)
-          << ", \"source_coverage\": " << json_number(e.source_coverage) << "}";
+          << ", \"source_coverage\": " << json_number(e.source_coverage) << ", \"size\": " << e.digest.size
+          << ", \"checksum\": " << json_string(e.digest.checksum) << "}";
     out << "\n  }\n}\n";
     if (!out) {
       std::error_code ec;
@@ -242,7 +251,26 @@ void write_report(const std::string& path, const std::string& settings, const st
   }
   std::error_code ec;
   fs::rename(temp, target, ec);
-  if (ec) throw IoError(concat("cannot move the job report into place at '", path, "': ", ec.message()));
+  if (ec) {
+    fs::remove(temp, ec);
+    throw IoError(concat("cannot move the job report into place at '", path, "': ", ec.message()));
+  }
+}
+
+// Temporary files (".<name>.tmp<pid>-<random>...") of writers killed with -9.
+// A live writer holds one for the seconds an image takes to write, so one
+// older than an hour is dead; it is never read, only removed here.
+void remove_stale_temporaries(const std::string& folder) {
+  std::error_code ec;
+  const auto now = fs::file_time_type::clock::now();
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() < 2 || name[0] != '.' || name.find(".tmp") == std::string::npos) continue;
+    std::error_code stat_ec;
+    const auto written = fs::last_write_time(it->path(), stat_ec);
+    if (!stat_ec && now - written > std::chrono::hours(1) && fs::is_regular_file(it->path(), stat_ec))
+      fs::remove(it->path(), stat_ec);
+  }
 }
 
 void validate_config(const StylizeJobConfig& c) {
@@ -250,11 +278,13 @@ void validate_config(const StylizeJobConfig& c) {
     throw ValueError(concat("unknown output format '", c.format, "' (choose png or exr)"));
   if (c.prefix.find('/') != std::string::npos) throw ValueError(concat("prefix '", c.prefix, "' must not contain '/'"));
   if (c.frames.empty()) throw ValueError("no frames to stylize");
-  for (std::size_t i = 0; i < c.frames.size(); ++i) {
-    if (c.frames[i] < 0) throw ValueError(concat("frame numbers must be >= 0, got ", c.frames[i]));
-    if (std::find(c.frames.begin(), c.frames.begin() + i, c.frames[i]) != c.frames.begin() + i)
-      throw ValueError(concat("frame ", c.frames[i], " is listed twice"));
-  }
+  for (int frame : c.frames)
+    if (frame < 0 || frame > kMaxFrame)
+      throw ValueError(concat("frame numbers must be from 0 to ", kMaxFrame, " (Blender's last frame), got ", frame));
+  std::vector<int> sorted = c.frames;  // n log n: a million frames are checked at once
+  std::sort(sorted.begin(), sorted.end());
+  const auto twice = std::adjacent_find(sorted.begin(), sorted.end());
+  if (twice != sorted.end()) throw ValueError(concat("frame ", *twice, " is listed twice"));
   if (c.out.empty()) throw ValueError("no output folder given");
   const SynthesisOptions& o = c.stylit.synthesis;
   if (o.patch_size < 3 || o.patch_size % 2 == 0)
@@ -272,7 +302,7 @@ int resolve_exemplar_frame(const StylizeJobConfig& c) {
     std::string list;
     for (int f : found) list += concat(list.empty() ? "" : ", ", f);
     throw ValueError(concat("the exemplar guide folder '", c.exemplar_guides, "' holds ", found.size(),
-                            " frames (", list, "); choose one with exemplar_frame (--exemplar-frame)"));
+                            " frames (", list, "); choose one with Exemplar Frame (--exemplar-frame)"));
   }
   return found.front();
 }
@@ -321,10 +351,22 @@ StylizeJob::StylizeJob(StylizeJobConfig config) : config_(std::move(config)) {
                                    missing, " (render them with tempera render-guides)"));
   check_target_guides(names);
 
+  // The stylized frames would replace guide frames (frame_0001.exr) or
+  // the painting: refuse before anything is written.
+  for (const auto& [folder, what] : {std::pair{config_.guides, "guide cache"},
+                                     std::pair{config_.exemplar_guides, "exemplar guide cache"}})
+    if (same_path(config_.out, folder))
+      throw ValueError(concat("the output folder '", config_.out, "' is the ", what, " folder: the stylized frames "
+                              "would overwrite the guides; choose another output folder"));
+  for (int frame : config_.frames)
+    if (same_path(output_path(frame), config_.style))
+      throw ValueError(concat("the stylized frame '", output_path(frame), "' would overwrite the painting '",
+                              config_.style, "'; choose another output folder"));
   std::error_code ec;
   fs::create_directories(config_.out, ec);
   if (!fs::is_directory(config_.out, ec))
-    throw IoError(concat("cannot create the output folder '", config_.out, "'"));
+    throw IoError(concat("cannot create the output folder '", config_.out, "'", ec ? ": " + ec.message() : ""));
+  remove_stale_temporaries(config_.out);
   settings_ = settings_text(config_);
   const std::string base = hash_hex(settings_ + "\n" + file_stamp(config_.style) + "\n" + file_stamp(exemplar_path_));
   // The predecessor's result is deliberately not part of a frame's key: frames
@@ -360,6 +402,8 @@ std::string StylizeJob::output_path(int frame) const {
 
 std::string StylizeJob::report_path() const { return (fs::path(config_.out) / kReportName).string(); }
 
+std::string StylizeJob::lock_path() const { return config_.out; }  // the folder itself: no lock file
+
 std::string StylizeJob::target_path(int frame) const { return guide_cache_frame(config_.guides, frame); }
 
 // Velocities of frame f point to frame f - 1, so only that frame can be chained.
@@ -377,9 +421,16 @@ FrameResult StylizeJob::run_frame(std::size_t index, const ProgressCallback& pro
   result.path = output_path(result.frame);
   std::error_code ec;
   if (config_.resume) {
-    const auto done = read_report(report_path());
+    std::map<int, ReportEntry> done;
+    {
+      FileLock lock(lock_path());
+      done = read_report(report_path(), warnings_);
+    }
     const auto it = done.find(result.frame);
-    if (it != done.end() && it->second.key == keys_[index] && fs::is_regular_file(result.path, ec)) {
+    // Current: same key, and the file is the one written (size and checksum),
+    // so a truncated or overwritten output is made again.
+    if (it != done.end() && it->second.key == keys_[index] && fs::is_regular_file(result.path, ec) &&
+        file_digest(result.path) == it->second.digest) {
       result.status = "skipped";
       result.flicker = it->second.flicker;
       result.source_coverage = it->second.source_coverage;
@@ -410,38 +461,66 @@ FrameResult StylizeJob::run_frame(std::size_t index, const ProgressCallback& pro
                        ? std::numeric_limits<double>::quiet_NaN()
                        : flicker(previous.view(), synth.image.view(), temporal.velocity_backward,
                                  temporal.occlusion_backward);
-  // Merge into what is on disk: other machines may share this folder.
-  const ReportLock lock(report_path());
-  auto entries = read_report(report_path());
-  entries[result.frame] = {keys_[index], fs::path(result.path).filename().string(), result.flicker,
-                           result.source_coverage};
-  write_report(report_path(), settings_, entries);
+  // Merge into what is on disk under the folder's lock: other processes and
+  // machines may share this folder, and each adds its own frames.
+  const FileDigest digest = file_digest(result.path);
+  {
+    FileLock lock(lock_path());
+    auto entries = read_report(report_path(), warnings_);
+    entries[result.frame] = {keys_[index], fs::path(result.path).filename().string(), result.flicker,
+                             result.source_coverage, digest};
+    write_report(report_path(), settings_, entries);
+  }
   result.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return result;
 }
 
+// The sheet is laid out from the files' headers, then each frame is read,
+// downscaled and pasted in turn: memory holds the sheet and one frame, not
+// every frame at full float resolution.
 void StylizeJob::write_contact_sheet(const std::string& path, int columns) const {
-  std::vector<Image> images = {style_};
+  if (same_path(path, config_.style)) throw ValueError(concat("the contact sheet '", path, "' would overwrite the painting"));
+  std::vector<std::string> files;
+  std::vector<std::pair<int, int>> sizes = {{style_.width(), style_.height()}};
   std::error_code ec;
-  for (int frame : config_.frames)
-    if (fs::is_regular_file(output_path(frame), ec)) images.push_back(read_image(output_path(frame)));
-  const int n = int(images.size());
-  const int cols = std::min(columns > 0 ? columns : int(std::ceil(std::sqrt(double(n)))), n);
-  int widest = 0;
-  for (const auto& image : images) widest = std::max(widest, image.width());
-  const double scale = std::min(1.0, double(kSheetMaxWidth - (cols - 1) * kSheetGap) / (double(cols) * widest));
-  std::vector<ImageView> views;
-  for (auto& image : images) {
-    if (scale < 1.0)
-      image = resize_image(image.view(), std::max(1, int(std::lround(image.width() * scale))),
-                           std::max(1, int(std::lround(image.height() * scale))));
-    views.push_back(image.view());
+  for (int frame : config_.frames) {
+    if (!fs::is_regular_file(output_path(frame), ec)) continue;
+    const ImageFileInfo info = inspect_image(output_path(frame));
+    files.push_back(output_path(frame));
+    sizes.push_back({info.width, info.height});
   }
-  ContactSheetLayout layout;
-  layout.columns = cols;
-  layout.gap = kSheetGap;
-  layout.background = {1.0f};  // white paper between the paintings
-  write_image(path, contact_sheet(views, layout).view());
+  const int n = int(sizes.size());
+  const int cols = std::min(columns > 0 ? columns : int(std::ceil(std::sqrt(double(n)))), n);
+  const int rows = (n + cols - 1) / cols;
+  int widest = 0;
+  for (const auto& [w, h] : sizes) widest = std::max(widest, w);
+  const double scale = std::min(1.0, double(kSheetMaxWidth - (cols - 1) * kSheetGap) / (double(cols) * widest));
+  auto scaled = [&](int v) { return scale < 1.0 ? std::max(1, int(std::floor(v * scale))) : v; };
+  int cell_w = 0, cell_h = 0;
+  for (const auto& [w, h] : sizes) cell_w = std::max(cell_w, scaled(w)), cell_h = std::max(cell_h, scaled(h));
+  const int channels = style_.channels() == 1 ? 3 : style_.channels();
+  Image sheet(cols * cell_w + (cols - 1) * kSheetGap, rows * cell_h + (rows - 1) * kSheetGap, channels);
+  std::fill(sheet.data(), sheet.data() + sheet.pixel_count() * channels, 1.0f);  // white paper between the paintings
+  auto paste = [&](const ImageView& full, int i) {
+    Image small;
+    ImageView image = full;
+    if (scaled(full.width) != full.width || scaled(full.height) != full.height) {
+      small = resize_image(full, scaled(full.width), scaled(full.height));
+      image = small.view();
+    }
+    const int x0 = (i % cols) * (cell_w + kSheetGap) + (cell_w - image.width) / 2;
+    const int y0 = (i / cols) * (cell_h + kSheetGap) + (cell_h - image.height) / 2;
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x) {
+        float* out = sheet.pixel(x0 + x, y0 + y);
+        const float* in = image.pixel(x, y);
+        for (int c = 0; c < channels; ++c) out[c] = in[image.channels == 1 ? 0 : std::min(c, image.channels - 1)];
+        if (channels == 4 && image.channels < 4) out[3] = 1.0f;
+      }
+  };
+  paste(style_.view(), 0);
+  for (std::size_t i = 0; i < files.size(); ++i) paste(read_image(files[i]).view(), int(i) + 1);
+  write_image(path, sheet.view());
 }
 
 }  // namespace tempera

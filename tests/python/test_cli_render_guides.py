@@ -96,3 +96,59 @@ def test_lpe_options_reach_the_guide_cache(cli_path, user_blend, tmp_path):
     assert bad.returncode != 0
     assert "Light path expression 1 'L(DE' is malformed" in bad.stderr and "position 4" in bad.stderr
     assert not (tmp_path / "bad").exists()
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--tensor-sigma", "1e9"], "tensor_sigma (structure tensor sigma (pixels)) must be from 0 to 1000"),
+    (["--lpe", "(" * 60000 + "L" + ")" * 60000], "at most 1000"),
+    (["--lpe", "L.*D.{30}E"], "too complex"),
+    (["--samples", "0"], "samples (Cycles samples) must be from 1"),
+])
+def test_bad_values_exit_2_before_rendering_and_leave_nothing(cli_path, user_blend, tmp_path, args, message):
+    """Issue 18: these crashed Blender (exit 139), hung it, or left temporary folders."""
+    private_tmp = tmp_path / "tmp"  # the system's temporary folder of this run alone (others share /tmp)
+    private_tmp.mkdir()
+    result = subprocess.run([str(cli_path), "render-guides", str(user_blend), "--frames", "1", "--out",
+                             str(tmp_path / "g"), *args], capture_output=True, text=True, timeout=300,
+                            env=dict(os.environ, TEMPERA_BLENDER=BLENDER, TMPDIR=str(private_tmp)))
+    assert result.returncode == 2, result.stdout[-1500:] + result.stderr[-1500:]
+    assert message in result.stderr
+    assert not (tmp_path / "g").exists()
+    assert [p.name for p in private_tmp.iterdir() if p.name.startswith("tempera-guides-")] == []
+
+
+def test_frames_beyond_blenders_last_frame_exit_2(cli_path, user_blend, tmp_path):
+    result = render_guides(cli_path, user_blend, "--frames", "1-99999999999", "--out", tmp_path / "g")
+    assert result.returncode == 2 and "outside 0-1048574" in result.stderr, result.stderr[-1500:]
+
+
+def test_ctrl_c_keeps_the_finished_frames(cli_path, user_blend, tmp_path):
+    """Issue 18: Ctrl-C at frame 3 of 8 used to leave an empty cache (frames
+    waited in the system's temporary folder for the whole range)."""
+    import signal
+    import time
+
+    private_tmp = tmp_path / "tmp"  # the system's temporary folder of this run alone (others share /tmp)
+    private_tmp.mkdir()
+    out = tmp_path / "g"
+    process = subprocess.Popen([str(cli_path), "render-guides", str(user_blend), "--frames", "1-60", "--out",
+                                str(out), "--samples", "2", "--ld12e-samples", "2"], start_new_session=True,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               env=dict(os.environ, TEMPERA_BLENDER=BLENDER, TMPDIR=str(private_tmp)))
+    deadline = time.monotonic() + 240
+    while time.monotonic() < deadline and not (out / "frame_0002.exr").exists() and process.poll() is None:
+        time.sleep(0.05)
+    os.killpg(process.pid, signal.SIGINT)  # what a terminal's Ctrl-C does
+    _, err = process.communicate(timeout=240)
+    assert process.returncode == 130, err[-2000:]
+    assert "interrupted; the frames finished so far are in the cache" in err
+    manifest = guide_cache.read_manifest(out)
+    kept = sorted(int(f) for f in manifest["frames"])
+    assert kept and kept == list(range(1, len(kept) + 1)) and len(kept) < 60
+    for f in kept:
+        assert guide_cache.is_frame_current(out, manifest, f, manifest["frames"][str(f)]["key"])
+    assert [p.name for p in private_tmp.iterdir() if p.name.startswith("tempera-guides-")] == []
+    again = render_guides(cli_path, user_blend, "--frames", f"1-{len(kept) + 2}", "--out", out, "--samples", "2",
+                          "--ld12e-samples", "2")
+    assert again.returncode == 0 and f"{len(kept)} already current" in again.stdout, again.stdout[-1500:]
+    assert not list(out.glob(".tempera-render-*"))

@@ -62,12 +62,15 @@ def test_manifest_is_written_atomically_and_frames_are_current_by_key(tmp_path):
     assert read["format"] == guide_cache.FORMAT_VERSION and read["frames"]["1"]["key"] == key
     assert not guide_cache.is_frame_current(tmp_path, read, 1, key)  # no EXR yet
     guide_cache.write_frame(tmp_path, 1, {"alpha": np.ones((2, 2))})
+    assert not guide_cache.is_frame_current(tmp_path, read, 1, key)  # no size and checksum recorded
+    read["frames"]["1"] = guide_cache.frame_entry(tmp_path, 1, key)
     assert guide_cache.is_frame_current(tmp_path, read, 1, key)
     assert not guide_cache.is_frame_current(tmp_path, read, 1, "other")
     assert not guide_cache.is_frame_current(tmp_path, read, 2, key)
     assert set(guide_cache.read_frame(tmp_path, 1)) == {"alpha"}
     (tmp_path / "manifest.json").write_text("{ broken")
-    assert guide_cache.read_manifest(tmp_path) is None
+    with pytest.warns(UserWarning, match="damaged"):
+        assert guide_cache.read_manifest(tmp_path) is None
 
 
 def test_vector_pass_signs():

@@ -76,7 +76,7 @@ def test_missing_files_and_guides_are_named(inputs):
     with pytest.raises(ValueError, match="guide 'LD12E' missing from '.*frame_0001.exr'"):
         job(inputs, weights={"LD12E": 1.0})
     guide_cache.write_frame(inputs / "exemplar", 2, light_paths(10))
-    with pytest.raises(ValueError, match="exemplar_frame"):
+    with pytest.raises(ValueError, match="Exemplar Frame"):
         job(inputs)
     assert job(inputs, exemplar_frame=1).frames == [1, 2, 3]
 

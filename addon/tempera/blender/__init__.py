@@ -7,6 +7,7 @@ and come back when the add-on is enabled again).
 """
 import bpy
 
+from . import job_operator, kit_operators
 from .guide_operator import TEMPERA_OT_render_guides
 from .panels import TEMPERA_PT_output
 from .preferences import TemperaPreferences
@@ -19,6 +20,7 @@ CLASSES = (
     TemperaSettings,
     TEMPERA_OT_render_guides,
     TEMPERA_OT_stylize,
+    *kit_operators.CLASSES,
     TEMPERA_PT_output,
 )
 
@@ -28,8 +30,7 @@ def register(addon_id="tempera"):
     'bl_ext.<repository>.tempera' for the extension); the preferences are
     registered under it."""
     TemperaPreferences.bl_idname = addon_id
-    for operator in (TEMPERA_OT_render_guides, TEMPERA_OT_stylize):
-        operator._running = False  # a run cut short by disabling the add-on is over
+    job_operator._set_running(None, False)  # a run cut short by disabling the add-on is over
     registered = []
     try:
         for cls in CLASSES:
@@ -38,6 +39,7 @@ def register(addon_id="tempera"):
         bpy.types.Scene.tempera = bpy.props.PointerProperty(
             type=TemperaSettings, name="Tempera", description="Tempera stylization settings"
         )
+        kit_operators.register_previews()
     except Exception:
         # Leave nothing half-registered behind: Blender does not call
         # unregister() when register() fails.
@@ -47,6 +49,7 @@ def register(addon_id="tempera"):
 
 
 def unregister():
+    kit_operators.unregister_previews()
     if hasattr(bpy.types.Scene, "tempera"):
         del bpy.types.Scene.tempera
     for cls in reversed(CLASSES):

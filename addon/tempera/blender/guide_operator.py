@@ -18,6 +18,7 @@ import os
 import time
 
 import bpy
+from bpy.props import StringProperty
 from bpy.types import Operator
 
 from .. import guide_cache
@@ -79,11 +80,51 @@ def render_guide_frame(scene, frame, folder, params, progress=None):
     return render_guides(scene, [frame], folder, params, progress)
 
 
+# A run asks before it starts when it is longer than this (UI only).
+CONFIRM_FRAMES = 50
+CONFIRM_SECONDS = 600.0
+# Rough costs on a 2-core machine (docs/benchmarks.md), per megapixel.
+CYCLES_SECONDS_PER_MPIX_SAMPLE = 0.06  # each of the two guide renders
+TRACER_SECONDS_PER_MPIX_SAMPLE = 0.03  # each light path expression
+
+
+def estimate_guide_seconds(scene, params, frames):
+    """A rough duration of rendering `frames` guide frames from scratch."""
+    r = scene.render
+    mpix = r.resolution_x * r.resolution_y * (r.resolution_percentage / 100.0) ** 2 / 1e6
+    per_frame = mpix * CYCLES_SECONDS_PER_MPIX_SAMPLE * (params["samples"] + params["ld12e_samples"])
+    per_frame += mpix * TRACER_SECONDS_PER_MPIX_SAMPLE * params["lpe_samples"] * len(params["lpe"])
+    return per_frame * frames
+
+
+def long_run_question(frames, seconds, what):
+    """The confirmation text of a run of `frames` frames taking about
+    `seconds` (frames already current are skipped, so it may be shorter), or
+    None if the run is short enough to start at once."""
+    if frames <= CONFIRM_FRAMES and seconds <= CONFIRM_SECONDS:
+        return None
+    return (f"This will {what} {frames} frames, {rough_duration(seconds)} on a 2-core machine.\n"
+            "Frames already done are skipped; Esc stops after the frame at hand.\nStart?")
+
+
+def rough_duration(seconds):
+    """'about 40 seconds', 'about 12 minutes', 'about 3 hours 5 minutes'."""
+    if seconds < 90:
+        return f"about {max(1, round(seconds))} seconds"
+    if seconds < 2 * 3600:
+        return f"about {round(seconds / 60)} minutes"
+    hours, minutes = divmod(round(seconds / 60), 60)
+    return f"about {hours} hours {minutes} minutes"
+
+
 def format_duration(seconds):
     seconds = int(round(seconds))
     hours, rest = divmod(seconds, 3600)
     minutes, secs = divmod(rest, 60)
     return f"{hours}:{minutes:02d}:{secs:02d}" if hours else f"{minutes}:{secs:02d}"
+
+
+ETA_AFTER_FRAMES = 2  # frames actually computed before an ETA is shown
 
 
 class GuideJob:
@@ -152,16 +193,18 @@ class GuideJob:
         return report
 
     def eta_seconds(self):
-        """Time left if the remaining frames take as long as the rendered ones (None: no estimate yet)."""
-        if not self.rendered:
+        """Time left if the remaining frames take as long as the rendered
+        ones; None until it means something: two frames rendered (the first
+        one also pays Cycles' start-up) and at least one still to do."""
+        if len(self.rendered) < ETA_AFTER_FRAMES or self.index >= self.total:
             return None
         return self.render_seconds / len(self.rendered) * (self.total - self.index)
 
     def status_text(self):
         eta = self.eta_seconds()
-        eta_text = "…" if eta is None else format_duration(eta)
+        eta_text = "" if eta is None else f", ETA {format_duration(eta)}"
         current = min(self.index + 1, self.total)
-        return f"Tempera: guides frame {current}/{self.total}, ETA {eta_text} (Esc to stop)"
+        return f"Tempera: guides frame {current}/{self.total}{eta_text} (Esc to stop)"
 
     def summary(self):
         parts = [f"{len(self.rendered)} rendered"]
@@ -177,7 +220,7 @@ class GuideJob:
 
 @functools.lru_cache(maxsize=16)
 def _current_frames(folder, manifest_mtime_ns, params_json, fingerprint_json, frames):
-    manifest = guide_cache.read_manifest(folder)
+    manifest = guide_cache.read_manifest(folder, set_aside=False)  # draw() moves no files
     if not manifest:
         return 0
     params = json.loads(params_json)
@@ -185,21 +228,44 @@ def _current_frames(folder, manifest_mtime_ns, params_json, fingerprint_json, fr
     current = 0
     for frame in frames:
         fingerprint["frame"] = frame
-        if guide_cache.is_frame_current(folder, manifest, frame, guide_cache.frame_key(params, fingerprint)):
+        key = guide_cache.frame_key(params, fingerprint)
+        if guide_cache.is_frame_current(folder, manifest, frame, key, verify=False):  # size only: draw() is no place to hash files
             current += 1
     return current
+
+
+# Light Path Expressions field text -> what is wrong with it (None: fine),
+# filled by the field's update callback (properties.py), never by draw():
+# compiling an expression may take a while, and draw() runs on every redraw.
+LPE_PROBLEMS = {}
+
+
+def check_lpe_field(text):
+    """Checks the field's expressions once per text (the update callback)."""
+    if text not in LPE_PROBLEMS:
+        if len(LPE_PROBLEMS) > 64:
+            LPE_PROBLEMS.clear()
+        try:
+            check_lpe_expressions(guide_cache.split_expressions(text))
+            LPE_PROBLEMS[text] = None
+        except GuideRenderError as exc:
+            LPE_PROBLEMS[text] = str(exc)
+    return LPE_PROBLEMS[text]
 
 
 def cache_status(scene):
     """(text, icon) for the panel: how many frames of the range are in the
     cache and current. Reads the manifest only (cached per manifest version
-    and scene state); never renders."""
+    and scene state); never renders, never compiles an expression (a problem
+    found by the field's update callback is shown)."""
     settings = scene.tempera
     try:
+        problem = LPE_PROBLEMS.get(settings.guide_lpe)
+        if problem:
+            raise GuideRenderError(problem)
         folder = resolve_guide_dir(settings.guide_dir)
         frames = guide_frames(scene, settings)
         check_scene(scene)
-        check_lpe_expressions(guide_cache.split_expressions(settings.guide_lpe))
     except (ValueError, GuideRenderError) as exc:
         return str(exc), "ERROR"
     try:
@@ -226,16 +292,14 @@ class TEMPERA_OT_render_guides(JobOperator, Operator):
     bl_options = {"REGISTER"}
 
     job_errors = (ValueError, GuideRenderError)
-
-    @classmethod
-    def poll(cls, context):
-        if cls._running:
-            cls.poll_message_set("Tempera is already rendering guides")
-            return False
-        return context.scene is not None and hasattr(context.scene, "tempera")
+    question: StringProperty(options={"SKIP_SAVE", "HIDDEN"})  # the confirmation of a long run
 
     def make_job(self, context):
         return GuideJob.from_settings(context.scene)
+
+    def confirmation(self, job):
+        return long_run_question(len(job.frames), estimate_guide_seconds(job.scene(), job.params, len(job.frames)),
+                                 "render the guides of")
 
     def job_finished(self, context, job):
         for warning in job.warnings:  # approximations of the light-path tracer, e.g. unsupported nodes

@@ -13,7 +13,10 @@ Every setting changed for this (render, Cycles, passes, view layers, frame,
 objects' pass index) is put back exactly afterwards by GuideRenderSettings:
 the user's file is never left changed.
 """
-import tempfile
+import math
+import os
+import secrets
+import shutil
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -22,6 +25,7 @@ import numpy as np
 
 from .. import guide_cache, guides, image_info, read_image
 from . import compat
+from ..frames import MAX_FRAME, check_frame
 from ..lpe import check_lpe, trace_lpe
 from ..stylize import tonemap
 from .scene_export import SceneExportError, evaluated_depsgraph, export_scene, path_settings
@@ -151,6 +155,40 @@ def check_lpe_expressions(expressions):
         if name in seen:
             raise GuideRenderError(f"Light path expression {i} '{expression}' repeats expression {seen[name]}.")
         seen[name] = i
+
+
+# Valid ranges of the numeric guide parameters: (low, high, what it is);
+# checked before anything is rendered, so no value can crash the renderer.
+PARAM_RANGES = {
+    "samples": (1, 1 << 20, "Cycles samples"),
+    "ld12e_samples": (1, 1 << 20, "Cycles samples of the LD{1,2}E render"),
+    "seed": (0, (1 << 31) - 1, "Cycles seed"),
+    "occlusion_epsilon": (1e-6, 1e6, "occlusion epsilon (squared pixels)"),
+    "tensor_sigma": (0.0, 1000.0, "structure tensor sigma (pixels)"),
+    "line_depth_threshold": (0.0, 1e30, "line depth threshold"),
+    "line_normal_angle": (0.0, 180.0, "line normal angle (degrees)"),
+    "line_d_max": (1e-3, 1e6, "line distance max (pixels)"),
+    "lpe_samples": (1, 1 << 20, "path-tracer samples"),
+}
+INT_PARAMS = {"samples", "ld12e_samples", "seed", "lpe_samples"}
+MASK_MODES = ("objects+collections", "objects", "collections", "none")
+
+
+def check_params(params):
+    """Raises ValueError naming the first guide parameter out of its range."""
+    for name, (low, high, what) in PARAM_RANGES.items():
+        value = params[name]
+        integral = isinstance(value, int) and not isinstance(value, bool)
+        if name in INT_PARAMS and not integral:
+            raise ValueError(f"{name} ({what}) must be a whole number, got {value!r}")
+        if not integral and not isinstance(value, float):
+            raise ValueError(f"{name} ({what}) must be a number, got {value!r}")
+        if not (math.isfinite(value) and low <= value <= high):
+            raise ValueError(f"{name} ({what}) must be from {low:g} to {high:g}, got {value!r}")
+    if params["masks"] not in MASK_MODES:
+        raise ValueError(f"masks must be one of {', '.join(MASK_MODES)}, got {params['masks']!r}")
+    if not isinstance(params["orientation_aov"], str):
+        raise ValueError(f"orientation_aov must be a string, got {params['orientation_aov']!r}")
 
 
 def trace_lpe_guides(scene, layer, frame, size, params, paths=None):
@@ -432,29 +470,74 @@ def render_guides(scene, frames, out_dir, params=None, progress=None):
     # A list of stripped strings: as JSON gives it back, so that the manifest's params compare equal.
     lpe = params["lpe"]
     params["lpe"] = lpe if isinstance(lpe, str) else [e.strip() if isinstance(e, str) else e for e in lpe]
+    check_params(params)
     check_lpe_expressions(params["lpe"])
     check_scene(scene)
-    frames = sorted({int(f) for f in frames})
+    if isinstance(frames, range) and len(frames) > MAX_FRAME + 1:
+        raise ValueError(f"render_guides: {len(frames)} frames; Blender has frames 0-{MAX_FRAME} only")
+    frames = sorted({check_frame(f) for f in frames})
     if not frames:
         raise ValueError("render_guides: no frames to render")
     out_dir = Path(out_dir)
-    manifest = guide_cache.read_manifest(out_dir) or {}
+    report = {"rendered": [], "skipped": [], "manifest": out_dir / guide_cache.MANIFEST_NAME, "warnings": []}
+    warn = report["warnings"].append  # a damaged manifest set aside is said in the report
+    manifest = guide_cache.read_manifest(out_dir, warn) or {}
     if manifest.get("params") != params:
         manifest = {}  # other parameters: no cached frame can be current
-    report = {"rendered": [], "skipped": [], "manifest": out_dir / guide_cache.MANIFEST_NAME, "warnings": []}
     paths = path_settings(scene)  # the user's, before the Cycles guides change them
     with shown_in_window(scene), guide_render_settings(scene):
         keys = {f: guide_cache.frame_key(params, scene_fingerprint(scene, f)) for f in frames}
         todo = [f for f in frames if not guide_cache.is_frame_current(out_dir, manifest, f, keys[f])]
         report["skipped"] = [f for f in frames if f not in todo]
-        if _forget_stale_frames(scene, manifest, out_dir, params) and not todo:
-            guide_cache.write_manifest(out_dir, manifest)
+        if _has_stale_frames(scene, manifest, out_dir, params) and not todo:
+            guide_cache.update_manifest(out_dir, lambda m: _forget_stale_frames(scene, m, out_dir, params), warn)
         if todo:
-            with tempfile.TemporaryDirectory(prefix="tempera-guides-") as tmp:
-                report["warnings"] = _render_frames(scene, todo, keys, manifest, out_dir, Path(tmp), params,
-                                                    progress, paths)
+            out_dir.mkdir(parents=True, exist_ok=True)
+            with _work_folder(out_dir) as tmp:
+                report["warnings"] += _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress,
+                                                     warn, paths)
         report["rendered"] = todo
     return report
+
+
+WORK_PREFIX = ".tempera-render-"
+
+
+@contextmanager
+def _work_folder(out_dir):
+    """A folder for the renders in progress, inside the cache (same file
+    system, so nothing is left in the system's temporary folder), holding a
+    lock while its run lives. Folders of runs that died (kill -9, power cut)
+    are removed here: their lock is free."""
+    import fcntl
+
+    for old in out_dir.glob(WORK_PREFIX + "*"):
+        try:
+            fd = os.open(old, os.O_RDONLY | os.O_DIRECTORY)
+        except OSError:
+            continue
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            shutil.rmtree(old, ignore_errors=True)
+        except OSError:
+            pass  # a live run holds it
+        finally:
+            os.close(fd)
+    tmp = out_dir / f"{WORK_PREFIX}{os.getpid()}-{secrets.token_hex(4)}"
+    tmp.mkdir()
+    fd = os.open(tmp, os.O_RDONLY | os.O_DIRECTORY)  # locked through itself while this run lives
+    fcntl.flock(fd, fcntl.LOCK_EX)
+    try:
+        yield tmp
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+        os.close(fd)
+
+
+def _has_stale_frames(scene, manifest, out_dir, params):
+    return any(not guide_cache.is_frame_current(
+        out_dir, manifest, int(f), guide_cache.frame_key(params, scene_fingerprint(scene, int(f))), verify=False)
+        for f in manifest.get("frames", {}))
 
 
 def _forget_stale_frames(scene, manifest, out_dir, params):
@@ -462,7 +545,7 @@ def _forget_stale_frames(scene, manifest, out_dir, params):
     scene (the manifest lists only current frames). True if any was dropped."""
     entries = manifest.get("frames", {})
     stale = [f for f in entries if not guide_cache.is_frame_current(
-        out_dir, manifest, int(f), guide_cache.frame_key(params, scene_fingerprint(scene, int(f))))]
+        out_dir, manifest, int(f), guide_cache.frame_key(params, scene_fingerprint(scene, int(f))), verify=False)]
     for f in stale:
         del entries[f]
     if stale and entries:
@@ -478,7 +561,7 @@ def uses_freestyle(scene, layer):
     return scene.render.use_freestyle and layer.use_freestyle and drawing
 
 
-def _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress, paths=None):
+def _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress, warn=None, paths=None):
     layer = guide_view_layer(scene)
     masks = assign_pass_indices(scene, params["masks"])
     main_passes = {**MAIN_PASSES, "Freestyle": "RGBA"} if uses_freestyle(scene, layer) else dict(MAIN_PASSES)
@@ -486,16 +569,20 @@ def _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress, 
         check_orientation_aov(scene, layer, params["orientation_aov"])
         main_passes[params["orientation_aov"]] = "RGB"  # declared AOVs are written with every render
     total = len(todo)
+    todo_set = set(todo)
 
     def step(done, message):
         if progress:
             progress(done, total, message)
 
-    # 1. The renders of every frame to do, kept in `tmp` until all are done:
-    #    occlusion needs the velocities of the neighbouring frames.
+    # Occlusion needs the velocities of the neighbouring frames, so a frame is
+    # finished once the next one is rendered (or is not to be rendered); then
+    # its EXR goes into the cache atomically and its entry into the manifest.
+    # An interrupted run keeps every frame finished so far, and `tmp` holds at
+    # most three frames' renders.
     renders = {}
-    for i, frame in enumerate(todo):
-        step(i, f"rendering frame {frame}")
+
+    def render(frame):
         _configure(scene, layer, params["samples"], main_passes, params["seed"])
         main = _render(scene, tmp / f"main_{frame}.exr", frame)
         _configure(scene, layer, params["ld12e_samples"], LD12E_PASSES, params["seed"])
@@ -503,12 +590,15 @@ def _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress, 
             ld12e = _render(scene, tmp / f"ld12e_{frame}.exr", frame)
         renders[frame] = (main, ld12e)
 
+    finished = {}  # frame -> manifest entry, of this run
+
     def vector_pass(frame):
-        """Vector pass of a neighbouring frame: rendered now, in the cache, or
-        from a quick motion-only render (one sample: only its velocities are used)."""
+        """Vector pass of a neighbouring frame: rendered now, finished in this
+        run, in the cache, or from a quick motion-only render (one sample:
+        only its velocities are used)."""
         if frame in renders:
             return _read_passes(renders[frame][0], layer.name, {"Vector": "XYZW"})["Vector"]
-        if guide_cache.is_frame_current(out_dir, manifest, frame, keys.get(frame)):
+        if frame in finished or guide_cache.is_frame_current(out_dir, manifest, frame, keys.get(frame)):
             cached = guide_cache.read_frame(out_dir, frame, ["velocity_backward", "velocity_forward"])
             back, fwd = cached["velocity_backward"], cached["velocity_forward"]
             return np.dstack([-back[:, :, 0], back[:, :, 1], -fwd[:, :, 0], fwd[:, :, 1]])  # inverse conversion
@@ -516,10 +606,9 @@ def _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress, 
         path = _render(scene, tmp / f"motion_{frame}.exr", frame)
         return _read_passes(path, layer.name, MOTION_PASSES)["Vector"]
 
-    # 2. Derived and traced guides, one cache EXR per frame, manifest after each.
-    frame_entries = manifest.get("frames", {})
     warnings = []
-    for i, frame in enumerate(todo):
+
+    def finish(i, frame):
         main = _read_passes(renders[frame][0], layer.name, main_passes)
         ld12e = _read_passes(renders[frame][1], layer.name, LD12E_PASSES)
         _, v_plus_prev = guide_cache.velocities_from_vector_pass(vector_pass(frame - 1))
@@ -530,12 +619,37 @@ def _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress, 
             step(i, f"tracing the light path expressions of frame {frame}")
             traced, frame_warnings = trace_lpe_guides(scene, layer, frame, (width, height), params, paths)
             frame_data.update(traced)
-            warnings += [w for w in frame_warnings if w not in warnings]
-        path = guide_cache.write_frame(out_dir, frame, frame_data)
-        frame_entries[str(frame)] = {"key": keys[frame], "file": path.name}
-        manifest = _manifest(scene, layer, params, frame_entries, list(frame_data), masks, (width, height))
-        guide_cache.write_manifest(out_dir, manifest)
+            warnings.extend(w for w in frame_warnings if w not in warnings)
+        guide_cache.write_frame(out_dir, frame, frame_data)
+        finished[frame] = guide_cache.frame_entry(out_dir, frame, keys[frame])
+        guide_names = list(frame_data)
+
+        def merge(on_disk):
+            # Under the folder's lock: other runs (a farm) add their frames too.
+            if on_disk.get("params") != params:
+                on_disk.clear()  # made with other parameters: none of its frames is current for us
+            entries = on_disk.get("frames", {})
+            entries.update({str(f): e for f, e in finished.items()})
+            on_disk.clear()
+            on_disk.update(_manifest(scene, layer, params, entries, guide_names, masks, (width, height)))
+
+        nonlocal manifest
+        manifest = guide_cache.update_manifest(out_dir, merge, warn)
+        for old in [f for f in renders if f < frame]:  # no later frame needs them
+            for path in renders.pop(old):
+                Path(path).unlink(missing_ok=True)
         step(i + 1, f"guides of frame {frame} written")
+
+    done = 0
+    for frame in todo:
+        step(done, f"rendering frame {frame}")
+        render(frame)
+        if frame - 1 in todo_set and frame - 1 not in finished:
+            finish(done, frame - 1)
+            done += 1
+        if frame + 1 not in todo_set:
+            finish(done, frame)
+            done += 1
     return warnings
 
 

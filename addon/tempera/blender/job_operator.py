@@ -27,16 +27,42 @@ from .. import Cancelled
 
 TIMER_STEP = 0.1  # seconds between timer ticks: redraws and Esc are seen this often
 
+# The Tempera job running in this Blender, if any (its operator's label):
+# one at a time, whichever operator started it (see JobOperator.poll).
+_RUNNING = {"label": None}
+
+
+def running_job():
+    """The label of the Tempera job running now ("Render Guides", "Stylize"), or None."""
+    return _RUNNING["label"]
+
+
+def _set_running(operator, running):
+    _RUNNING["label"] = (getattr(operator, "bl_label", None) or type(operator).__name__) if running else None
+
 
 class JobOperator:
     """Mix-in for bpy.types.Operator subclasses; they define make_job(context)
     returning the job or raising one of job_errors (reported, nothing done)."""
 
     job_errors = (ValueError,)
-    _running = False  # one run per operator class at a time (see poll)
+
+    @classmethod
+    def poll(cls, context):
+        """Disabled while any Tempera job runs in this Blender (rendering
+        guides and stylizing share the scene's renders and output folders)."""
+        label = running_job()
+        if label is not None:
+            cls.poll_message_set(f"Tempera is busy ({label} is running; Esc stops it)")
+            return False
+        return context.scene is not None and hasattr(context.scene, "tempera")
 
     def make_job(self, context):
         raise NotImplementedError
+
+    def confirmation(self, job):
+        """A question to ask before a long run in the UI, or None (no question)."""
+        return None
 
     def job_finished(self, context, job):
         """Called once after the last step (not when stopped or failed)."""
@@ -75,11 +101,13 @@ class JobOperator:
     # -- background / scripts: every step now
 
     def execute(self, context):
+        if getattr(self, "question", "") and not bpy.app.background and context.window is not None:
+            return self._execute_confirmed(context)
         job = self._start(context)
         if job is None:
             return {"CANCELLED"}
         wm = context.window_manager
-        type(self)._running = True
+        _set_running(self, True)
         wm.progress_begin(0, job.total)
         try:
             while not job.finished:
@@ -91,7 +119,7 @@ class JobOperator:
                 wm.progress_update(job.index)
         finally:
             wm.progress_end()
-            type(self)._running = False
+            _set_running(self, False)
         self._complete(context, job)
         return {"FINISHED"}
 
@@ -103,20 +131,43 @@ class JobOperator:
         job = self._start(context)
         if job is None:
             return {"CANCELLED"}
+        question = self.confirmation(job)
+        if question and hasattr(self, "question"):
+            # A dialog first; its OK calls execute(), which then goes modal too.
+            self.question = question
+            return context.window_manager.invoke_props_dialog(self, width=460)
+        self._begin(context, job)
+        return {"RUNNING_MODAL"}
+
+    def draw(self, _context):
+        """The confirmation dialog's text (one label per line)."""
+        for line in getattr(self, "question", "").split("\n"):
+            self.layout.label(text=line)
+
+    def _execute_confirmed(self, context):
+        """execute() after the confirmation dialog's OK, in the UI: modal."""
+        job = self._start(context)
+        if job is None:
+            return {"CANCELLED"}
         self._begin(context, job)
         return {"RUNNING_MODAL"}
 
     def _begin(self, context, job):
+        self._over = False
         self._job_state = job
         self._worker, self._future, self._fraction, self._stop = None, None, 0.0, False
         wm = context.window_manager
-        type(self)._running = True
+        _set_running(self, True)
         self._timer = wm.event_timer_add(TIMER_STEP, window=context.window)
         wm.modal_handler_add(self)
         wm.progress_begin(0, job.total)
         self._show(context, job)
 
     def modal(self, context, event):
+        if getattr(self, "_over", False):
+            # A copy of this handler (Blender copies a window's handlers into
+            # a window opened meanwhile) must not step a finished job again.
+            return {"FINISHED"}
         job = self._job_state
         if event.type == "ESC" and event.value == "PRESS":
             self._stop = True
@@ -190,6 +241,7 @@ class JobOperator:
         _redraw_properties(context)
 
     def _finish(self, context):
+        self._over = True
         wm = context.window_manager
         if getattr(self, "_timer", None) is not None:
             wm.event_timer_remove(self._timer)
@@ -201,7 +253,7 @@ class JobOperator:
         if context.workspace is not None:
             context.workspace.status_text_set(None)
         _redraw_properties(context)
-        type(self)._running = False
+        _set_running(self, False)
 
 
 class _Finished:

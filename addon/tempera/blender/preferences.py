@@ -4,7 +4,7 @@ import functools
 from bpy.props import StringProperty
 from bpy.types import AddonPreferences
 
-from .. import cli
+from .. import __version__, cli
 
 # The legacy add-on's module name; the extension registers the preferences under
 # its own ("bl_ext.<repository>.tempera", see tempera.blender.register).
@@ -42,6 +42,7 @@ class TemperaPreferences(AddonPreferences):
     def draw(self, _context):
         layout = self.layout
         layout.use_property_split = True
+        layout.label(text=f"Tempera {__version__}")
         layout.prop(self, "cli_path")
         ok, text = cli_status(self.cli_path)
         layout.label(text=text, icon="CHECKMARK" if ok else "INFO")

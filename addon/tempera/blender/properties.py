@@ -5,6 +5,7 @@ from bpy.types import PropertyGroup
 
 from .. import guide_cache
 from .. import settings as limits
+from ..frames import MAX_FRAME
 
 DEFAULT_GUIDE_DIR = "//tempera/guides/"
 
@@ -75,6 +76,12 @@ def _keep_patch_size_odd(self, _context):
         self.patch_size = size  # re-runs this callback once, with an odd value
 
 
+def _check_lpe_field(self, _context):
+    from .guide_operator import check_lpe_field  # compiled here, once per text, never in draw()
+
+    check_lpe_field(self.guide_lpe)
+
+
 def _keep_guide_start_before_end(self, _context):
     if self.guide_frame_end < self.guide_frame_start:
         self.guide_frame_end = self.guide_frame_start
@@ -88,7 +95,8 @@ def _keep_guide_end_after_start(self, _context):
 class TemperaSettings(PropertyGroup):
     output_dir: StringProperty(
         name="Output Folder",
-        description="Folder for Tempera's guide passes and stylized frames; "
+        description="Where Stylize writes its results: the stylized frames (in frames/, with their resume "
+        "record), contact_sheet.png and stylized.mp4. The guide passes go to the Guide Folder. "
         "'//' is relative to the .blend file",
         subtype="DIR_PATH",
         default=limits.DEFAULT_OUTPUT_DIR,
@@ -124,22 +132,24 @@ class TemperaSettings(PropertyGroup):
     )
     guide_frame_range: EnumProperty(
         name="Frames",
-        description="Frames of Render Guides and Stylize Animation (frames already done and current are skipped)",
+        description="Frames of Stylize Animation and Render Guides (frames already done and current are skipped)",
         items=GUIDE_FRAME_RANGES,
         default="SCENE",
     )
     guide_frame_start: IntProperty(
         name="Start",
-        description="First frame of the custom guide range",
+        description="First frame of the custom range",
         default=1,
         min=0,
+        max=MAX_FRAME,
         update=_keep_guide_start_before_end,
     )
     guide_frame_end: IntProperty(
         name="End",
-        description="Last frame of the custom guide range (included)",
+        description="Last frame of the custom range (included)",
         default=250,
         min=0,
+        max=MAX_FRAME,
         update=_keep_guide_end_after_start,
     )
     guide_samples: IntProperty(
@@ -151,8 +161,10 @@ class TemperaSettings(PropertyGroup):
     )
     guide_occlusion_epsilon: FloatProperty(
         name="Occlusion Epsilon",
-        description="Tolerance of the occlusion guides in squared pixels: a pixel whose motion disagrees "
-        "with its neighbour frame's by more than this counts as (dis)occluded",
+        description="How far (in squared pixels) a pixel's motion may disagree with the neighbouring frame's "
+        "before it counts as hidden or newly revealed. There the temporal guide lets go and fresh paint "
+        "is made. Lower: more fresh paint at edges (more flicker); higher: paint smears across "
+        "occlusions. Typical 1-4 (default 2)",
         default=guide_cache.DEFAULT_PARAMS["occlusion_epsilon"],
         min=0.01,
         soft_max=20.0,
@@ -179,6 +191,7 @@ class TemperaSettings(PropertyGroup):
                      "S glossy/specular, T transmission, E eye; . any, * + ? {m,n} [..] | (..). "
                      "E.g. 'L.*SDE; LD{2}E' (caustics; second diffuse bounce)"),
         default="; ".join(guide_cache.DEFAULT_PARAMS["lpe"]),
+        update=_check_lpe_field,
     )
     guide_lpe_samples: IntProperty(
         name="LPE Samples",

@@ -16,6 +16,11 @@ from .. import guide_cache
 from ..frames import parse_frames
 from .guide_render import GuideRenderError, render_guides
 
+# Exit statuses, mapped by the `tempera` CLI (native/cli/render_guides_command.cpp):
+EXIT_BAD_VALUE = 2  # a bad option value or scene setting (argparse uses 2 too)
+EXIT_FILE_ERROR = 3  # a file that cannot be read or written (the CLI reports 1)
+EXIT_INTERRUPTED = 130
+
 # Command-line flags for the guide parameters (see guide_cache.DEFAULT_PARAMS).
 PARAM_FLAGS = {
     "samples": ("--samples", int),
@@ -66,8 +71,15 @@ def main():
         report = render_guides(scene, frames, args.out, params, progress)
         for warning in report["warnings"]:
             print(f"tempera render-guides: warning: {warning}", flush=True)
-    except (GuideRenderError, ValueError, OSError) as exc:
+    except (GuideRenderError, ValueError) as exc:
         print(f"tempera render-guides: error: {exc}", file=sys.stderr, flush=True)
-        sys.exit(1)
+        sys.exit(EXIT_BAD_VALUE)
+    except OSError as exc:
+        print(f"tempera render-guides: error: {exc}", file=sys.stderr, flush=True)
+        sys.exit(EXIT_FILE_ERROR)
+    except KeyboardInterrupt:
+        print("tempera render-guides: interrupted; the frames finished so far are in the cache, rerun the same "
+              "command to render the rest", file=sys.stderr, flush=True)
+        sys.exit(EXIT_INTERRUPTED)
     print(f"tempera render-guides: rendered {len(report['rendered'])} frame(s), "
           f"{len(report['skipped'])} already current; manifest {report['manifest']}", flush=True)

@@ -21,15 +21,18 @@ import time
 
 import bpy
 from bpy.types import Operator
-from bpy.props import EnumProperty
+from bpy.props import EnumProperty, StringProperty
 
 from .. import kit, settings as limits
-from .guide_operator import GuideJob, format_duration, guide_frames, resolve_guide_dir
+from .guide_operator import (ETA_AFTER_FRAMES, GuideJob, estimate_guide_seconds, format_duration, guide_frames,
+                             long_run_question, resolve_guide_dir)
 from .guide_render import GuideRenderError
 from .job_operator import JobOperator
 from .properties import WEIGHT_PROPERTIES
 from . import results
 
+# Rough stylizing cost per megapixel on a 2-core machine (docs/benchmarks.md).
+STYLIZE_SECONDS_PER_MPIX = {"final": 40.0, "preview": 8.0}
 FRAMES_DIR = "frames"
 CONTACT_SHEET = "contact_sheet.png"
 VIDEO = "stylized.mp4"
@@ -159,18 +162,28 @@ class StylizeRun:
         return f"{what} of frame {self.current_frame()} failed: {exc}"
 
     def eta_seconds(self):
+        """Time left stylizing, once it means something: two frames actually
+        stylized (the first also reads the painting and guides) and more to do."""
         stylized = [r for r in self.results if r["status"] == "stylized"]
-        if not stylized:
+        left = len(self.frames) - len(self.results)
+        if len(stylized) < ETA_AFTER_FRAMES or left <= 0:
             return None
-        return self.stylize_seconds / len(stylized) * (len(self.frames) - len(self.results))
+        return self.stylize_seconds / len(stylized) * left
 
     def status_text(self):
         if self.in_guide_phase:
             return self.guides.status_text()
         eta = self.eta_seconds()
         current = min(len(self.results) + 1, len(self.frames))
-        return (f"Tempera: stylizing frame {current}/{len(self.frames)}, "
-                f"ETA {'…' if eta is None else format_duration(eta)} (Esc to stop)")
+        eta_text = "" if eta is None else f", ETA {format_duration(eta)}"
+        return f"Tempera: stylizing frame {current}/{len(self.frames)}{eta_text} (Esc to stop)"
+
+    def estimate_seconds(self, scene):
+        """A rough duration of the whole run from scratch (guides and stylizing)."""
+        r = scene.render
+        mpix = r.resolution_x * r.resolution_y * (r.resolution_percentage / 100.0) ** 2 / 1e6
+        per_frame = mpix * STYLIZE_SECONDS_PER_MPIX.get(self.config["quality"], STYLIZE_SECONDS_PER_MPIX["final"])
+        return estimate_guide_seconds(scene, self.guides.params, len(self.frames)) + per_frame * len(self.frames)
 
     def mean_flicker(self):
         values = [r["flicker"] for r in self.results if r.get("flicker") is not None and r["flicker"] == r["flicker"]]
@@ -186,8 +199,15 @@ class StylizeRun:
         if left:
             parts.append(f"{left} not done")
         flicker = self.mean_flicker()
-        tail = f", flicker {flicker:.3f}" if flicker is not None else ""
+        tail = f". {flicker_text(flicker)}" if flicker is not None else ""
         return f"Tempera: {', '.join(parts)} in {self.config['out']}{tail}"
+
+
+def flicker_text(flicker):
+    """The flicker figure, said so that an artist can read it."""
+    verdict = "steady" if flicker < 0.02 else "some flicker" if flicker < 0.05 else "strong flicker"
+    return (f"Flicker {flicker:.3f} ({verdict}: the mean colour change between frames along the motion; "
+            "below 0.02 looks steady, raise Temporal Coherence to lower it)")
 
 
 # --------------------------------------------------------------------------- operator
@@ -208,6 +228,7 @@ class TEMPERA_OT_stylize(JobOperator, Operator):
     )
 
     job_errors = (ValueError, OSError, GuideRenderError)
+    question: StringProperty(options={"SKIP_SAVE", "HIDDEN"})  # the confirmation of a long run
 
     @classmethod
     def description(cls, _context, properties):
@@ -216,36 +237,51 @@ class TEMPERA_OT_stylize(JobOperator, Operator):
         return ("Stylize the frame range with the exemplar: renders missing guides, then paints every frame "
                 "(frames already done with the same settings are skipped; Esc stops)")
 
-    @classmethod
-    def poll(cls, context):
-        if cls._running:
-            cls.poll_message_set("Tempera is already stylizing")
-            return False
-        return context.scene is not None and hasattr(context.scene, "tempera")
-
     def make_job(self, context):
         return StylizeRun.from_settings(context.scene, self.mode)
 
+    def confirmation(self, job):
+        if job.mode != "ANIMATION":
+            return None
+        return long_run_question(len(job.frames), job.estimate_seconds(bpy.data.scenes[job.guides.scene_name]),
+                                 "stylize")
+
     def job_finished(self, context, job):
-        settings = context.scene.tempera
-        frames_dir = job.config["out"]
+        scene = context.scene
+        settings = scene.tempera
         paths = [r["path"] for r in job.results]
+        results.reload_images_under(job.out)  # images already open show this run's pixels
+        shown = []
         if job.mode == "ANIMATION":
             sheet = os.path.join(job.out, CONTACT_SHEET)
             job.job.write_contact_sheet(sheet)
+            shown.append(f"contact sheet {sheet}")
             if settings.make_video:
-                self._encode_video(context.scene, job)
-        results.load(context.scene, paths, job.frames, settings.load_result if job.mode == "ANIMATION" else "IMAGE")
+                video = self._encode_video(scene, job)
+                if video:
+                    shown.append(f"video {video}")
+        how = settings.load_result if job.mode == "ANIMATION" else "IMAGE"
+        loaded = results.load(scene, paths, job.frames, how)
+        where = results.show(context, loaded, how)
+        if where:
+            shown.insert(0, where)
         for warning in job.warnings:
             self.report({"WARNING"}, warning)
+        if shown:
+            self.report({"INFO"}, "Tempera: " + "; ".join(shown))
 
     def _encode_video(self, scene, job):
+        """Encodes the mp4; its path, or None (reported why)."""
         from ..stylize import encode_video
 
         if job.config["format"] != "png":
             self.report({"INFO"}, "No mp4: the video is made from PNG frames (Format is OpenEXR)")
-            return
-        pattern = os.path.join(job.config["out"], "frame_%04d.png")
+            return None
+        # A '%' in the folder would be read by ffmpeg as a number of its own.
+        pattern = os.path.join(job.config["out"].replace("%", "%%"), "frame_%04d.png")
         fps = scene.render.fps / scene.render.fps_base
-        if not encode_video(pattern, job.frames[0], os.path.join(job.out, VIDEO), fps):
+        video = os.path.join(job.out, VIDEO)
+        if not encode_video(pattern, job.frames[0], video, fps):
             self.report({"WARNING"}, "ffmpeg not found: no mp4 written (the frames are there)")
+            return None
+        return video

@@ -1,6 +1,7 @@
 #pragma once
 // Reading and writing images through OpenImageIO: PNG, JPEG, TIFF, EXR (and
 // whatever else OIIO knows). Multilayer EXR channels are selected by name.
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,19 @@ struct ImageFileInfo {
   int height = 0;
   std::vector<std::string> channel_names;
 };
+
+// Images whose header declares more pixels than this are refused (IoError)
+// before any pixel memory is allocated: a 74-byte PNG can declare 12000².
+// 50 Mpix by default (8K UHD fits); TEMPERA_MAX_IMAGE_PIXELS or
+// set_max_image_pixels() (CLI --max-image-pixels) change it.
+constexpr std::int64_t kDefaultMaxImagePixels = 50'000'000;
+std::int64_t max_image_pixels();
+void set_max_image_pixels(std::int64_t pixels);
+
+// ".<stem>.tmp<pid>-<16 random hex digits><extension>": a temporary file name
+// no other process writing into the same folder picks (even one with the same
+// process ID, as in containers).
+std::string temporary_name(const std::string& stem, const std::string& extension);
 
 // Size and channel names of an image file without reading its pixels.
 ImageFileInfo inspect_image(const std::string& path);

@@ -17,7 +17,11 @@ using StructureTensorField = Image;
 // Structure tensor of `gray`: the mean of the first 3 channels (or the only
 // one) is differentiated with Sobel filters, and the tensor components are
 // smoothed with a separable Gaussian of standard deviation `sigma` pixels
-// (0: no smoothing). Borders replicate the edge pixels.
+// (0: no smoothing, at most kMaxStructureTensorSigma, else ValueError). Borders
+// replicate the edge pixels; the kernel is clamped to the image (exactly: the
+// taps beyond it all read the edge pixel), so a huge sigma costs no more
+// than one as wide as the image.
+constexpr float kMaxStructureTensorSigma = 1000.0f;
 StructureTensorField structure_tensor(const ImageView& gray, float sigma = 2.0f);
 
 // (angle, coherence) per pixel from a 3-channel tensor: angle in [0, π) of

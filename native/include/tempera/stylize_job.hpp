@@ -42,6 +42,7 @@ class StylizeJob {
   explicit StylizeJob(StylizeJobConfig config);
 
   const std::vector<int>& frames() const { return config_.frames; }
+  // What was fixed on the way: a resampled painting, a damaged resume record set aside.
   const std::vector<std::string>& warnings() const { return warnings_; }
   std::string output_path(int frame) const;
   std::string report_path() const;
@@ -56,6 +57,7 @@ class StylizeJob {
 
  private:
   std::string target_path(int frame) const;
+  std::string lock_path() const;  // guards the report's read-merge-write
   bool has_temporal_predecessor(std::size_t index) const;
   void check_target_guides(const std::vector<std::string>& names);
 
