@@ -72,7 +72,13 @@ void write_stats(const std::string& path, const SynthesisResult& r, const Synthe
   out << "  ]\n}\n";
   out.close();
   if (!out) throw IoError(concat("cannot write stats file '", path, "'"));
-  std::rename((path + ".tmp").c_str(), path.c_str());
+  std::error_code ec;
+  std::filesystem::rename(path + ".tmp", path, ec);
+  if (ec) {
+    const std::string why = ec.message();
+    std::filesystem::remove(path + ".tmp", ec);
+    throw IoError(concat("cannot move the stats file into place at '", path, "': ", why));
+  }
 }
 
 }  // namespace

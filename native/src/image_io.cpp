@@ -240,8 +240,9 @@ void write_image(const std::string& path, const ImageView& image,
   }
   fs::rename(temp, target, ec);
   if (ec) {
+    const std::string why = ec.message();  // before remove() resets ec ("...: Success")
     fs::remove(temp, ec);
-    throw IoError(concat("cannot move finished image into place at '", path, "': ", ec.message()));
+    throw IoError(concat("cannot move finished image into place at '", path, "': ", why));
   }
 }
 

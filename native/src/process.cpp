@@ -85,8 +85,9 @@ bool encode_video(const std::string& pattern, int first_frame, double fps, const
   }
   fs::rename(temp, target, ec);
   if (ec) {
+    const std::string why = ec.message();  // before remove() resets ec ("...: Success")
     fs::remove(temp, ec);
-    throw IoError(concat("cannot move the video into place at '", out_path, "': ", ec.message()));
+    throw IoError(concat("cannot move the video into place at '", out_path, "': ", why));
   }
   return true;
 }

@@ -252,8 +252,9 @@ void write_report(const std::string& path, const std::string& settings, const st
   std::error_code ec;
   fs::rename(temp, target, ec);
   if (ec) {
+    const std::string why = ec.message();  // before remove() resets ec ("...: Success")
     fs::remove(temp, ec);
-    throw IoError(concat("cannot move the job report into place at '", path, "': ", ec.message()));
+    throw IoError(concat("cannot move the job report into place at '", path, "': ", why));
   }
 }
 

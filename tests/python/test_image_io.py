@@ -115,3 +115,17 @@ def test_overwrite_replaces_the_file(tmp_path, image):
     tempera.write_image(str(path), image * 2)
     np.testing.assert_array_equal(tempera.read_image(str(path)), image * 2)
     assert os.listdir(tmp_path) == ["frame.exr"]
+
+
+def test_a_failed_final_rename_names_the_reason(tmp_path):
+    """Writing onto a folder fails at the last step, the rename; the message
+    says why (it once said 'Success': the cleanup reset the error)."""
+    import tempera
+
+    target = tmp_path / "frame.png"
+    target.mkdir()
+    (target / "keep").write_text("x")  # a non-empty folder cannot be replaced
+    with pytest.raises(OSError) as err:
+        tempera.write_image(str(target), np.zeros((4, 4, 3), np.float32))
+    assert "Success" not in str(err.value) and "frame.png" in str(err.value)
+    assert [p.name for p in tmp_path.iterdir()] == ["frame.png"]  # no temporary file left
