@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import _native
+from .synthesis import method_options
 
 NoisyOptions = _native.NoisyOptions
 # The paper's tested widths f (thesis fig. 4.11), the panel's slider steps.
@@ -20,18 +21,7 @@ def options(**values) -> "NoisyOptions":
     """NoisyOptions from keywords: its own (noise, lattice_spacing, shift_min,
     shift_max, deform) and engine options (SynthesisOptions names, starting
     from Color Me Noisy's defaults: patch 7, mode voting, 4 EM x 2 PM)."""
-    own = {row["name"] for row in NoisyOptions.table()}
-    opts = NoisyOptions(**{k: v for k, v in values.items() if k in own})
-    engine = _native.noisy_defaults()
-    for name, value in values.items():
-        if name in own:
-            continue
-        if not hasattr(engine, name):
-            raise TypeError(f"unknown Color Me Noisy option '{name}'")
-        setattr(engine, name, value)
-    engine.validate()
-    opts.synthesis = engine
-    return opts
+    return method_options(NoisyOptions, _native.noisy_defaults(), values, "Color Me Noisy")
 
 
 def _image(a, what):

@@ -146,6 +146,24 @@ def synthesize(
     return _native.synthesize(style, guide_list, opts, maps, target_shape, exemplar_list, reference, fixed, report)
 
 
+def method_options(options_class, engine_defaults, values: dict, method: str):
+    """A method's options from keywords: the method's own (the fields of
+    `options_class`) and engine options (SynthesisOptions names), starting
+    from the method's engine defaults; unknown names are TypeErrors."""
+    own = {row["name"] for row in options_class.table()}
+    opts = options_class(**{k: v for k, v in values.items() if k in own})
+    engine = engine_defaults
+    for name, value in values.items():
+        if name in own:
+            continue
+        if not hasattr(engine, name):
+            raise TypeError(f"unknown {method} option '{name}'")
+        setattr(engine, name, value)
+    engine.validate()
+    opts.synthesis = engine
+    return opts
+
+
 synthesize.__doc__ = synthesize.__doc__.replace("    {options}", _option_help())
 USAGE_MODES = tuple(next(r["choices"] for r in _native.SynthesisOptions.table() if r["name"] == "usage"))
 SynthesisOptions = _native.SynthesisOptions

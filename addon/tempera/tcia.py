@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import _native
+from .synthesis import method_options
 
 TciaOptions = _native.TciaOptions
 
@@ -19,18 +20,7 @@ def options(**values) -> "TciaOptions":
     coherence_max, sweep_pairs) and engine options (SynthesisOptions names,
     from the method's defaults: 9 x 9 Gaussian window, centre output,
     histogram usage, 4 levels)."""
-    own = {row["name"] for row in TciaOptions.table()}
-    opts = TciaOptions(**{k: v for k, v in values.items() if k in own})
-    engine = _native.tcia_defaults()
-    for name, value in values.items():
-        if name in own:
-            continue
-        if not hasattr(engine, name):
-            raise TypeError(f"unknown option '{name}' of the coherent method")
-        setattr(engine, name, value)
-    engine.validate()
-    opts.synthesis = engine
-    return opts
+    return method_options(TciaOptions, _native.tcia_defaults(), values, "coherent-method")
 
 
 def _image(a):

@@ -4,12 +4,12 @@
 // beside it, and a rerun skips frames whose key still matches.
 #include <filesystem>
 #include <fstream>
-#include <iomanip>
 #include <iostream>
 #include <sstream>
 
 #include "cli_args.hpp"
 #include "tempera/error.hpp"
+#include "tempera/file_keys.hpp"
 #include "tempera/image_io.hpp"
 #include "tempera/noisy.hpp"
 
@@ -38,27 +38,6 @@ std::string noisy_help() {
          "\nengine options (defaults: patch 7, mode voting, 4 EM x 2 PatchMatch, usage none):\n" +
          flags_help<SynthesisOptions>(synthesis_option_table()) +
          "\nExit status: 0 done, 1 error, 2 bad usage.\n";
-}
-
-std::string frame_name(const std::string& prefix, int frame, const char* ext) {
-  std::ostringstream s;
-  s << prefix << std::setw(4) << std::setfill('0') << frame << ext;
-  return s.str();
-}
-
-// FNV-1a over the settings and the inputs' sizes and times: a changed input
-// or setting redoes the frame.
-std::string key_of(const std::string& text) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : text) h = (h ^ c) * 1099511628211ull;
-  std::ostringstream out;
-  out << std::hex << std::setw(16) << std::setfill('0') << h;
-  return out.str();
-}
-
-std::string stamp(const std::string& path) {
-  std::error_code ec;
-  return concat(path, "|", fs::file_size(path, ec), "|", fs::last_write_time(path, ec).time_since_epoch().count());
 }
 
 std::string read_text(const fs::path& path) {
@@ -117,15 +96,15 @@ int run_noisy(const Args& args) {
   if (!noise_map.empty()) map = extract_channels(read_image(noise_map).view(), 0, 1);
   fs::create_directories(fs::path(out) / ".tempera_noisy");
   const std::string settings = settings_text(opt, noisy_option_table()) +
-                               settings_text(opt.synthesis, synthesis_option_table()) + stamp(exemplar) +
-                               (noise_map.empty() ? "" : stamp(noise_map));
+                               settings_text(opt.synthesis, synthesis_option_table()) + file_stamp(exemplar) +
+                               (noise_map.empty() ? "" : file_stamp(noise_map));
   int made = 0, skipped = 0;
   for (int frame : frames) {
-    const std::string input = (fs::path(reference) / frame_name(prefix, frame, ".png")).string();
+    const std::string input = (fs::path(reference) / frame_file(prefix, frame, "png")).string();
     if (!fs::is_regular_file(input)) throw FileNotFoundError(concat("reference frame not found: '", input, "'"));
-    const fs::path output = fs::path(out) / frame_name(prefix, frame, ".png");
-    const fs::path key_file = fs::path(out) / ".tempera_noisy" / frame_name("", frame, ".key");
-    const std::string key = key_of(concat(settings, "|", frame, "|", stamp(input)));
+    const fs::path output = fs::path(out) / frame_file(prefix, frame, "png");
+    const fs::path key_file = fs::path(out) / ".tempera_noisy" / frame_file("", frame, "key");
+    const std::string key = hash_hex(concat(settings, "|", frame, "|", file_stamp(input)));
     if (resume && fs::is_regular_file(output) && fs::is_regular_file(key_file) && read_text(key_file) == key) {
       ++skipped;
       continue;

@@ -20,6 +20,7 @@
 
 #include "tempera/contact_sheet.hpp"
 #include "tempera/error.hpp"
+#include "tempera/file_keys.hpp"
 #include "tempera/image_io.hpp"
 #include "tempera/paths.hpp"
 
@@ -32,30 +33,6 @@ constexpr const char* kReportName = "tempera_stylize.json";
 constexpr const char* kReportFormat = "tempera-stylize 2";
 constexpr int kSheetMaxWidth = 2000;
 constexpr int kSheetGap = 4;
-
-std::string frame_file(const std::string& prefix, int frame, const std::string& extension) {
-  char number[32];
-  std::snprintf(number, sizeof number, "%04d", frame);
-  return prefix + number + "." + extension;
-}
-
-// FNV-1a, 64 bits: stable across runs and builds (std::hash is not).
-std::string hash_hex(const std::string& text) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : text) h = (h ^ c) * 1099511628211ull;
-  std::ostringstream out;
-  out << std::hex << std::setw(16) << std::setfill('0') << h;
-  return out.str();
-}
-
-// Size and modification time: a changed file changes the key without hashing
-// megabytes of pixels per frame.
-std::string file_stamp(const std::string& path) {
-  std::error_code ec;
-  const auto size = fs::file_size(path, ec);
-  const auto mtime = fs::last_write_time(path, ec).time_since_epoch().count();
-  return concat(size, "|", mtime);
-}
 
 void require_file(const std::string& path, const std::string& what) {
   std::error_code ec;
