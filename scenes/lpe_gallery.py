@@ -16,6 +16,8 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
+import lpe_scene  # noqa: E402  (scenes/, beside this file)
+
 SIZE = (80, 60)
 BOUNCES = 6
 
@@ -598,17 +600,8 @@ def build(key):
 
 
 def remove(scene):
-    for obj in list(scene.collection.all_objects):
-        data = obj.data
-        bpy.data.objects.remove(obj)
-        if data is not None and data.users == 0:
-            if isinstance(data, bpy.types.Mesh):
-                bpy.data.meshes.remove(data)
-            elif isinstance(data, bpy.types.Light):
-                bpy.data.lights.remove(data)
-            elif isinstance(data, bpy.types.Camera):
-                bpy.data.cameras.remove(data)
+    """lpe_scene.remove_scene, and the gallery scene's own world."""
     world = scene.world
-    bpy.data.scenes.remove(scene)
+    lpe_scene.remove_scene(scene)
     if world is not None and world.users == 0:
         bpy.data.worlds.remove(world)
