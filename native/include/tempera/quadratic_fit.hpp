@@ -24,7 +24,7 @@ struct QuadraticFitOptions {
   std::vector<float> blurs{8, 4, 2};  // Gaussian sigma (px) of each coarse-to-fine stage
   int iterations = 25;                // Gauss-Newton steps per stage
   float chamfer_weight = 0.5f;        // weight of the outline-to-stroke chamfer term
-  float prior = 1e-3f;                // mu in mu |[Q m]|^2
+  float prior = 0.02f;                // mu in mu |[Q m]|^2
 };
 
 inline const auto& quadratic_fit_option_table() {
@@ -36,7 +36,7 @@ inline const auto& quadratic_fit_option_table() {
       field(&F::chamfer_weight, "fit_chamfer", "fit-chamfer",
             "weight of the chamfer term pulling the proxy's outline onto the drawn strokes (0.5; 0 = silhouettes only)",
             0, 1e6),
-      field(&F::prior, "fit_prior", "fit-prior", "prior mu |[Q m]|^2 against needless bending (0.001)", 0, 1e6));
+      field(&F::prior, "fit_prior", "fit-prior", "prior mu |[Q m]|^2 against needless bending (0.02)", 0, 1e6));
   return table;
 }
 

@@ -53,13 +53,15 @@ QuadraticMap damped(const QuadraticMap& D, double xi);
 // did not converge (q outside D's image, or a fold).
 Vec2 inverse_apply(const QuadraticMap& D, Vec2 q, bool* ok = nullptr);
 
-// Least det J of D on a grid over [-extent, extent]^2.
+// Least det J of D over the disc |p| <= extent (radius units).
 double min_jacobian_det(const QuadraticMap& D, double extent);
-// The fold guard: D unchanged when det J >= min_det over the box; otherwise
+// The fold guard: D unchanged when det J >= min_det over the disc of radius
+// `extent` (every proxy lies in the unit disc; 1.25 leaves room for the
+// strokes); otherwise
 // its quadratic part (Q, m) is scaled down by the largest factor s in [0, 1]
 // that keeps det J >= min_det (bisection), and if the affine part itself is
 // folded, the whole map is blended towards the identity.
-QuadraticMap fold_guarded(const QuadraticMap& D, double extent = 1.5, double min_det = 0.05);
+QuadraticMap fold_guarded(const QuadraticMap& D, double extent = 1.25, double min_det = 0.05);
 
 // Frobenius norm of D - I: how far a frame is from rigid.
 double distance_from_identity(const QuadraticMap& D);
