@@ -83,6 +83,7 @@ void bind_stylize(py::module_& m);    // bind_stylize.cpp
 void bind_tracer(py::module_& m);     // bind_tracer.cpp
 void bind_noisy(py::module_& m);      // bind_noisy.cpp
 void bind_tcia(py::module_& m);       // bind_tcia.cpp
+void bind_rigid(py::module_& m);      // bind_rigid.cpp
 
 PYBIND11_MODULE(_native, m) {
   m.doc() = "Tempera native engine";
@@ -95,4 +96,5 @@ PYBIND11_MODULE(_native, m) {
   bind_tracer(m);
   bind_noisy(m);
   bind_tcia(m);
+  bind_rigid(m);
 }

@@ -240,6 +240,7 @@ QuadraticMap fit_quadratic_map(const ImageView& source_mask, const ImageView& dr
   if (source_mask.channels != 1 || drawn_ink.channels != 1)
     throw ValueError("the source mask and the drawing must have 1 channel each");
   if (!(frame.radius > 0)) throw ValueError("the object's radius must be positive");
+  validate_fields(options, quadratic_fit_option_table());
   if (options.blurs.empty()) throw ValueError("fit_blurs needs at least one stage");
   const Image drawn_silhouette = filled_silhouette(drawn_ink);
   const bool closed = outline_is_closed(drawn_silhouette.view(), drawn_ink);

@@ -187,6 +187,7 @@ void validate(const std::vector<RigidExemplar>& exemplars, const Track& target) 
 std::vector<RigidFrame> synthesize_deformations(const std::vector<RigidExemplar>& exemplars, const Track& target,
                                                 const RigidOptions& options) {
   validate(exemplars, target);
+  validate_fields(options, rigid_option_table());
   const double lambda_vel = resolved_lambda_vel(target, options);
   const std::vector<SubSequence> target_subs = cut_subsequences(target);
   // Per target sub-sequence, its K nearest augmented sources.

@@ -47,6 +47,7 @@ EventInfluence event_influence(const Track& track, int frame, int squash_frames)
 }
 
 QuadraticMap generator_map(const Track& track, int frame, const ExemplarStyle& style) {
+  validate_fields(style, exemplar_style_table());
   if (frame < 0 || frame >= int(track.frames.size())) throw ValueError(concat("frame ", frame, " is outside the track"));
   const TrackFrame& f = track.frames[std::size_t(frame)];
   const EventInfluence inf = event_influence(track, frame, style.squash_frames);

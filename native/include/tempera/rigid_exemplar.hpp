@@ -15,15 +15,22 @@
 //  - a squash along the event's normal by 1 - a ramp, ramp = 1 - |f - e| / 4
 //    over +-3 frames, about the contact point (-n), area-preserving;
 //  - the contact translation that puts the drawing on the obstacle.
+#include <array>
 #include <cstdint>
 
 #include "tempera/image.hpp"
+#include "tempera/option_table.hpp"
 #include "tempera/quadratic_map.hpp"
 #include "tempera/rigid.hpp"
 
 namespace tempera {
 
 enum class ProxyShape { circle, box };
+template <>
+struct EnumNames<ProxyShape> {
+  static constexpr const char* what = "proxy shape";
+  static constexpr std::array<const char*, 2> names{"circle", "box"};
+};
 
 struct ExemplarStyle {
   double stretch = 0.6;     // k
@@ -35,6 +42,20 @@ struct ExemplarStyle {
   ProxyShape shape = ProxyShape::circle;
   std::uint64_t seed = 1;   // the pencil's jitter, fresh every frame: mix(seed, frame)
 };
+
+inline const auto& exemplar_style_table() {
+  using E = ExemplarStyle;
+  static const auto table = std::make_tuple(
+      field(&E::stretch, "stretch", "stretch", "stretch along the velocity per radius-per-frame of speed, k (0.6)", 0, 10),
+      field(&E::squash, "squash", "squash", "squash along the normal at an event, a (0.3)", 0, 0.9),
+      field(&E::squash_frames, "squash_frames", "squash-frames", "half width of the squash ramp in frames (3)", 0, 30),
+      field(&E::bend, "bend", "bend", "bend against the motion per radius-per-frame of speed, b (0.25)", 0, 10),
+      field(&E::wobble, "wobble", "wobble", "the pencil's wobble amplitude in px (0.6)", 0, 20),
+      field(&E::line_width, "line_width", "line-width", "the pencil's line width in px (2.5)", 0.5, 50),
+      field(&E::shape, "shape", "shape", "the proxy: circle or box"),
+      field(&E::seed, "seed", "seed", "seed of the pencil's jitter (fresh every frame)"));
+  return table;
+}
 
 // How strongly frame f of the track is stylized: (stretch window, squash ramp,
 // nearest event index or -1).
