@@ -29,6 +29,23 @@ def test_transfer_follows_the_oracle(source):
     assert np.corrcoef(got, want)[0, 1] >= 0.9
 
 
+def test_the_flip_augmentation_is_what_matches_a_reversed_throw(source):
+    # The source is thrown to the right, the target to the left: without the
+    # flip (or without augmentation) the stretch no longer follows the oracle.
+    target = _native.bouncing_ball((290, 30), (-3.5, 1), 16, 1.0, 185, 0.7, -0.08, 64)
+    oracle = rigid.oracle_maps(target)
+    want = [rigid.stretch_along(o, v) for o, v in zip(oracle, target["velocity"])]
+
+    def r(**kw):
+        got = [rigid.stretch_along(D, v) for (D, _, _), v in zip(rigid.deformations([source], target, **kw),
+                                                                 target["velocity"])]
+        return np.corrcoef(got, want)[0, 1]
+
+    assert r() >= 0.9
+    assert r(flip=False) < 0.6
+    assert r(augment=False) < 0.6
+
+
 def test_switching_damping_off_changes_the_result(source):
     target = _native.bouncing_ball((280, 40), (-1.0, 0), 16, 0.5, 185, 0.5, 0.0, 30)
     damped = rigid.deformations([source], target)
