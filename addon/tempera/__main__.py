@@ -2,7 +2,9 @@
 `python -m tempera`.
 
 `tempera farm ...` and `tempera stylize --scheduler ADDRESS ...` run a shot on
-a Dask cluster (tempera.farm); every other command is the native batch CLI
+a Dask cluster (tempera.farm); `tempera rigid ...` runs the rigid-body method
+on a guide cache's tracks (tempera.rigid_cli); every other command is the
+native batch CLI
 (tempera_native/bin/tempera: synth, stylize, render-guides), run with this
 package as the add-on that `render-guides` hands to Blender.
 """
@@ -39,6 +41,10 @@ def main(argv=None):
         from .farm import main as farm_main
 
         return farm_main(argv[1:])
+    if argv[:1] == ["rigid"]:
+        from .rigid_cli import main as rigid_main
+
+        return rigid_main(argv[1:])
     try:
         cli = native_cli()
     except FileNotFoundError as exc:

@@ -65,15 +65,17 @@ def fit_exemplar(track, drawings, shape="circle", masks=None, **fit):
     return track, maps, residuals
 
 
-def stylize(exemplars, target, width, height, progress=None, **values):
-    """Every target frame as (rgba, D_hat, contact_shift). `exemplars` are
+def stylize(exemplars, target, width, height, progress=None, only=None, **values):
+    """Every target frame as (rgba, D_hat, contact_shift), or None for frames
+    not in `only` (a list of frame indices; None = all). `exemplars` are
     fit_exemplar results; `values` RigidOptions keywords (k, lambda_vel,
     lambda_dir, lambda_rot, symmetry, augment, scales, flip, damp,
     fold_min_det, contact_fade). progress(frame) returning False cancels
     (tempera._native.Cancelled)."""
     options = RigidOptions(**values)
     prepared = [(t, list(m), [_rgba(r, "residual") for r in rs]) for t, m, rs in exemplars]
-    return _native.rigid_stylize(prepared, target, options, int(width), int(height), progress)
+    return _native.rigid_stylize(prepared, target, options, int(width), int(height), progress,
+                                 None if only is None else [int(f) for f in only])
 
 
 def deformations(exemplars, target, **values):
