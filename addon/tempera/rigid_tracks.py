@@ -107,7 +107,7 @@ def _obstacle(centre, radius, normal, frame, others, near):
         o = np.asarray(oc, dtype=float)[frame]
         away = centre - o
         dist = float(np.linalg.norm(away))
-        gap = dist - radius - float(np.broadcast_to(orad, (frame + 1,))[frame])
+        gap = dist - radius - float(np.ravel(orad)[frame] if np.ndim(orad) else orad)
         if gap < best_gap and gap <= near * radius and dist > 0 and float(away @ normal) > 0.7 * dist:
             best, best_gap = name, gap
     return best
