@@ -5,6 +5,9 @@
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
+#include <optional>
+
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
 #include "tempera/error.hpp"
@@ -202,7 +205,7 @@ void bind_rigid(py::module_& m) {
   m.def(
       "rigid_stylize",
       [](const py::list& exemplars, const py::dict& target, const RigidOptions& options, int width, int height,
-         const std::function<bool(int)>& progress) {
+         const std::function<bool(int)>& progress, std::optional<std::vector<int>> only) {
         // exemplars: [(track, [maps], [residual RGBA arrays])]
         std::vector<RigidExemplar> ex;
         std::vector<std::vector<FloatArray>> residual_arrays;
@@ -235,6 +238,10 @@ void bind_rigid(py::module_& m) {
           shifts = contact_shifts(ex, source, t, frames, width, height, options.contact_fade);
         }
         for (int f = 0; f < int(frames.size()); ++f) {
+          if (only && std::find(only->begin(), only->end(), f) == only->end()) {
+            frames_out.append(py::none());  // not asked for (already written: a resumed run)
+            continue;
+          }
           if (progress && !progress(f)) throw CancelledError("rigid-body stylization cancelled");
           Image out;
           {
@@ -247,6 +254,7 @@ void bind_rigid(py::module_& m) {
         return frames_out;
       },
       py::arg("exemplars"), py::arg("target"), py::arg("options"), py::arg("width"), py::arg("height"),
-      py::arg("progress") = nullptr,
-      "Every target frame: [(RGBA, D_hat, contact shift)]; progress(frame) returning False cancels.");
+      py::arg("progress") = nullptr, py::arg("only") = py::none(),
+      "Every target frame: [(RGBA, D_hat, contact shift)] (None for frames not in `only`); progress(frame) "
+      "returning False cancels.");
 }
