@@ -2,7 +2,7 @@
 #   make demo    install deps, build, stylize the bundled demo scene in background Blender
 #   make test    install deps, build, run C++, Python, in-Blender (3.4, 4.2, 4.5, 5.0), wheel/farm
 #                and Flamenco tests
-# Other targets: deps, build, kit, addon-zip, wheel, extension, bench, bench-tracer, sanitize, clean.
+# Other targets: deps, build, kit, addon-zip, wheel, extension, demo-rigid, bench, bench-tracer, sanitize, clean.
 
 PYTHON   := /usr/bin/python3
 BLENDER  ?= blender
@@ -28,7 +28,7 @@ KIT_SOURCES := scenes/exemplar_kit.py scenes/scene_kit.py addon/tempera/exemplar
                addon/tempera/blender/guide_render.py addon/tempera/guide_cache.py
 DEMO_OUT ?= out/demo
 
-.PHONY: all deps build kit addon-zip wheel extension test demo bench bench-tracer sanitize fuzz clean
+.PHONY: all deps build kit addon-zip wheel extension test demo demo-rigid bench bench-tracer sanitize fuzz clean
 
 all: build
 
@@ -70,6 +70,11 @@ test: build addon-zip extension
 
 demo: build addon-zip
 	$(PYTHON) tools/run_demo.py --addon-zip $(ADDON_ZIP) --blender $(BLENDER) --out $(DEMO_OUT)
+
+# The rigid-body demo (scenes/rigid_demo.py): three balls and a box on ramps, hand-drawn.
+DEMO_RIGID_OUT ?= out/demo-rigid
+demo-rigid: build
+	$(BLENDER) -b --factory-startup --python-exit-code 1 --python scenes/rigid_demo.py -- --out $(DEMO_RIGID_OUT)
 
 bench: build
 	PYTHONPATH=addon $(PYTHON) bench/bench_synthesis.py --size 1024 --json docs/bench_synthesis_1024.json
