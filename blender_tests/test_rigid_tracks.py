@@ -124,3 +124,18 @@ def test_planarity_warning(world):
     ball.keyframe_insert("rotation_euler", frame=FRAMES)
     _, _, warnings = brt.extract_tracks(world, [ball])
     assert warnings and "view axis" in warnings[0]
+
+
+def test_guide_render_writes_the_tracks(world, tmp_path):
+    from tempera import rigid_tracks
+    from tempera.blender.guide_render import render_guides
+
+    _ball("Cached", (0, 0, 3))
+    world.render.resolution_x, world.render.resolution_y = 64, 48
+    world.frame_set(5)
+    render_guides(world, [1, 2], tmp_path / "cache", {"samples": 2, "ld12e_samples": 2})
+    assert world.frame_current == 5  # the track extraction puts the frame back
+    data = rigid_tracks.read_tracks(tmp_path / "cache")
+    track = data["objects"]["Cached"]
+    assert len(track["centre"]) == FRAMES and data["frame_start"] == 1
+    assert [e["frame"] for e in track["events"]][:1] == [18]  # the drop's first bounce (test_drop)

@@ -24,7 +24,7 @@ import bpy
 import numpy as np
 
 from .. import guide_cache, guides, image_info, read_image
-from . import compat
+from . import compat, rigid_tracks
 from ..frames import MAX_FRAME, check_frame
 from ..lpe import check_lpe, trace_lpe
 from ..stylize import tonemap
@@ -497,6 +497,9 @@ def render_guides(scene, frames, out_dir, params=None, progress=None):
                 report["warnings"] += _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress,
                                                      warn, paths)
         report["rendered"] = todo
+    bodies = rigid_tracks.rigid_body_objects(scene)
+    if bodies:  # a rigid-body world: its tracks beside the masks (docs/rigid_bodies.md)
+        report["warnings"] += rigid_tracks.write_tracks(scene, bodies, out_dir)
     return report
 
 

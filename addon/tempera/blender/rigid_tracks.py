@@ -29,7 +29,16 @@ def _size(scene):
 
 
 def extract_tracks(scene, objects, camera=None):
-    """({name: track}, gravity_px, warnings) over the scene's frame range."""
+    """({name: track}, gravity_px, warnings) over the scene's frame range;
+    the scene is back at its current frame afterwards."""
+    current = scene.frame_current
+    try:
+        return _extract(scene, objects, camera)
+    finally:
+        scene.frame_set(current)
+
+
+def _extract(scene, objects, camera):
     camera = camera or scene.camera
     if camera is None:
         raise ValueError("the scene has no camera to project the rigid bodies through")
