@@ -6,7 +6,7 @@ import pytest
 
 from tempera import noisy, temporal
 
-FRAMES = 12
+FRAMES = 32  # a static R repeated 32 times, as in the issue
 
 
 def medium(rng, h, w):
@@ -32,7 +32,7 @@ def run(inputs, f, frames=FRAMES, **kw):
 
 @pytest.fixture(scope="module")
 def sweep(inputs):
-    return {f: run(inputs, f) for f in (1.3, 2.2, 4.3)}
+    return {f: run(inputs, f) for f in (1.3, 2.2, 3.1, 4.3)}
 
 
 def energy(frames):
@@ -41,21 +41,19 @@ def energy(frames):
 
 def test_noise_rises_with_the_width(sweep):
     e = {f: energy(frames) for f, frames in sweep.items()}
-    assert e[1.3] < e[2.2] < e[4.3]
-    # Measured 1.8x here; the issue asks 2x on a 32-frame static R
-    # (docs/noisy.md, open).
-    assert e[4.3] >= 1.5 * e[1.3]
+    assert e[1.3] < e[2.2] < e[3.1] < e[4.3]
+    assert e[4.3] >= 2 * e[1.3]  # measured 2.16 (docs/noisy.md)
 
 
 def test_noise_is_white(sweep):
-    for f in (2.2, 4.3):
+    for f in (2.2, 3.1, 4.3):
         assert temporal.spectral_flatness(temporal.temporal_power_spectrum(sweep[f])) >= 0.9
 
 
 def test_large_shapes_follow_the_reference(inputs, sweep):
     _, reference = inputs
     for f, frames in sweep.items():
-        assert max(temporal.box_consistency_error(x, reference, f) for x in frames) <= 0.06, f
+        assert max(temporal.box_consistency_error(x, reference, f) for x in frames) <= 0.05, f
     # Without the low-frequency term they drift away from R.
     loose = run(inputs, 2.2, frames=3, consistency=0.0)
     assert max(temporal.box_consistency_error(x, reference, 2.2) for x in loose) > \
@@ -65,8 +63,8 @@ def test_large_shapes_follow_the_reference(inputs, sweep):
 def test_without_deformation_there_is_less_noise(inputs, sweep):
     """The paper's ablation (§3.2): without the MLS pre-deformation low f
     gives a floating texture, not noise."""
-    rigid = run(inputs, 1.3, deform=False)
-    assert energy(rigid) < energy(sweep[1.3])
+    rigid = run(inputs, 1.3, frames=12, deform=False)
+    assert energy(rigid) < energy(sweep[1.3][:12])
 
 
 def test_a_full_noise_map_changes_nothing(inputs):
@@ -75,6 +73,27 @@ def test_a_full_noise_map_changes_nothing(inputs):
     for i in range(2):
         np.testing.assert_array_equal(noisy.noisy_frame(style, reference, i, noise=3.1, noise_map=ones, threads=2),
                                       noisy.noisy_frame(style, reference, i, noise=3.1, threads=2))
+
+
+def test_a_split_map_splits_the_noise_in_the_global_ratio(inputs, sweep):
+    """§3.3: the calm half (f_p = 1.3) boils like a global 1.3, the lively
+    half (4.3) like a global 4.3: their energy ratio is the global one
+    (within 30%; measured 0.90 of it)."""
+    style, reference = inputs
+    h, w = reference.shape[:2]
+    split = np.ones((h, w), np.float32)
+    split[:, : w // 2] = 1.3 / 4.3
+    n = 16
+    mapped = [noisy.noisy_frame(style, reference, i, noise=4.3, noise_map=split, threads=2) for i in range(n)]
+    calm, lively = slice(4, w // 2 - 4), slice(w // 2 + 4, w - 4)  # away from the seam
+
+    def half(frames, cols):
+        return energy([x[:, cols] for x in frames])
+
+    split_ratio = half(mapped, lively) / half(mapped, calm)
+    global_ratio = half(sweep[4.3][:n], lively) / half(sweep[1.3][:n], calm)
+    assert global_ratio > 1.3
+    assert 0.7 * global_ratio <= split_ratio <= 1.3 * global_ratio, (split_ratio, global_ratio)
 
 
 def test_bad_options_are_named(inputs):
