@@ -102,3 +102,24 @@ def test_bad_options_are_named(inputs):
         noisy.noisy_frame(style, reference, 1, sparkle=3)
     with pytest.raises(ValueError, match="noise"):
         noisy.noisy_frame(style, reference, 1, noise=-2)
+
+
+def test_the_warp_error_of_a_moving_shot_rises_with_the_width(inputs):
+    """A moving R (the medium sliding right 2 px a frame, its Vector passes
+    as Blender writes them): the warp error along the motion, the flicker
+    figure, rises strictly over f = 1.3, 2.2, 3.1, 4.3 (the issue's test on
+    the moving shot), and is small for R itself (R is coherent)."""
+    style, _ = inputs
+    h, w, dx, n = 48, 64, 2, 6
+    shot = [np.ascontiguousarray(style[10:10 + h, 24 - dx * t:24 - dx * t + w]) for t in range(n)]
+    vector = np.zeros((h, w, 4), np.float32)
+    vector[..., 0] = vector[..., 2] = -dx  # XY = p(t-1) - p(t), ZW = p(t) - p(t+1), content moving right
+    backward, visible = temporal.motion(vector, vector)
+
+    def warp_error(frames):
+        return np.mean([temporal.flicker(a, b, backward, visible) for a, b in zip(frames, frames[1:])])
+
+    errors = [warp_error([noisy.noisy_frame(style, r, t, noise=f, threads=2) for t, r in enumerate(shot)])
+              for f in (1.3, 2.2, 3.1, 4.3)]
+    assert all(a < b for a, b in zip(errors, errors[1:])), errors
+    assert warp_error(shot) < 0.2 * errors[0]
