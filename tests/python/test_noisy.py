@@ -123,3 +123,35 @@ def test_the_warp_error_of_a_moving_shot_rises_with_the_width(inputs):
               for f in (1.3, 2.2, 3.1, 4.3)]
     assert all(a < b for a, b in zip(errors, errors[1:])), errors
     assert warp_error(shot) < 0.2 * errors[0]
+
+
+def test_the_panel_steps_and_map_choices():
+    assert [noisy.noise_width(k) for k in range(9)] == [0.0, *noisy.TESTED_NOISE]
+    with pytest.raises(ValueError, match="0 \\(off\\) to 8"):
+        noisy.noise_width(9)
+    assert noisy.noise_map_spec("NONE") is None
+    assert noisy.noise_map_spec("OBJECT", object_name="Face.001") == "mask.OB_Face_001"
+    assert noisy.noise_map_spec("COLLECTION", collection_name="Background") == "mask.CO_Background"
+    assert noisy.noise_map_spec("GUIDE", guide="aov_wetness") == "aov_wetness"
+    with pytest.raises(ValueError, match="object"):
+        noisy.noise_map_spec("OBJECT")
+
+
+def test_a_sequence_is_made_then_current(inputs, tmp_path):
+    import tempera
+
+    style, reference = inputs
+    (tmp_path / "R").mkdir()
+    tempera.write_image(str(tmp_path / "medium.png"), style)
+    for f in (1, 2):
+        tempera.write_image(str(tmp_path / "R" / f"frame_{f:04d}.png"), reference)
+    args = dict(exemplar=tmp_path / "medium.png", reference=tmp_path / "R", frames=[1, 2], out=tmp_path / "out",
+                noise=2.2, threads=2)
+    first = noisy.NoisySequence(**args)
+    assert [first.run_frame(i)["status"] for i in range(2)] == ["made", "made"]
+    assert [noisy.NoisySequence(**args).run_frame(i)["status"] for i in range(2)] == ["skipped", "skipped"]
+    assert noisy.NoisySequence(**dict(args, noise=3.1)).run_frame(0)["status"] == "made"  # new settings
+    with pytest.raises(tempera.Cancelled):
+        noisy.NoisySequence(**dict(args, noise=1.6)).run_frame(0, lambda f: False)
+    with pytest.raises(ValueError, match="neither an image file nor a guide"):
+        noisy.NoisySequence(**args, noise_map="alpha")
