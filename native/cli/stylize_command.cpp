@@ -74,7 +74,7 @@ const char* kStylizeHelpText =
     "                          guide cache (alpha, mask.OB_Name, an AOV); 0 = coherent, 1 = --noise\n"
     "  --noise-reference DIR   boil these coherent frames (DIR/frame_0001.png ...) instead of\n"
     "                          stylizing: no exemplar guides needed\n"
-    "  (Color Me Noisy's options of 'tempera noisy --help', e.g. --consistency 2 --no-deform... )\n"
+    "  (Color Me Noisy's options of 'tempera noisy --help', e.g. --consistency 2 --deform false)\n"
     "\n"
     "guide rendering (SCENE.blend / --exemplar-scene only):\n"
     "  --samples N             Cycles samples of the guide renders (default 16)\n"
