@@ -180,6 +180,7 @@ def test_output_panel_draws_settings_with_the_frames_by_the_buttons():
     labels = [text for kind, text in calls if kind == "label"]
     assert props == ["guide_frame_range", "exemplar_source", "weight_full", "weight_lde", "weight_lse",
                      "weight_ldde", "weight_ld12e", "quality", "usage", "temporal_weight", "patch_size", "seed",
+                     "noise_level",
                      "output_dir", "output_format", "make_video", "load_result",
                      "guide_dir", "guide_samples",
                      "guide_occlusion_epsilon", "guide_line_d_max", "guide_masks",
@@ -205,6 +206,16 @@ def test_output_panel_draws_settings_with_the_frames_by_the_buttons():
     finally:
         settings.guide_lpe = ""
     assert [name for kind, name in calls if kind == "prop"][-2:] == ["guide_lpe", "guide_lpe_samples"]
+    # Temporal Noise on: its width, the map picker and the chosen map's field.
+    settings.noise_level, settings.noise_map_source = 4, "OBJECT"
+    try:
+        calls.clear()
+        bpy.types.TEMPERA_PT_output.draw(fake, bpy.context)
+    finally:
+        settings.noise_level, settings.noise_map_source = 0, "NONE"
+    props = [name for kind, name in calls if kind == "prop"]
+    assert props[props.index("noise_level") + 1:][:2] == ["noise_map_source", "noise_map_object"]
+    assert any(kind == "label" and text.startswith("f = 2.2 px") for kind, text in calls)
 
 
 def test_preferences_draw_reports_the_cli(tmp_path):

@@ -195,3 +195,44 @@ def test_motion_blur_is_reported(scene):
     scene.render.use_motion_blur = True
     with pytest.raises(RuntimeError, match="[Mm]otion blur"):
         bpy.ops.tempera.stylize(mode="FRAME")
+
+
+def test_temporal_noise_boils_the_coherent_frames_where_the_map_says(scene, tmp_path):
+    """Temporal Noise (Color Me Noisy) after the coherent pass: OUT/noisy holds
+    frames that differ from the coherent ones and from each other; with the
+    moving cube's mask as the map, the pixels off the cube stay the coherent
+    frame bit for bit; a rerun finds every frame current."""
+    import tempera
+    from tempera import guide_cache
+    from tempera.blender.stylize_operator import StylizeRun
+
+    settings = scene.tempera
+    settings.noise_level = 6  # f = 3.1
+    settings.make_video = False
+    assert bpy.ops.tempera.stylize(mode="ANIMATION") == {"FINISHED"}
+    out = tmp_path / "out"
+    coherent = {f: tempera.read_image(str(out / "frames" / f"frame_{f:04d}.png")) for f in FRAMES}
+    noisy = {f: tempera.read_image(str(out / "noisy" / f"frame_{f:04d}.png")) for f in FRAMES}
+    for f in FRAMES:
+        assert noisy[f].shape == coherent[f].shape and np.abs(noisy[f] - coherent[f]).mean() > 0.005, f
+    assert np.abs(noisy[FRAMES[0]] - noisy[FRAMES[1]]).mean() > 0.005
+    strip = compat.sequencer_strips(bpy.data.scenes[SCENE + " Tempera"].sequence_editor)[0]
+    assert strip.directory.rstrip("/\\").endswith("noisy")  # the noisy sequence is the result shown
+
+    settings.noise_map_source = "OBJECT"
+    settings.noise_map_object = bpy.data.objects["MovingCube"]
+    run = StylizeRun.from_settings(scene)
+    while not run.finished:
+        run.step()
+    assert [r["status"] for r in run.results] == ["skipped"] * len(FRAMES)
+    assert [r["status"] for r in run.noise_results] == ["made"] * len(FRAMES)  # a new map: boiled again
+    for f in FRAMES:
+        mask = guide_cache.read_frame(tmp_path / "guides", f, ["mask.OB_MovingCube"])["mask.OB_MovingCube"]
+        off = mask.reshape(mask.shape[0], mask.shape[1], -1)[:, :, 0] * 3.1 < 1.0
+        assert off.any() and (~off).any()
+        boiled = tempera.read_image(str(out / "noisy" / f"frame_{f:04d}.png"))
+        np.testing.assert_array_equal(boiled[off], coherent[f][off])
+    rerun = StylizeRun.from_settings(scene)
+    while not rerun.finished:
+        rerun.step()
+    assert [r["status"] for r in rerun.noise_results] == ["skipped"] * len(FRAMES)

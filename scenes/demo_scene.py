@@ -45,6 +45,7 @@ SAMPLES = 32  # per guide render; no denoising, the synthesis averages noise out
 SCENE_NAME = "Demo"
 CAMERA_ORBIT = math.radians(6)  # the camera turns this far around the table over FRAMES
 FRAMES_PER_ROW = 6  # on the comparison sheet
+NOISE_LEVEL = 4  # the noisy variant: Temporal Noise step 4, f = 2.2 px (docs/noisy.md)
 
 
 # --------------------------------------------------------------------------- scene
@@ -166,12 +167,21 @@ def run(out, started):
     if result != {"FINISHED"}:
         raise RuntimeError(f"Stylize Animation ended with {result}; see the messages above")
     sheet = comparison_sheet(out, scene)
+    # The noisy variant, as an artist makes it: Temporal Noise up, Stylize
+    # again; the guides and the coherent frames are current, only the noise
+    # pass runs (into out/noisy), and its frames become the result shown.
+    scene.tempera.noise_level = NOISE_LEVEL
+    scene.tempera.make_video = False
+    result = bpy.ops.tempera.stylize(mode="ANIMATION")
+    if result != {"FINISHED"}:
+        raise RuntimeError(f"Stylize Animation with Temporal Noise ended with {result}; see the messages above")
     blend = out / "demo.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(blend), check_existing=False)
 
     print(f"tempera {tempera.__version__} (from {Path(tempera.__file__).parent})")
     print(f"guides:           {out / 'guides'}/frame_####.exr ({len(FRAMES)} frames)")
     print(f"frames:           {out / 'frames'}/frame_####.png (stylized)")
+    print(f"noisy variant:    {out / 'noisy'}/frame_####.png (Temporal Noise {NOISE_LEVEL})")
     print(f"contact sheet:    {out / 'contact_sheet.png'}")
     print(f"comparison sheet: {sheet}")
     video = out / "stylized.mp4"

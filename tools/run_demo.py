@@ -40,6 +40,7 @@ def main():
 
     expected = [out / "guides" / f"frame_{f:04d}.exr" for f in range(1, FRAMES + 1)]
     expected += [out / "frames" / f"frame_{f:04d}.png" for f in range(1, FRAMES + 1)]
+    expected += [out / "noisy" / f"frame_{f:04d}.png" for f in range(1, FRAMES + 1)]  # the Temporal Noise variant
     expected += [out / name for name in ("contact_sheet.png", "comparison_sheet.png", "demo.blend")]
     missing = [str(p) for p in expected if not p.is_file()]
     if missing:
@@ -47,6 +48,7 @@ def main():
         return 1
     print(f"\ndemo finished in {elapsed:.1f} s")
     print(f"  frames           {out / 'frames'}  ({FRAMES} stylized PNG)")
+    print(f"  noisy variant    {out / 'noisy'}  ({FRAMES} PNG with Temporal Noise, f = 2.2 px)")
     print(f"  contact sheet    {out / 'contact_sheet.png'}  (the painting, then every frame)")
     print(f"  comparison sheet {out / 'comparison_sheet.png'}  (renders above stylized frames)")
     video = out / "stylized.mp4"

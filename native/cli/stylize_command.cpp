@@ -14,6 +14,7 @@
 #include "cli_args.hpp"
 #include "tempera/error.hpp"
 #include "tempera/image_io.hpp"
+#include "tempera/noisy_sequence.hpp"
 #include "tempera/process.hpp"
 #include "tempera/stylize_job.hpp"
 
@@ -66,6 +67,15 @@ const char* kStylizeHelpText =
     "  --no-video              do not encode OUT/stylized.mp4\n"
     "  --no-resume             stylize every frame again, even if current\n"
     "\n"
+    "temporal noise (Color Me Noisy, after the coherent frames; docs/noisy.md):\n"
+    "  --noise F               low-pass width f in pixels: the coherent frames boil by this amount\n"
+    "                          into OUT/noisy/frame_0001.png ... (1.3 calm .. 4.3 lively; 0 = off)\n"
+    "  --noise-map FILE|GUIDE  where the noise goes: an image of the frames' size, or a guide of the\n"
+    "                          guide cache (alpha, mask.OB_Name, an AOV); 0 = coherent, 1 = --noise\n"
+    "  --noise-reference DIR   boil these coherent frames (DIR/frame_0001.png ...) instead of\n"
+    "                          stylizing: no exemplar guides needed\n"
+    "  (Color Me Noisy's options of 'tempera noisy --help', e.g. --consistency 2 --deform false)\n"
+    "\n"
     "guide rendering (SCENE.blend / --exemplar-scene only):\n"
     "  --samples N             Cycles samples of the guide renders (default 16)\n"
     "  --blender PATH          Blender to run (default: $TEMPERA_BLENDER or 'blender')\n"
@@ -94,11 +104,19 @@ volatile std::sig_atomic_t g_interrupted = 0;
 
 void on_sigint(int) { g_interrupted = 1; }
 
+NoisyOptions no_noise() {
+  NoisyOptions o = default_noisy_options();
+  o.noise = 0;
+  return o;
+}
+
 struct Options {
   std::string scene, exemplar, exemplar_scene, exemplar_guides, guides, frames_text, out, samples;
   std::optional<int> exemplar_frame;
   std::vector<int> frames;
   StylitOptions stylit;
+  NoisyOptions noisy = no_noise();  // noise 0: no noise pass
+  std::string noise_map, noise_reference;
   std::string format = "png";
   double fps = 24;
   bool video = true, resume = true;
@@ -131,13 +149,26 @@ Options parse(const Args& args) {
     else if (flag == "--blender") o.blender.blender = r.value(flag);
     else if (flag == "--addon-path") o.blender.addon = r.value(flag);
     else if (flag == "--max-image-pixels") set_max_image_pixels(r.number<std::int64_t>(flag));
+    else if (flag == "--noise-map") o.noise_map = r.value(flag);
+    else if (flag == "--noise-reference") o.noise_reference = r.value(flag);
+    else if (set_from_flag(o.noisy, noisy_option_table(), flag.substr(2), [&] { return r.value(flag); })) continue;
     else if (!set_from_flag(o.stylit.synthesis, synthesis_option_table(), flag.substr(2), [&] { return r.value(flag); }))
       throw ValueError(concat("unknown option '", flag, "' (see tempera stylize --help)"));
   }
   validate(o.stylit.synthesis);
+  validate_fields(o.noisy, noisy_option_table());
+  const bool noise = o.noisy.noise > 0;
+  if (!noise && !(o.noise_map.empty() && o.noise_reference.empty()))
+    throw ValueError("--noise-map and --noise-reference need --noise F (the amount of temporal noise)");
+  if (noise && o.noise_reference.empty() && o.format != "png")
+    throw ValueError("--noise boils PNG frames: use --format png (the default)");
   if (o.exemplar.empty()) throw ValueError("--exemplar is required (the painting)");
   if (o.frames.empty()) throw ValueError("--frames is required (e.g. --frames 1-24)");
   if (o.out.empty()) throw ValueError("--out is required (the output folder)");
+  if (!o.noise_reference.empty()) {  // the coherent frames are given: no stylization
+    if (o.guides.empty() && !o.scene.empty()) o.guides = (fs::path(o.out) / "guides").string();
+    return o;
+  }
   if (o.exemplar_scene.empty() == o.exemplar_guides.empty())
     throw ValueError("give one of --exemplar-scene EXEMPLAR.blend or --exemplar-guides DIR");
   if (o.scene.empty() && o.guides.empty())
@@ -236,6 +267,42 @@ int interrupted(const std::vector<FrameResult>& results) {
   return 130;
 }
 
+// The noise pass: the coherent frames (OUT/frames, or --noise-reference)
+// boiled into OUT/noisy, resumable like the stylization; false if interrupted.
+bool run_noise_pass(const Options& o) {
+  NoisySequenceConfig c;
+  c.exemplar = o.exemplar;
+  c.reference = o.noise_reference.empty() ? (fs::path(o.out) / "frames").string() : o.noise_reference;
+  c.frames = o.frames;
+  c.out = (fs::path(o.out) / "noisy").string();
+  c.noise_map = o.noise_map;
+  c.guides = o.guides;
+  c.options = o.noisy;
+  c.options.synthesis.seed = o.stylit.synthesis.seed;
+  c.options.synthesis.threads = o.stylit.synthesis.threads;
+  c.resume = o.resume;
+  NoisySequence sequence(c);
+  const std::size_t n = sequence.frames().size();
+  for (std::size_t i = 0; i < n; ++i) {
+    NoisyFrameResult r;
+    try {
+      r = sequence.run_frame(i, [](double) { return !g_interrupted; });
+    } catch (const CancelledError&) {
+      return false;
+    }
+    std::cout << "noisy frame " << i + 1 << "/" << n << " (#" << r.frame << "): ";
+    if (r.status == "skipped") std::cout << "skipped, already current\n";
+    else std::cout << std::fixed << std::setprecision(2) << r.seconds << " s" << std::defaultfloat << std::endl;
+  }
+  std::cout << "noisy frames: " << c.out << "\n";
+  if (o.video && consecutive(o.frames)) {
+    const fs::path video = fs::path(o.out) / "noisy.mp4";
+    const std::string pattern = printf_escaped(c.out) + "/frame_%04d.png";
+    if (encode_video(pattern, o.frames.front(), o.fps, video.string())) std::cout << "video: " << video.string() << "\n";
+  }
+  return true;
+}
+
 }  // namespace
 
 int run_stylize(const Args& args) {
@@ -249,7 +316,12 @@ int run_stylize(const Args& args) {
   sigaction(SIGINT, &action, nullptr);
   std::vector<FrameResult> results;
   try {
-    if (!o.scene.empty()) render_guides(o, o.scene, o.frames_text, o.guides);
+    const bool guide_map = !o.noise_map.empty() && !fs::is_regular_file(o.noise_map);
+    if (!o.scene.empty() && (o.noise_reference.empty() || guide_map)) render_guides(o, o.scene, o.frames_text, o.guides);
+    if (!o.noise_reference.empty()) {  // boil the given coherent frames
+      if (!run_noise_pass(o)) return interrupted(results);
+      return 0;
+    }
     if (!o.exemplar_scene.empty()) {
       o.exemplar_guides = (fs::path(o.out) / "exemplar_guides").string();
       o.exemplar_frame = o.exemplar_frame.value_or(1);
@@ -270,6 +342,7 @@ int run_stylize(const Args& args) {
     if (!run_frames(job, results)) return interrupted(results);
     write_extras(job, o);
     print_summary(results, o.out);
+    if (o.noisy.noise > 0 && !run_noise_pass(o)) return interrupted(results);
   } catch (const CancelledError&) {
     return interrupted(results);
   }  // ValueError (bad values in the files or options) reaches main(): exit status 2

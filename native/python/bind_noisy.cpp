@@ -4,13 +4,62 @@
 
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
-#include "tempera/noisy.hpp"
+#include "tempera/noisy_sequence.hpp"
 
 namespace py = pybind11;
 using namespace tempera;
 using py_bridge::FloatArray;
 
+namespace {
+
+// The paths and frames of a NoisySequenceConfig; the options come set.
+NoisySequenceConfig sequence_config(const py::dict& d, const NoisyOptions& options) {
+  NoisySequenceConfig c;
+  c.exemplar = d["exemplar"].cast<std::string>();
+  c.reference = d["reference"].cast<std::string>();
+  c.frames = d["frames"].cast<std::vector<int>>();
+  c.out = d["out"].cast<std::string>();
+  if (d.contains("prefix")) c.prefix = d["prefix"].cast<std::string>();
+  if (d.contains("noise_map")) c.noise_map = d["noise_map"].cast<std::string>();
+  if (d.contains("guides")) c.guides = d["guides"].cast<std::string>();
+  if (d.contains("resume")) c.resume = d["resume"].cast<bool>();
+  c.options = options;
+  return c;
+}
+
+void bind_sequence(py::module_& m) {
+  py::class_<NoisySequence>(m, "NoisySequence", "Color Me Noisy over a folder of frames; use tempera.noisy.NoisySequence.")
+      .def(py::init([](const py::dict& config, const NoisyOptions& options) {
+             NoisySequenceConfig c = sequence_config(config, options);
+             py::gil_scoped_release release;  // reads the medium, checks every frame
+             return std::make_unique<NoisySequence>(std::move(c));
+           }),
+           py::arg("config"), py::arg("options"))
+      .def_property_readonly("frames", &NoisySequence::frames)
+      .def("output_path", &NoisySequence::output_path, py::arg("frame"))
+      .def(
+          "run_frame",
+          [](NoisySequence& s, std::size_t index, const std::function<bool(double)>& progress) {
+            ProgressCallback callback = py_bridge::with_gil([&](double f) { return progress ? progress(f) : true; });
+            NoisyFrameResult r;
+            {
+              py::gil_scoped_release release;
+              r = s.run_frame(index, callback);
+            }
+            py::dict out;
+            out["frame"] = r.frame;
+            out["path"] = r.path;
+            out["status"] = r.status;
+            out["seconds"] = r.seconds;
+            return out;
+          },
+          py::arg("index"), py::arg("progress") = nullptr);
+}
+
+}  // namespace
+
 void bind_noisy(py::module_& m) {
+  bind_sequence(m);
   py_bridge::bind_options_class<NoisyOptions>(m, "NoisyOptions", noisy_option_table(),
                                               "Options of Color Me Noisy (native/include/tempera/noisy.hpp).")
       .def_readwrite("synthesis", &NoisyOptions::synthesis, "engine options (defaults: noisy_defaults())");

@@ -51,6 +51,15 @@ Image deform_exemplar(const ImageView& style, const NoisyOptions& o, int frame) 
 
 namespace {
 
+// The level at which a pixel with width f_p joins the synthesis: the
+// coarsest whose f_bar <= f_p; -1 below 1 (the pixel copies R).
+int join_level(const std::vector<float>& widths, float fp) {
+  if (fp < 1.0f) return -1;
+  int l = 0;
+  while (l + 1 < int(widths.size()) && widths[std::size_t(l) + 1] <= fp + 1e-6f) ++l;
+  return l;
+}
+
 void validate(const ImageView& style, const ImageView& reference, const NoisyOptions& o, const ImageView& map) {
   require_nonempty(style, "exemplar");
   require_nonempty(reference, "reference frame");
@@ -63,6 +72,40 @@ void validate(const ImageView& style, const ImageView& reference, const NoisyOpt
     if (map.channels != 1) throw ValueError("the noise map must have 1 channel");
     require_same_size(map, "noise map", reference, "reference frame");
     require_finite(map, "noise map");
+  }
+}
+
+// Eq. 2 as guide pairs, h_w * S against h_w * R, weight `consistency`. With a
+// local map, eq. 2's h_f becomes h_{f_p} (§3.3): one pair per level at which
+// pixels join, with the f_bar of that level, each weighted by a map of its
+// pixels, so a calm region is held as firmly as a global run at its f.
+void add_low_frequency_guides(SynthesisInput& in, const ImageView& exemplar, const ImageView& reference,
+                              const NoisyOptions& o, float f, const ImageView& noise_map, std::vector<Image>& keep) {
+  const std::vector<float> widths = noisy_box_widths(f);
+  std::vector<int> join;  // per pixel: the level it joins at, -1 = a copy of R
+  if (!noise_map.empty())
+    for (std::size_t i = 0; i < noise_map.size(); ++i) join.push_back(join_level(widths, o.noise * noise_map.data[i]));
+  std::vector<int> levels(join.begin(), join.end());
+  std::sort(levels.begin(), levels.end());
+  levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
+  levels.erase(std::remove(levels.begin(), levels.end(), -1), levels.end());
+  keep.reserve(3 * std::max<std::size_t>(1, levels.size()));
+  if (levels.size() <= 1) {  // one width everywhere: the global term
+    keep.push_back(box_blur(exemplar, f));
+    keep.push_back(box_blur(reference, f));
+    in.guides.add("low_frequencies", keep[0].view(), keep[1].view(), o.consistency);
+    return;
+  }
+  for (int l : levels) {
+    const float w = widths[std::size_t(l)];
+    keep.push_back(box_blur(exemplar, w));
+    keep.push_back(box_blur(reference, w));
+    Image weight(reference.width, reference.height, 1);
+    for (std::size_t i = 0; i < join.size(); ++i) weight.data()[i] = join[i] == l ? 1.0f : 0.0f;
+    keep.push_back(std::move(weight));
+    const std::size_t k = keep.size();
+    in.guides.add(concat("low_frequencies_", l), keep[k - 3].view(), keep[k - 2].view(), o.consistency);
+    in.target_weight_maps.push_back(keep[k - 1].view());
   }
 }
 
@@ -81,20 +124,22 @@ Image noisy_frame(const ImageView& style, const ImageView& reference, int frame,
   in.target_width = reference.width;
   in.target_height = reference.height;
   in.reference = reference;
-  // Eq. 2 as a guide pair: the low-passed exemplar against the low-passed R.
-  const Image low_s = box_blur(exemplar.view(), f), low_r = box_blur(reference, f);
-  if (o.consistency > 0) in.guides.add("low_frequencies", low_s.view(), low_r.view(), o.consistency);
+  std::vector<Image> low_frequency_images;  // kept alive for the guides' views
+  if (o.consistency > 0) add_low_frequency_guides(in, exemplar.view(), reference, o, f, noise_map, low_frequency_images);
   SynthesisOptions opt = o.synthesis;
-  opt.level_ratio = kRatio;
   opt.levels = noisy_levels(f);
-  opt.level_box_widths = noisy_box_widths(f);
+  opt.level_ratio = kRatio;
+  // Eq. 4 with a box h: area resampling to the level's size is already
+  // h_f_bar * S (down)f_bar; a further box would low-pass twice (measured:
+  // half the noise at f = 4.3).
+  opt.level_box_widths.clear();
   opt.seed = noisy_frame_seed(o.synthesis.seed, frame);
   // The local noise map: per level, pixels whose f_p is below that level's
   // f_bar are held at R (blurred and downsampled like it).
   std::vector<Image> reference_levels;
-  if (!noise_map.empty()) reference_levels = build_pyramid(reference, opt.levels, kRatio, opt.level_box_widths);
+  if (!noise_map.empty()) reference_levels = build_pyramid(reference, opt.levels, kRatio, {});
   const Solver solver(in, opt);
-  const std::vector<float>& widths = opt.level_box_widths;
+  const std::vector<float> widths = noisy_box_widths(f);  // f_bar per level, for the local map
   LevelResult r;
   for (int l = solver.coarsest(); l >= 0; --l) {
     Image mask;
@@ -110,9 +155,10 @@ Image noisy_frame(const ImageView& style, const ImageView& reference, int frame,
       const Image fp = resize_area(noise_map, solver.target_width(l), solver.target_height(l));
       const Image& held = reference_levels[std::size_t(l)];
       mask = Image(fp.width(), fp.height(), 1);
-      for (std::size_t i = 0; i < fp.pixel_count(); ++i) {
-        const float fpi = o.noise * fp.data()[i];
-        mask.data()[i] = (fpi < 1.0f || widths[std::size_t(l)] > fpi + 1e-6f) ? 1.0f : 0.0f;
+      std::vector<int> join(fp.pixel_count());
+      for (std::size_t i = 0; i < join.size(); ++i) {
+        join[i] = join_level(widths, o.noise * fp.data()[i]);
+        mask.data()[i] = join[i] < 0 || join[i] < l ? 1.0f : 0.0f;
       }
       start.fixed_mask = &mask;
       start.fixed_values = &held;
@@ -120,11 +166,7 @@ Image noisy_frame(const ImageView& style, const ImageView& reference, int frame,
       // the others from the B' voted from the upsampled field.
       if (l < solver.coarsest()) {
         joining = Image(fp.width(), fp.height(), 1);
-        for (std::size_t i = 0; i < fp.pixel_count(); ++i) {
-          const float fpi = o.noise * fp.data()[i];
-          joining.data()[i] = fpi >= 1.0f && widths[std::size_t(l)] <= fpi + 1e-6f &&
-                              widths[std::size_t(l) + 1] > fpi + 1e-6f;
-        }
+        for (std::size_t i = 0; i < join.size(); ++i) joining.data()[i] = join[i] == l ? 1.0f : 0.0f;
         start.image = &held;
         start.image_mask = &joining;
       }

@@ -49,4 +49,80 @@ def test_errors_name_the_problem(cli_path, inputs):
     assert missing.returncode == 1 and "frame_0004.png" in missing.stderr
     same = run(cli_path, "--exemplar", inputs / "medium.png", "--reference", inputs / "R", "--out", inputs / "R",
                "--frames", "1")
-    assert same.returncode == 2 and "must not be the --reference folder" in same.stderr
+    assert same.returncode == 2 and "must not be the reference folder" in same.stderr
+
+
+# --------------------------------------------------------------------------- tempera stylize --noise
+from synthetic_cache import make_cache, make_exemplar  # noqa: E402
+
+
+def stylize(cli, *args):
+    return subprocess.run([str(cli), "stylize", *map(str, args)], capture_output=True, text=True, timeout=300)
+
+
+@pytest.fixture()
+def caches(tmp_path):
+    make_cache(tmp_path / "cache")
+    make_exemplar(tmp_path / "exemplar", tmp_path / "paint.png")
+    return tmp_path
+
+
+def farm(p, *extra):
+    return ("--guides", p / "cache", "--exemplar", p / "paint.png", "--exemplar-guides", p / "exemplar",
+            "--frames", "1-3", "--out", p / "out", "--threads", "2", "--no-video", *extra)
+
+
+def frames(folder):
+    return [tempera.read_image(str(folder / f"frame_{f:04d}.png")) for f in (1, 2, 3)]
+
+
+def test_stylize_boils_its_coherent_frames_and_resumes(cli_path, caches):
+    first = stylize(cli_path, *farm(caches, "--temporal", "0.5", "--noise", "2.2"))
+    assert first.returncode == 0, first.stderr
+    assert "noisy frame 3/3 (#3)" in first.stdout
+    coherent, noisy = frames(caches / "out" / "frames"), frames(caches / "out" / "noisy")
+    assert all(n.shape == c.shape for n, c in zip(noisy, coherent))
+    assert np.abs(noisy[0] - coherent[0]).mean() > 0.005          # the noise pass changed the frames
+    again = stylize(cli_path, *farm(caches, "--temporal", "0.5", "--noise", "2.2"))
+    assert again.returncode == 0 and again.stdout.count("skipped, already current") == 6
+    (caches / "out" / "noisy" / "frame_0002.png").unlink()
+    third = stylize(cli_path, *farm(caches, "--temporal", "0.5", "--noise", "2.2"))
+    assert third.stdout.count("skipped, already current") == 5
+    np.testing.assert_array_equal(frames(caches / "out" / "noisy")[1], noisy[1])  # resumed = uninterrupted
+    # A guide of the cache as the map, read per frame (alpha = 1: the full amount everywhere).
+    mapped = stylize(cli_path, *farm(caches, "--temporal", "0.5", "--noise", "2.2", "--noise-map", "alpha"))
+    assert mapped.returncode == 0, mapped.stderr
+    assert mapped.stdout.count("skipped, already current") == 3  # the coherent frames only
+    for got, want in zip(frames(caches / "out" / "noisy"), noisy):
+        np.testing.assert_array_equal(got, want)
+
+
+def test_noise_reference_and_noise_maps(cli_path, caches, inputs):
+    base = ("--exemplar", inputs / "medium.png", "--frames", "1-3", "--threads", "2", "--no-video", "--noise", "3.1",
+            "--noise-reference", inputs / "R")
+    plain = stylize(cli_path, *base, "--out", caches / "plain")
+    assert plain.returncode == 0, plain.stderr
+    reference = frames(inputs / "R")
+    assert np.abs(frames(caches / "plain" / "noisy")[0] - reference[0]).mean() > 0.01
+    tempera.write_image(str(inputs / "calm.png"), np.zeros((40, 48), np.float32))
+    calm = stylize(cli_path, *base, "--out", caches / "calm", "--noise-map", inputs / "calm.png")
+    assert calm.returncode == 0, calm.stderr
+    for got, want in zip(frames(caches / "calm" / "noisy"), reference):  # map 0: R bit for bit
+        np.testing.assert_array_equal(got, want)
+
+
+def test_noise_errors_name_the_problem(cli_path, caches, inputs):
+    bad = stylize(cli_path, *farm(caches, "--noise", "-1"))
+    assert bad.returncode == 2 and "noise" in bad.stderr
+    bad = stylize(cli_path, *farm(caches, "--noise", "lots"))
+    assert bad.returncode == 2 and "--noise" in bad.stderr
+    bad = stylize(cli_path, *farm(caches, "--noise-map", "alpha"))
+    assert bad.returncode == 2 and "need --noise" in bad.stderr
+    bad = stylize(cli_path, *farm(caches, "--noise", "2.2", "--format", "exr"))
+    assert bad.returncode == 2 and "--format png" in bad.stderr
+    lone = ("--exemplar", inputs / "medium.png", "--frames", "1-3", "--out", caches / "o", "--noise", "2.2",
+            "--noise-reference", inputs / "R")
+    bad = stylize(cli_path, *lone, "--noise-map", "alpha")
+    assert bad.returncode == 2 and "neither an image file nor a guide" in bad.stderr
+    bad = stylize(cli_path, *farm(caches, "--noise", "2.2", "--noise-map", "mask.OB_Nothing"))
+    assert bad.returncode == 2 and "mask.OB_Nothing" in bad.stderr

@@ -6,7 +6,7 @@ import pytest
 
 from tempera import noisy, temporal
 
-FRAMES = 12
+FRAMES = 32  # a static R repeated 32 times, as in the issue
 
 
 def medium(rng, h, w):
@@ -32,7 +32,7 @@ def run(inputs, f, frames=FRAMES, **kw):
 
 @pytest.fixture(scope="module")
 def sweep(inputs):
-    return {f: run(inputs, f) for f in (1.3, 2.2, 4.3)}
+    return {f: run(inputs, f) for f in (1.3, 2.2, 3.1, 4.3)}
 
 
 def energy(frames):
@@ -41,21 +41,19 @@ def energy(frames):
 
 def test_noise_rises_with_the_width(sweep):
     e = {f: energy(frames) for f, frames in sweep.items()}
-    assert e[1.3] < e[2.2] < e[4.3]
-    # Measured 1.8x here; the issue asks 2x on a 32-frame static R
-    # (docs/noisy.md, open).
-    assert e[4.3] >= 1.5 * e[1.3]
+    assert e[1.3] < e[2.2] < e[3.1] < e[4.3]
+    assert e[4.3] >= 2 * e[1.3]  # measured 2.16 (docs/noisy.md)
 
 
 def test_noise_is_white(sweep):
-    for f in (2.2, 4.3):
+    for f in (2.2, 3.1, 4.3):
         assert temporal.spectral_flatness(temporal.temporal_power_spectrum(sweep[f])) >= 0.9
 
 
 def test_large_shapes_follow_the_reference(inputs, sweep):
     _, reference = inputs
     for f, frames in sweep.items():
-        assert max(temporal.box_consistency_error(x, reference, f) for x in frames) <= 0.06, f
+        assert max(temporal.box_consistency_error(x, reference, f) for x in frames) <= 0.05, f
     # Without the low-frequency term they drift away from R.
     loose = run(inputs, 2.2, frames=3, consistency=0.0)
     assert max(temporal.box_consistency_error(x, reference, 2.2) for x in loose) > \
@@ -65,8 +63,8 @@ def test_large_shapes_follow_the_reference(inputs, sweep):
 def test_without_deformation_there_is_less_noise(inputs, sweep):
     """The paper's ablation (§3.2): without the MLS pre-deformation low f
     gives a floating texture, not noise."""
-    rigid = run(inputs, 1.3, deform=False)
-    assert energy(rigid) < energy(sweep[1.3])
+    rigid = run(inputs, 1.3, frames=12, deform=False)
+    assert energy(rigid) < energy(sweep[1.3][:12])
 
 
 def test_a_full_noise_map_changes_nothing(inputs):
@@ -77,9 +75,83 @@ def test_a_full_noise_map_changes_nothing(inputs):
                                       noisy.noisy_frame(style, reference, i, noise=3.1, threads=2))
 
 
+def test_a_split_map_splits_the_noise_in_the_global_ratio(inputs, sweep):
+    """§3.3: the calm half (f_p = 1.3) boils like a global 1.3, the lively
+    half (4.3) like a global 4.3: their energy ratio is the global one
+    (within 30%; measured 0.90 of it)."""
+    style, reference = inputs
+    h, w = reference.shape[:2]
+    split = np.ones((h, w), np.float32)
+    split[:, : w // 2] = 1.3 / 4.3
+    n = 16
+    mapped = [noisy.noisy_frame(style, reference, i, noise=4.3, noise_map=split, threads=2) for i in range(n)]
+    calm, lively = slice(4, w // 2 - 4), slice(w // 2 + 4, w - 4)  # away from the seam
+
+    def half(frames, cols):
+        return energy([x[:, cols] for x in frames])
+
+    split_ratio = half(mapped, lively) / half(mapped, calm)
+    global_ratio = half(sweep[4.3][:n], lively) / half(sweep[1.3][:n], calm)
+    assert global_ratio > 1.3
+    assert 0.7 * global_ratio <= split_ratio <= 1.3 * global_ratio, (split_ratio, global_ratio)
+
+
 def test_bad_options_are_named(inputs):
     style, reference = inputs
     with pytest.raises(TypeError, match="sparkle"):
         noisy.noisy_frame(style, reference, 1, sparkle=3)
     with pytest.raises(ValueError, match="noise"):
         noisy.noisy_frame(style, reference, 1, noise=-2)
+
+
+def test_the_warp_error_of_a_moving_shot_rises_with_the_width(inputs):
+    """A moving R (the medium sliding right 2 px a frame, its Vector passes
+    as Blender writes them): the warp error along the motion, the flicker
+    figure, rises strictly over f = 1.3, 2.2, 3.1, 4.3 (the issue's test on
+    the moving shot), and is small for R itself (R is coherent)."""
+    style, _ = inputs
+    h, w, dx, n = 48, 64, 2, 6
+    shot = [np.ascontiguousarray(style[10:10 + h, 24 - dx * t:24 - dx * t + w]) for t in range(n)]
+    vector = np.zeros((h, w, 4), np.float32)
+    vector[..., 0] = vector[..., 2] = -dx  # XY = p(t-1) - p(t), ZW = p(t) - p(t+1), content moving right
+    backward, visible = temporal.motion(vector, vector)
+
+    def warp_error(frames):
+        return np.mean([temporal.flicker(a, b, backward, visible) for a, b in zip(frames, frames[1:])])
+
+    errors = [warp_error([noisy.noisy_frame(style, r, t, noise=f, threads=2) for t, r in enumerate(shot)])
+              for f in (1.3, 2.2, 3.1, 4.3)]
+    assert all(a < b for a, b in zip(errors, errors[1:])), errors
+    assert warp_error(shot) < 0.2 * errors[0]
+
+
+def test_the_panel_steps_and_map_choices():
+    assert [noisy.noise_width(k) for k in range(9)] == [0.0, *noisy.TESTED_NOISE]
+    with pytest.raises(ValueError, match="0 \\(off\\) to 8"):
+        noisy.noise_width(9)
+    assert noisy.noise_map_spec("NONE") is None
+    assert noisy.noise_map_spec("OBJECT", object_name="Face.001") == "mask.OB_Face_001"
+    assert noisy.noise_map_spec("COLLECTION", collection_name="Background") == "mask.CO_Background"
+    assert noisy.noise_map_spec("GUIDE", guide="aov_wetness") == "aov_wetness"
+    with pytest.raises(ValueError, match="object"):
+        noisy.noise_map_spec("OBJECT")
+
+
+def test_a_sequence_is_made_then_current(inputs, tmp_path):
+    import tempera
+
+    style, reference = inputs
+    (tmp_path / "R").mkdir()
+    tempera.write_image(str(tmp_path / "medium.png"), style)
+    for f in (1, 2):
+        tempera.write_image(str(tmp_path / "R" / f"frame_{f:04d}.png"), reference)
+    args = dict(exemplar=tmp_path / "medium.png", reference=tmp_path / "R", frames=[1, 2], out=tmp_path / "out",
+                noise=2.2, threads=2)
+    first = noisy.NoisySequence(**args)
+    assert [first.run_frame(i)["status"] for i in range(2)] == ["made", "made"]
+    assert [noisy.NoisySequence(**args).run_frame(i)["status"] for i in range(2)] == ["skipped", "skipped"]
+    assert noisy.NoisySequence(**dict(args, noise=3.1)).run_frame(0)["status"] == "made"  # new settings
+    with pytest.raises(tempera.Cancelled):
+        noisy.NoisySequence(**dict(args, noise=1.6)).run_frame(0, lambda f: False)
+    with pytest.raises(ValueError, match="neither an image file nor a guide"):
+        noisy.NoisySequence(**args, noise_map="alpha")

@@ -137,6 +137,23 @@ def draw_synthesis(box, settings):
     wide_prop(col, settings, "temporal_weight")
     col.prop(settings, "patch_size")
     col.prop(settings, "seed")
+    draw_noise(box, settings)
+
+
+def draw_noise(box, settings):
+    """Temporal Noise (Color Me Noisy): the slider, its width f, the map picker."""
+    from .. import noisy
+
+    col = box.column()
+    wide_prop(col, settings, "noise_level")
+    if settings.noise_level == 0:
+        return
+    col.label(text=f"f = {noisy.noise_width(settings.noise_level)} px: frames boil into Output Folder/noisy")
+    col.prop(settings, "noise_map_source")
+    field = {"IMAGE": "noise_map_image", "OBJECT": "noise_map_object", "COLLECTION": "noise_map_collection",
+             "GUIDE": "noise_map_guide"}.get(settings.noise_map_source)
+    if field:
+        col.prop(settings, field)
 
 
 def draw_output(box, settings):

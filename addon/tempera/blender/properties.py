@@ -1,9 +1,10 @@
 """Per-scene Tempera settings, stored in the .blend file as Scene.tempera."""
 import bpy
-from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 from bpy.types import PropertyGroup
 
 from .. import guide_cache
+from .. import noisy
 from .. import settings as limits
 from ..frames import MAX_FRAME
 
@@ -250,3 +251,21 @@ class TemperaSettings(PropertyGroup):
                              description="Also encode the stylized animation as an mp4 (needs ffmpeg)")
     load_result: EnumProperty(name="Load Result", items=RESULT_ITEMS, default="SEQUENCER",
                               description="What to load into Blender after Stylize Animation")
+    # Color Me Noisy (docs/noisy.md): steps 1..8 are the paper's tested widths f.
+    noise_level: IntProperty(
+        name="Temporal Noise",
+        description="Hand-drawn 'boiling' after the coherent pass: every frame re-synthesizes the medium's "
+        "texture above a width f (steps 1-8: f = " + ", ".join(map(str, noisy.TESTED_NOISE)) + " px; "
+        "0 = off, the coherent frames as they are)",
+        default=0, min=0, max=len(noisy.TESTED_NOISE),
+    )
+    noise_map_source: EnumProperty(name="Noise Map", items=noisy.NOISE_MAP_SOURCES, default="NONE",
+                                   description="Where the temporal noise goes")
+    noise_map_image: StringProperty(name="Map Image", subtype="FILE_PATH",
+                                    description="Greyscale image of the render's size: 0 coherent, 1 full noise")
+    noise_map_object: PointerProperty(name="Map Object", type=bpy.types.Object,
+                                      description="The object that boils (its mask guide)")
+    noise_map_collection: PointerProperty(name="Map Collection", type=bpy.types.Collection,
+                                          description="The collection that boils (its mask guide)")
+    noise_map_guide: StringProperty(name="Map Guide",
+                                    description="Name of a guide of the guide cache (an attribute or AOV)")

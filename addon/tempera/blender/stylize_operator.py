@@ -36,6 +36,7 @@ STYLIZE_SECONDS_PER_MPIX = {"final": 40.0, "preview": 8.0}
 FRAMES_DIR = "frames"
 CONTACT_SHEET = "contact_sheet.png"
 VIDEO = "stylized.mp4"
+NOISY_DIR = "noisy"  # the Temporal Noise pass (Color Me Noisy) writes here
 
 
 # --------------------------------------------------------------------------- settings -> job
@@ -82,6 +83,25 @@ def stylize_options(settings):
     }
 
 
+def noise_config(settings, out, config):
+    """The NoisySequence arguments of the Temporal Noise settings (None = off):
+    the coherent frames of this run boiled into OUT/noisy."""
+    from .. import noisy
+
+    if settings.noise_level == 0:
+        return None
+    if config["format"] != "png":
+        raise ValueError("Temporal Noise boils PNG frames: set Format to PNG.")
+    image = settings.noise_map_image.strip()
+    noise_map = noisy.noise_map_spec(
+        settings.noise_map_source, resolve_path(image, "noise map image") if image else "",
+        settings.noise_map_object.name if settings.noise_map_object else "",
+        settings.noise_map_collection.name if settings.noise_map_collection else "", settings.noise_map_guide.strip())
+    return dict(exemplar=config["style"], reference=config["out"], frames=config["frames"],
+                out=os.path.join(out, NOISY_DIR), noise_map=noise_map, guides=config["guides"],
+                noise=noisy.noise_width(settings.noise_level), seed=config["seed"])
+
+
 def output_dir(settings):
     return resolve_path(settings.output_dir, "Output Folder")
 
@@ -101,6 +121,9 @@ class StylizeRun:
                            out=os.path.join(self.out, FRAMES_DIR))
         if exemplar_frame is not None:
             self.config["exemplar_frame"] = exemplar_frame
+        self.noise = noise_config(settings, self.out, self.config)  # None: no Temporal Noise pass
+        self.noise_job = None  # its NoisySequence, made once the coherent frames exist
+        self.noise_results = []
         self.job = None  # the native StylizeJob, made once the guides exist
         self.index = 0
         self.results = []
@@ -114,7 +137,7 @@ class StylizeRun:
 
     @property
     def total(self):
-        return 2 * len(self.frames)
+        return (3 if self.noise else 2) * len(self.frames)
 
     @property
     def finished(self):
@@ -124,12 +147,18 @@ class StylizeRun:
     def in_guide_phase(self):
         return self.index < len(self.frames)
 
+    @property
+    def in_noise_phase(self):
+        return self.index >= 2 * len(self.frames)
+
     def threaded(self):
         return not self.in_guide_phase  # the solver needs no bpy
 
     def step(self, progress=None):
         if self.in_guide_phase:
             self.guides.step(progress)
+        elif self.in_noise_phase:
+            self._boil(progress)
         else:
             self._stylize(progress)
         self.index += 1
@@ -153,12 +182,22 @@ class StylizeRun:
             note = f", flicker {flicker:.3f}" if flicker is not None and flicker == flicker else ""
             print(f"Tempera: frame {result['frame']} {result['status']} in {seconds:.1f} s{note}", flush=True)
 
+    def _boil(self, progress):
+        from ..noisy import NoisySequence
+
+        if self.noise_job is None:
+            self.noise_job = NoisySequence(**self.noise)
+        result = self.noise_job.run_frame(self.index - 2 * len(self.frames), progress)
+        self.noise_results.append(result)
+        if bpy.app.background:
+            print(f"Tempera: noisy frame {result['frame']} {result['status']} in {result['seconds']:.1f} s", flush=True)
+
     def current_frame(self):
         frames = self.frames
         return frames[min(self.index, self.total - 1) % len(frames)]
 
     def failure(self, exc):
-        what = "Guides" if self.in_guide_phase else "Stylizing"
+        what = "Guides" if self.in_guide_phase else "Temporal Noise" if self.in_noise_phase else "Stylizing"
         return f"{what} of frame {self.current_frame()} failed: {exc}"
 
     def eta_seconds(self):
@@ -173,6 +212,9 @@ class StylizeRun:
     def status_text(self):
         if self.in_guide_phase:
             return self.guides.status_text()
+        if self.in_noise_phase:
+            current = min(len(self.noise_results) + 1, len(self.frames))
+            return f"Tempera: temporal noise, frame {current}/{len(self.frames)} (Esc to stop)"
         eta = self.eta_seconds()
         current = min(len(self.results) + 1, len(self.frames))
         eta_text = "" if eta is None else f", ETA {format_duration(eta)}"
@@ -200,6 +242,9 @@ class StylizeRun:
             parts.append(f"{left} not done")
         flicker = self.mean_flicker()
         tail = f". {flicker_text(flicker)}" if flicker is not None else ""
+        if self.noise:
+            made = sum(r["status"] == "made" for r in self.noise_results)
+            parts.append(f"{made} boiled (Temporal Noise) in {self.noise['out']}")
         return f"Tempera: {', '.join(parts)} in {self.config['out']}{tail}"
 
 
@@ -249,7 +294,8 @@ class TEMPERA_OT_stylize(JobOperator, Operator):
     def job_finished(self, context, job):
         scene = context.scene
         settings = scene.tempera
-        paths = [r["path"] for r in job.results]
+        # With Temporal Noise the noisy frames are the result shown.
+        paths = [r["path"] for r in (job.noise_results if job.noise else job.results)]
         results.reload_images_under(job.out)  # images already open show this run's pixels
         shown = []
         if job.mode == "ANIMATION":

@@ -35,7 +35,7 @@ struct NoisyOptions {
   float lattice_spacing = 50;  // MLS lattice at 1 Mpix (scaled with sqrt(pixels / 1 Mpix))
   float shift_min = 15, shift_max = 25;
   bool deform = true;          // the MLS pre-deformation (off only for the paper's ablation)
-  float consistency = 2.0f;    // weight of the low-frequency term (eq. 2) as a guide pair
+  float consistency = 2.75f;    // weight of the low-frequency term (eq. 2) as a guide pair
   SynthesisOptions synthesis;  // patch 7, mode voting, 4 EM x 2 PM per level, usage none (noisy_defaults())
 };
 
@@ -52,7 +52,7 @@ inline const auto& noisy_option_table() {
       field(&N::shift_max, "shift_max", "shift-max", "largest move of an MLS lattice node, px at 1 Mpix (25)", 0, 10000),
       field(&N::deform, "deform", "deform", "pre-deform the exemplar every frame (off only for comparisons)"),
       field(&N::consistency, "consistency", "consistency",
-            "weight of the low-frequency term |h_f*R - h_f*T|^2: how firmly the large shapes stay R's (2)", 0, 1e6));
+            "weight of the low-frequency term |h_f*R - h_f*T|^2: how firmly the large shapes stay R's (2.75)", 0, 1e6));
   return table;
 }
 
