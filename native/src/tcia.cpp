@@ -88,19 +88,20 @@ class Sweeper {
  public:
   Sweeper(const Shot& shot, const TciaOptions& o) : shot_(shot), o_(o) {}
 
-  std::vector<Image> run(const ProgressCallback& progress) {
+  std::vector<Image> run(const SweepCallback& progress) {
     const int frames = int(shot_.frames.size());
     const int levels = make_solver(0, false)->levels();
     std::vector<FrameState> coarse, here(frames);
     const double visits = double(levels) * 2 * o_.sweep_pairs * frames;
     double done = 0;
-    auto report = [&] {
-      if (progress && !progress(++done / visits)) throw CancelledError("stylization cancelled");
+    auto report = [&](int l, int pair, int direction, int t) {
+      if (progress && !progress({l, levels, pair, o_.sweep_pairs, direction, t, ++done / visits}))
+        throw CancelledError("stylization cancelled");
     };
     for (int l = levels - 1; l >= 0; --l) {
       for (int pair = 0; pair < o_.sweep_pairs; ++pair) {
-        for (int t = 0; t < frames; ++t, report()) visit(l, t, +1, pair, coarse, here);
-        for (int t = frames - 1; t >= 0; --t, report()) visit(l, t, -1, pair, coarse, here);
+        for (int t = 0; t < frames; ++t) visit(l, t, +1, pair, coarse, here), report(l, pair, +1, t);
+        for (int t = frames - 1; t >= 0; --t) visit(l, t, -1, pair, coarse, here), report(l, pair, -1, t);
       }
       coarse = std::move(here);
       here.assign(frames, {});
@@ -264,9 +265,15 @@ class Sweeper {
 
 }  // namespace
 
-std::vector<Image> stylize_shot(const Shot& shot, const TciaOptions& options, const ProgressCallback& progress) {
+std::vector<Image> stylize_shot_sweeps(const Shot& shot, const TciaOptions& options, const SweepCallback& progress) {
   validate(shot, options);
   return Sweeper(shot, options).run(progress);
+}
+
+std::vector<Image> stylize_shot(const Shot& shot, const TciaOptions& options, const ProgressCallback& progress) {
+  SweepCallback sweeps;
+  if (progress) sweeps = [&](const SweepProgress& p) { return progress(p.fraction); };
+  return stylize_shot_sweeps(shot, options, sweeps);
 }
 
 }  // namespace tempera

@@ -19,6 +19,7 @@
 // the random merge leans toward the nearer key. Lines (eq. 9), ribbons, the
 // time-derivative terms (eq. 10) and layers are still to come (issue 12).
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -90,5 +91,21 @@ Image pick_resize(const ImageView& image, int width, int height, float scale = 1
 // The stylized frames of the shot, in order. progress(fraction) returning
 // false cancels (CancelledError).
 std::vector<Image> stylize_shot(const Shot& shot, const TciaOptions& options, const ProgressCallback& progress = {});
+
+// Where the sweeps are, reported after each frame visit: level counts down
+// from levels - 1 (coarsest) to 0, direction is +1 (forward sweep) or -1,
+// frame is the index into Shot::frames just solved.
+struct SweepProgress {
+  int level = 0, levels = 0;
+  int pair = 0, pairs = 0;
+  int direction = +1;
+  int frame = 0;
+  double fraction = 0;  // of all visits of the shot
+};
+using SweepCallback = std::function<bool(const SweepProgress&)>;
+
+// stylize_shot with the sweep position in the progress (the CLI's and the
+// panel's progress lines); returning false cancels (CancelledError).
+std::vector<Image> stylize_shot_sweeps(const Shot& shot, const TciaOptions& options, const SweepCallback& progress);
 
 }  // namespace tempera
