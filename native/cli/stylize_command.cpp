@@ -315,13 +315,9 @@ bool report_sweep(const SweepProgress& p, std::size_t index, std::size_t count, 
 
 // The coherent method's segments (all, or the one of --segment); false if interrupted.
 bool run_segments(TciaJob& job, const Options& o) {
-  std::vector<std::size_t> which;
-  if (o.segment) which = {job.segment_index(o.segment->first, o.segment->second)};
-  else
-    for (std::size_t i = 0; i < job.segments().size(); ++i) which.push_back(i);
   int stylized = 0, skipped = 0;
   double seconds = 0;
-  for (std::size_t i : which) {
+  for (std::size_t i : job.selected()) {
     if (g_interrupted) return false;
     const TciaSegment& s = job.segments()[i];
     const auto start = std::chrono::steady_clock::now();
@@ -380,7 +376,7 @@ int run_stylize(const Args& args) {
     config.stylit = o.stylit;
     config.resume = o.resume;
     if (o.method == "tcia") {
-      TciaJob job({config, o.keys, o.tcia});
+      TciaJob job({config, o.keys, o.tcia, o.segment});
       for (const auto& w : job.warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
       if (!run_segments(job, o)) return interrupted_segments();
       if (!o.segment) write_extras(job.frames_job(), o);  // a segment is a farm task: the finish writes them

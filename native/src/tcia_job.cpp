@@ -20,13 +20,6 @@ namespace {
 constexpr const char* kRecordFormat = "tempera-tcia-segment 1";
 const char* const kMotion[] = {"velocity_backward", "occlusion_backward", "velocity_forward", "occlusion_forward"};
 
-// The per-frame job checks the files and sizes; its temporal guide is
-// StyLit's, not this method's, so it is off there.
-StylizeJobConfig per_frame(StylizeJobConfig c) {
-  c.stylit.temporal_weight = 0;
-  return c;
-}
-
 std::vector<int> segment_bounds(const std::vector<int>& frames, const std::vector<KeyFile>& keys) {
   std::vector<int> bounds = {frames.front()};
   for (const KeyFile& k : keys)
@@ -45,6 +38,21 @@ std::vector<TciaSegment> make_segments(const std::vector<int>& frames, const std
     for (int f = s.first; f <= end; ++f) s.writes.push_back(f);
     out.push_back(s);
   }
+  return out;
+}
+
+// The segments to run: all, or the one of `segment`.
+std::vector<std::size_t> select(const std::vector<TciaSegment>& segments,
+                                const std::optional<std::pair<int, int>>& segment) {
+  std::vector<std::size_t> out;
+  std::string list;
+  for (std::size_t i = 0; i < segments.size(); ++i) {
+    if (!segment || (segments[i].first == segment->first && segments[i].last == segment->second)) out.push_back(i);
+    list += concat(i ? ", " : "", segments[i].first, "-", segments[i].last);
+  }
+  if (out.empty())
+    throw ValueError(concat("segment ", segment->first, "-", segment->second, " is not one of the shot's segments (",
+                            list, "; they run from key to key)"));
   return out;
 }
 
@@ -121,6 +129,18 @@ void write_text_atomically(const std::string& path, const std::string& text) {
 
 }  // namespace
 
+// The per-frame job checks the files and sizes of the frames to solve; its
+// temporal guide is StyLit's, not this method's, so it is off there.
+StylizeJobConfig per_frame(const TciaJobConfig& c) {
+  StylizeJobConfig out = c.frames;
+  out.stylit.temporal_weight = 0;
+  if (c.segment) {
+    out.frames.clear();
+    for (int f = c.segment->first; f <= c.segment->second; ++f) out.frames.push_back(f);
+  }
+  return out;
+}
+
 KeyFile parse_key(const std::string& text) {
   const std::size_t eq = text.find('=');
   if (eq == std::string::npos || eq == 0 || eq + 1 == text.size())
@@ -136,15 +156,18 @@ KeyFile parse_key(const std::string& text) {
   return k;
 }
 
+// Keys and segments are checked before the per-frame job reads any file.
 TciaJob::TciaJob(TciaJobConfig config)
-    : config_((check_frames(config.frames.frames), std::move(config))), frames_(per_frame(config_.frames)) {
-  config_.keys = sorted_keys(std::move(config_.keys), config_.frames.frames);
+    : config_(checked(std::move(config))),
+      segments_(make_segments(config_.frames.frames, config_.keys)),
+      selected_(select(segments_, config_.segment)),
+      frames_(per_frame(config_)) {
   validate_fields(config_.tcia, tcia_option_table());
   validate(config_.tcia.synthesis);
-  segments_ = make_segments(config_.frames.frames, config_.keys);
   // Motion: a segment's frames link to their neighbours inside it; its first
   // frame needs no V-, its last no V+.
-  for (const TciaSegment& s : segments_)
+  for (std::size_t i : selected_) {
+    const TciaSegment& s = segments_[i];
     for (int f = s.first; f <= s.last; ++f) {
       const std::string path = frames_.target_guides_path(f);
       const ImageFileInfo info = inspect_image(path);
@@ -157,10 +180,13 @@ TciaJob::TciaJob(TciaJobConfig config)
                                   "' (render the guides with motion)"));
       }
     }
+  }
   for (const KeyFile& k : config_.keys) {
+    paintings_.emplace_back(), masks_.emplace_back();
+    if (!is_read(k.frame)) continue;  // outside the one segment run
     const ImageFileInfo info = inspect_image(frames_.target_guides_path(k.frame));
-    paintings_.push_back(read_key_painting(k, frames_.style().channels(), info.width, info.height));
-    masks_.push_back(read_key_mask(k, info.width, info.height));
+    paintings_.back() = read_key_painting(k, frames_.style().channels(), info.width, info.height);
+    masks_.back() = read_key_mask(k, info.width, info.height);
   }
   std::ostringstream s;
   s << kRecordFormat << ";weights=";
@@ -173,14 +199,14 @@ TciaJob::TciaJob(TciaJobConfig config)
   fs::create_directories(fs::path(config_.frames.out) / "tempera_tcia", ec);
 }
 
-std::size_t TciaJob::segment_index(int first, int last) const {
-  std::string list;
-  for (std::size_t i = 0; i < segments_.size(); ++i) {
-    if (segments_[i].first == first && segments_[i].last == last) return i;
-    list += concat(i ? ", " : "", segments_[i].first, "-", segments_[i].last);
-  }
-  throw ValueError(concat("segment ", first, "-", last, " is not one of the shot's segments (", list,
-                          "; they run from key to key)"));
+TciaJobConfig TciaJob::checked(TciaJobConfig c) {
+  check_frames(c.frames.frames);
+  c.keys = sorted_keys(std::move(c.keys), c.frames.frames);
+  return c;
+}
+
+bool TciaJob::is_read(int frame) const {
+  return !config_.segment || (frame >= config_.segment->first && frame <= config_.segment->second);
 }
 
 std::string TciaJob::record_path(std::size_t index) const {
@@ -252,7 +278,9 @@ Shot TciaJob::load_shot(const TciaSegment& segment, std::deque<Image>& keep) con
 }
 
 SegmentResult TciaJob::run_segment(std::size_t index, const SegmentProgress& progress) {
-  const TciaSegment& segment = segments_.at(index);
+  if (std::find(selected_.begin(), selected_.end(), index) == selected_.end())
+    throw ValueError(concat("segment ", index, " is not one this job runs"));
+  const TciaSegment& segment = segments_[index];
   SegmentResult result;
   if (config_.frames.resume && is_current(index)) {
     result.status = "skipped";

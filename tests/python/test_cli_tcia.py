@@ -1,4 +1,5 @@
 """`tempera stylize --method tcia`: segments at keys, farm split, resume, cancel, threads, errors."""
+import shutil
 import signal
 import subprocess
 
@@ -49,10 +50,15 @@ def test_key_comes_out_as_painted_and_farm_split_equals_single_run(cli_path, sho
     key = tempera.read_image(str(shot / "key4.png"))
     out4 = tempera.read_image(str(shot / "single" / "frames" / "frame_0004.png"))
     assert np.abs(out4 - key).max() <= 1 / 255 + 1e-6
-    # A farm: each segment on its own "machine" (folder), then gathered.
+    # A farm: each segment on its own machine, which has only its own guide frames.
     for segment in ("4-7", "1-4"):
+        a, b = map(int, segment.split("-"))
+        own = shot / f"cache_{segment}"
+        own.mkdir(exist_ok=True)
+        for f in range(a, b + 1):
+            shutil.copy2(shot / "cache" / f"frame_{f:04d}.exr", own)
         result = stylize(cli_path, *args(shot, "farm", "--key", f"4={shot / 'key4.png'}", "--segment", segment,
-                                         "--threads", "1"))
+                                         "--threads", "1", cache=own.name))
         assert result.returncode == 0, result.stderr
         assert "1 segment(s) stylized" in result.stdout
     assert frames_of(shot, "farm") == single

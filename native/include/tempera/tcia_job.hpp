@@ -32,6 +32,10 @@ struct TciaJobConfig {
   StylizeJobConfig frames;  // painting, guide caches, frames (consecutive), output, guide weights
   std::vector<KeyFile> keys;
   TciaOptions tcia = default_tcia_options();
+  // Only the segment from frame A to B (a farm task): only its guide frames
+  // and bounding keys are read. ValueError listing the shot's segments if
+  // A-B is not one.
+  std::optional<std::pair<int, int>> segment;
 };
 
 // Frames first..last (inclusive) are solved together; the segment writes
@@ -56,14 +60,13 @@ class TciaJob {
   explicit TciaJob(TciaJobConfig config);
 
   const std::vector<TciaSegment>& segments() const { return segments_; }
-  // The index of the segment "A-B" (its first and last frame); ValueError
-  // listing the shot's segments otherwise.
-  std::size_t segment_index(int first, int last) const;
+  // The indices of the segments to run: all, or the one of config.segment.
+  const std::vector<std::size_t>& selected() const { return selected_; }
   const StylizeJob& frames_job() const { return frames_; }
   const std::vector<std::string>& warnings() const { return frames_.warnings(); }
   std::string record_path(std::size_t index) const;
 
-  // Solves segment `index` (or skips it when its record is current) and
+  // Solves segment `index` (one of selected()) (or skips it when its record is current) and
   // writes its frames. `progress` returning false cancels: CancelledError,
   // nothing written.
   SegmentResult run_segment(std::size_t index, const SegmentProgress& progress = {});
@@ -73,9 +76,13 @@ class TciaJob {
   bool is_current(std::size_t index) const;
   Shot load_shot(const TciaSegment& segment, std::deque<Image>& keep) const;
 
+  static TciaJobConfig checked(TciaJobConfig config);  // frames consecutive, keys sorted and in the shot
+  bool is_read(int frame) const;                       // in the frames this job reads
+
   TciaJobConfig config_;
-  StylizeJob frames_;  // validates the per-frame inputs, names the outputs, writes the contact sheet
   std::vector<TciaSegment> segments_;
+  std::vector<std::size_t> selected_;
+  StylizeJob frames_;  // validates the per-frame inputs, names the outputs, writes the contact sheet
   std::vector<Image> paintings_, masks_;  // per key (masks_ empty for a whole key)
   std::string settings_;
 };
