@@ -53,3 +53,28 @@ def test_a_key_comes_out_as_painted():
     mask[8:24, 10:30] = 1
     out = tcia.stylize_shot(style, guides, frames, keys=[(2, painting, mask)], levels=3, patch_size=7, threads=2)
     np.testing.assert_allclose(out[2][8:24, 10:30], painting[8:24, 10:30], atol=1 / 255)
+
+
+def test_shot_job_runs_segments_like_the_cli(tmp_path):
+    from synthetic_cache import make_cache, make_exemplar
+
+    make_cache(tmp_path / "cache", frames=(1, 2, 3, 4, 5), forward=True)
+    make_exemplar(tmp_path / "ex", tmp_path / "paint.png")
+    key = tmp_path / "paint.png"
+    assert tcia.segments(range(1, 6), [3]) == [(1, 3), (3, 5)] and tcia.segments([4], [4]) == [(4, 4)]
+    seen = []
+    job = tcia.ShotJob(tmp_path / "paint.png", tmp_path / "ex", tmp_path / "cache", range(1, 6), tmp_path / "out",
+                       keys=[(3, key)], weights={"LDE": 3}, levels=2, patch_size=7)
+    assert [s[:2] for s in job.segments] == tcia.segments(range(1, 6), [3]) and job.selected == [0, 1]
+    assert job.segments[0][2] == [1, 2] and job.segments[1][2] == [3, 4, 5]
+    assert job.run_segment(0, seen.append)["status"] == "stylized"
+    assert seen[-1]["fraction"] == pytest.approx(1.0) and {d["direction"] for d in seen} == {1, -1}
+    assert job.run_segment(0)["status"] == "skipped"
+    import tempera
+
+    with pytest.raises(tempera.Cancelled):
+        job.run_segment(1, lambda d: False)
+    assert not (tmp_path / "out" / "frame_0003.png").exists()
+    with pytest.raises(ValueError, match="segment 2-4 is not one"):
+        tcia.ShotJob(key, tmp_path / "ex", tmp_path / "cache", range(1, 6), tmp_path / "o", keys=[(3, key)],
+                     segment=(2, 4))
