@@ -25,7 +25,7 @@ def options(**values) -> "TciaOptions":
     """TciaOptions from keywords: its own (temporal_weight, coherence_weight,
     coherence_max, sweep_pairs) and engine options (SynthesisOptions names,
     from the method's defaults: 9 x 9 Gaussian window, centre output,
-    histogram usage, 4 levels)."""
+    histogram usage, automatic levels)."""
     return method_options(TciaOptions, _native.tcia_defaults(), values, "coherent-method")
 
 

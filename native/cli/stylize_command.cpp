@@ -78,7 +78,7 @@ const char* kStylizeHelpText =
     "  --segment A-B           tcia: solve only the segment from key A to key B (a farm\n"
     "                          task); the shot splits at keys into independent segments\n"
     "@TCIA@"
-    "  tcia's engine defaults: 9x9 Gaussian window, centre output, histogram usage, 4 levels;\n"
+    "  tcia's engine defaults: 9x9 Gaussian window, centre output, histogram usage, automatic levels;\n"
     "  its --temporal defaults to 1. Resume, Ctrl-C and SIGTERM work per segment.\n"
     "\n"
     "guide rendering (SCENE.blend / --exemplar-scene only):\n"

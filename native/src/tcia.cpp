@@ -17,7 +17,7 @@ SynthesisOptions tcia_defaults() {
   o.window_sigma = 3.0f;
   o.output = OutputMode::Centre;
   o.usage = PatchUsage::Histogram;
-  o.levels = 4;
+  o.levels = 0;  // automatic: the coarsest side >= 4 patches (4 levels at 0.25 Mpix, 5 at 1 Mpix)
   o.em_iterations = 1;
   o.pm_iterations = 4;  // "3 or 4 full iterations" of parallel PatchMatch (§3.3)
   o.guide_variance = 1.0;

@@ -15,6 +15,12 @@ runs them: modal with progress and Esc in the UI, all at once in background):
 
 After the last frame of an animation: a contact sheet, an mp4 (when ffmpeg
 is present) and the result loaded back into Blender (Load Result).
+
+With Method "Temporally Coherent (Bénard 2013)", Stylize Animation's second
+phase is CoherentRun: tempera.tcia.ShotJob, one step per segment between
+painted keyframes (each resumable, Esc stops within a segment and nothing of
+it is written). Stylize Frame stays per-frame StyLit: a quick look, and the
+ground Add Keyframe paints over.
 """
 import os
 import time
@@ -110,6 +116,8 @@ class StylizeRun:
     @classmethod
     def from_settings(cls, scene, mode="ANIMATION"):
         frames = [scene.frame_current] if mode == "FRAME" else guide_frames(scene, scene.tempera)
+        if mode == "ANIMATION" and scene.tempera.method == "TCIA":
+            return CoherentRun(scene, frames, mode)
         return cls(scene, frames, mode)
 
     @property
@@ -201,6 +209,69 @@ class StylizeRun:
         flicker = self.mean_flicker()
         tail = f". {flicker_text(flicker)}" if flicker is not None else ""
         return f"Tempera: {', '.join(parts)} in {self.config['out']}{tail}"
+
+
+class CoherentRun(StylizeRun):
+    """Guides of every frame, then the coherent method, one segment per step."""
+
+    def __init__(self, scene, frames, mode="ANIMATION"):
+        from .. import tcia
+        from .keyframes import key_list
+
+        super().__init__(scene, frames, mode)
+        if any(b != a + 1 for a, b in zip(self.frames, self.frames[1:])):
+            raise ValueError("The coherent method needs consecutive frames: set the scene's Frame Step to 1.")
+        self.keys = [k for k in key_list(scene.tempera) if self.frames[0] <= k[0] <= self.frames[-1]]
+        self.segments = tcia.segments(self.frames, [k[0] for k in self.keys])
+        self.segment_results = []
+
+    @property
+    def total(self):
+        return len(self.frames) + len(self.segments)
+
+    def _stylize(self, progress):
+        from ..tcia import ShotJob
+
+        c = self.config
+        if self.job is None:
+            self.job = ShotJob(c["style"], c["exemplar_guides"], c["guides"], self.frames, c["out"],
+                               exemplar_frame=c.get("exemplar_frame"), keys=self.keys, weights=c["weights"],
+                               format=c["format"], seed=c["seed"])
+            self.warnings = list(self.job.warnings)
+        i = self.index - len(self.frames)
+        started = time.monotonic()
+        result = self.job.run_segment(i, None if progress is None else lambda d: progress(d["fraction"]))
+        if result["status"] == "stylized":
+            self.stylize_seconds += time.monotonic() - started
+        self.segment_results.append(result)
+        for frame in self.job.segments[i][2]:
+            self.results.append({"frame": frame, "path": self.job.output_path(frame), "status": result["status"]})
+        if bpy.app.background:
+            first, last = self.segments[i]
+            print(f"Tempera: segment {i + 1}/{len(self.segments)} (frames {first}-{last}) {result['status']} "
+                  f"in {time.monotonic() - started:.1f} s", flush=True)
+
+    def current_frame(self):
+        if self.in_guide_phase:
+            return super().current_frame()
+        return self.segments[min(self.index - len(self.frames), len(self.segments) - 1)][0]
+
+    def eta_seconds(self):
+        stylized = [r for r in self.segment_results if r["status"] == "stylized"]
+        left = len(self.segments) - len(self.segment_results)
+        if not stylized or left <= 0:
+            return None
+        return self.stylize_seconds / len(stylized) * left
+
+    def status_text(self):
+        if self.in_guide_phase:
+            return self.guides.status_text()
+        i = min(len(self.segment_results), len(self.segments) - 1)
+        eta = self.eta_seconds()
+        first, last = self.segments[i]
+        eta_text = "" if eta is None else f", ETA {format_duration(eta)}"
+        return (f"Tempera: coherent segment {i + 1}/{len(self.segments)} (frames {first}-{last}){eta_text} "
+                "(Esc to stop)")
 
 
 def flicker_text(flicker):

@@ -75,7 +75,7 @@ inline const auto& tcia_option_table() {
 }
 
 // The engine options of the method: 9 x 9 patches in a Gaussian window of
-// sigma 3, output centre (a warp), usage histogram, 4 levels, one search of
+// sigma 3, output centre (a warp), usage histogram, automatic levels (coarsest side >= 4 patches), one search of
 // 4 PatchMatch iterations per visit, exact guides.
 SynthesisOptions tcia_defaults();
 inline TciaOptions default_tcia_options() {
