@@ -21,13 +21,24 @@ def coherent(scene, tmp_path):
     return scene
 
 
-def test_method_choice_and_keyframe_list_in_the_panel(coherent):
-    from tempera.blender import panels
+def test_method_choice_and_keyframe_list_in_the_panel(coherent, tmp_path):
+    from test_addon import _Recorder
     from tempera.blender.properties import METHOD_ITEMS
 
     assert ("TCIA", "Temporally Coherent (Bénard 2013)") == METHOD_ITEMS[1][:2]
-    assert hasattr(bpy.types, "TEMPERA_UL_keyframes") and hasattr(bpy.types, "TEMPERA_OT_add_keyframe")
-    assert callable(panels.draw_keyframes)
+    bpy.context.window.scene = coherent
+    bpy.ops.tempera.import_keyframe(filepath=__file__, frame=FRAMES[0])
+    calls = []
+    bpy.types.TEMPERA_PT_output.draw(type("FakePanel", (), {"layout": _Recorder(calls)})(), bpy.context)
+    props = [name for kind, name in calls if kind == "prop"]
+    assert props[props.index("method") + 1:props.index("method") + 4] == ["painting", "mask", "keyframe_dir"]
+    assert ("template_list", "keyframes") in calls
+    operators = [name for kind, name in calls if kind == "operator"]
+    assert operators.count("tempera.add_keyframe") == 2 and "tempera.import_keyframe" in operators
+    coherent.tempera.method = "STYLIT"
+    calls.clear()
+    bpy.types.TEMPERA_PT_output.draw(type("FakePanel", (), {"layout": _Recorder(calls)})(), bpy.context)
+    assert ("template_list", "keyframes") not in calls
 
 
 def test_add_keyframe_paint_it_and_stylize_coherently(coherent, tmp_path):
