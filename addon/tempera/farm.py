@@ -154,7 +154,7 @@ def plan(frames, out, exemplar, *, scene=None, guides=None, exemplar_guides=None
     if temporal is None and segments is None:
         from .settings import DEFAULT_TEMPORAL_WEIGHT as temporal
     # Always stated: the chunks must agree with a single run whatever the CLI's default. The
-    # coherent method keeps its own (1) unless one is given.
+    # coherent method keeps its own (3) unless one is given.
     common = ["--guides", guides, "--exemplar", str(exemplar), "--exemplar-guides", str(exemplar_guides),
               "--out", out] + ([] if temporal is None else ["--temporal", repr(float(temporal))])
     common += list(stylize_args)

@@ -173,7 +173,7 @@ function compileJob(job) {
     const stylizeArgs = splitArgs(s.stylize_args);
     const segments = tciaSegments(frames, stylizeArgs);
     // Always stated: the chunks must agree with a single run whatever the CLI's default. The
-    // coherent method keeps its own (1; give --temporal W in stylize_args to change it).
+    // coherent method keeps its own (3; give --temporal W in stylize_args to change it).
     let common = ["--guides", guides, "--exemplar", s.exemplar, "--exemplar-guides", exemplarGuides,
                   "--out", s.out].concat(segments ? [] : ["--temporal", pyFloat(s.temporal)]);
     common = common.concat(stylizeArgs);

@@ -79,7 +79,7 @@ const char* kStylizeHelpText =
     "                          task); the shot splits at keys into independent segments\n"
     "@TCIA@"
     "  tcia's engine defaults: 9x9 Gaussian window, centre output, histogram usage, automatic levels;\n"
-    "  its --temporal defaults to 1. Resume, Ctrl-C and SIGTERM work per segment.\n"
+    "  its --temporal defaults to 3. Resume, Ctrl-C and SIGTERM work per segment.\n"
     "\n"
     "guide rendering (SCENE.blend / --exemplar-scene only):\n"
     "  --samples N             Cycles samples of the guide renders (default 16)\n"
