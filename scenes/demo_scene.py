@@ -145,7 +145,8 @@ def comparison_sheet(out, scene):
 def paint_keys(out):
     """Two painted keyframes made by the project's own stand-in artist: the
     hatching that painted the kit's exemplar (tempera.exemplar_paint), drawn
-    over each key frame's render (the guide cache's FULL), one seed per frame."""
+    over each key frame's render (the guide cache's FULL) where the scene
+    covers the film (alpha; bare paper elsewhere), one seed per frame."""
     import tempera
     from tempera import guide_cache
     from tempera.exemplar_paint import paint_hatching
@@ -154,9 +155,9 @@ def paint_keys(out):
     keys.mkdir(exist_ok=True)
     paths = []
     for frame in KEY_FRAMES:
-        full = guide_cache.read_frame(out / "guides", frame, ["FULL"])["FULL"]
+        g = guide_cache.read_frame(out / "guides", frame, ["FULL", "alpha"])
         path = keys / f"key_{frame:04d}.png"
-        tempera.write_image(str(path), paint_hatching(full, seed=frame))
+        tempera.write_image(str(path), paint_hatching(g["FULL"], mask=g["alpha"], seed=frame))
         paths.append((frame, path))
     return paths
 
