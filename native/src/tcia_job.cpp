@@ -156,14 +156,12 @@ KeyFile parse_key(const std::string& text) {
   return k;
 }
 
-// Keys and segments are checked before the per-frame job reads any file.
+// Options, keys and segments are checked before the per-frame job reads any file.
 TciaJob::TciaJob(TciaJobConfig config)
     : config_(checked(std::move(config))),
       segments_(make_segments(config_.frames.frames, config_.keys)),
       selected_(select(segments_, config_.segment)),
       frames_(per_frame(config_)) {
-  validate_fields(config_.tcia, tcia_option_table());
-  validate(config_.tcia.synthesis);
   // Motion: a segment's frames link to their neighbours inside it; its first
   // frame needs no V-, its last no V+.
   for (std::size_t i : selected_) {
@@ -201,6 +199,8 @@ TciaJob::TciaJob(TciaJobConfig config)
 
 TciaJobConfig TciaJob::checked(TciaJobConfig c) {
   check_frames(c.frames.frames);
+  validate_fields(c.tcia, tcia_option_table());
+  validate(c.tcia.synthesis);
   c.keys = sorted_keys(std::move(c.keys), c.frames.frames);
   return c;
 }

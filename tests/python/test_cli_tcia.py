@@ -109,6 +109,7 @@ def test_any_thread_count_gives_the_same_frames(cli_path, shot):
     (("--segment", "2-5"), 2, "segment 2-5 is not one of the shot's segments (1-7"),
     (("--segment", "3"), 2, "--segment expects A-B"),
     (("--method", "ebsynth"), 2, "unknown --method 'ebsynth'"),
+    (("--sweeps", "0"), 2, "sweep"),
 ])
 def test_bad_input_names_the_problem(cli_path, shot, extra, code, message):
     small = shot / "small.png"
