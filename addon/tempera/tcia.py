@@ -70,6 +70,8 @@ class ShotJob:
     format, weights ({guide: weight}, the others keep their default), resume: as tempera.stylize.StylizeJob;
     keys      [(frame, painting path[, mask path]), ...]
     segment   (first, last): only that segment (a farm task)
+    lines     {weight, d_max, ink}: the line term of eq. 9 (tcia_job.hpp TciaLineOptions;
+              weight > 0 needs the cache's line_distance)
     **values  the method's and engine options (tempera.tcia.options)
 
     Construction checks every file, key and guide (FileNotFoundError,
@@ -77,14 +79,15 @@ class ShotJob:
     """
 
     def __init__(self, style, exemplar_guides, guides, frames, out, *, exemplar_frame=None, keys=(), segment=None,
-                 weights=None, format="png", resume=True, **values):
+                 weights=None, format="png", resume=True, lines=None, **values):
         config = dict(style=os.fspath(style), exemplar_guides=os.fspath(exemplar_guides), guides=os.fspath(guides),
                       frames=[int(f) for f in frames], out=os.fspath(out), format=str(format), resume=bool(resume),
                       exemplar_frame=None if exemplar_frame is None else int(exemplar_frame),
                       weights={str(k): float(v) for k, v in dict(weights or {}).items()},
                       keys=[(int(k[0]), os.fspath(k[1]), None if len(k) < 3 or not k[2] else os.fspath(k[2]))
                             for k in keys],
-                      segment=None if segment is None else (int(segment[0]), int(segment[1])))
+                      segment=None if segment is None else (int(segment[0]), int(segment[1])),
+                      lines=dict(lines or {}))
         self._job = _native.TciaJob(config, options(**values))
 
     @property

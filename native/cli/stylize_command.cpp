@@ -78,6 +78,7 @@ const char* kStylizeHelpText =
     "  --segment A-B           tcia: solve only the segment from key A to key B (a farm\n"
     "                          task); the shot splits at keys into independent segments\n"
     "@TCIA@"
+    "@LINES@"
     "  tcia's engine defaults: 9x9 Gaussian window, centre output, histogram usage, automatic levels;\n"
     "  its --temporal defaults to 3. Resume, Ctrl-C and SIGTERM work per segment.\n"
     "\n"
@@ -103,6 +104,7 @@ std::string stylize_help() {
   std::string text = kStylizeHelpText;
   text.replace(text.find("@WEIGHTS@"), 9, defaults);
   text.replace(text.find("@TCIA@"), 6, flags_help<TciaOptions>(tcia_option_table()));
+  text.replace(text.find("@LINES@"), 7, flags_help<TciaLineOptions>(tcia_line_option_table()));
   return text;
 }
 
@@ -124,6 +126,7 @@ struct Options {
   std::vector<KeyFile> keys;
   std::optional<std::pair<int, int>> segment;
   TciaOptions tcia = default_tcia_options();
+  TciaLineOptions lines;
   std::vector<std::pair<std::string, std::string>> engine_flags;
   std::vector<std::string> tcia_flags;
   bool temporal_given = false;
@@ -145,7 +148,9 @@ bool set_engine_flag(Options& o, const std::string& flag, ArgReader& r) {
     o.engine_flags.emplace_back(flag.substr(2), text);
     return true;
   }
-  if (!set_from_flag(o.tcia, tcia_option_table(), flag.substr(2), value)) return false;
+  if (!set_from_flag(o.tcia, tcia_option_table(), flag.substr(2), value) &&
+      !set_from_flag(o.lines, tcia_line_option_table(), flag.substr(2), value))
+    return false;
   o.tcia_flags.push_back(flag);
   return true;
 }
@@ -376,7 +381,7 @@ int run_stylize(const Args& args) {
     config.stylit = o.stylit;
     config.resume = o.resume;
     if (o.method == "tcia") {
-      TciaJob job({config, o.keys, o.tcia, o.segment});
+      TciaJob job({config, o.keys, o.tcia, o.lines, o.segment});
       for (const auto& w : job.warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
       if (!run_segments(job, o)) return interrupted_segments();
       if (!o.segment) write_extras(job.frames_job(), o);  // a segment is a farm task: the finish writes them

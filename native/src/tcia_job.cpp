@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "tempera/distance_transform.hpp"
 #include "tempera/error.hpp"
 #include "tempera/file_keys.hpp"
 #include "tempera/image_io.hpp"
@@ -106,6 +107,18 @@ Image read_key_mask(const KeyFile& k, int width, int height) {
   return out;
 }
 
+// D(S): the bounded distance to the painting's ink (eq. 9).
+Image ink_distance(const ImageView& style, const TciaLineOptions& o) {
+  Image ink(style.width, style.height, 1);
+  for (int y = 0; y < style.height; ++y)
+    for (int x = 0; x < style.width; ++x) {
+      const float* p = style.pixel(x, y);
+      const float lum = style.channels >= 3 ? 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2] : p[0];
+      ink.at(x, y, 0) = lum < o.ink ? 1.0f : 0.0f;
+    }
+  return line_distance(ink.view(), o.d_max);
+}
+
 void write_text_atomically(const std::string& path, const std::string& text) {
   const fs::path target(path);
   const fs::path temp = target.parent_path() / temporary_name(target.filename().string(), "");
@@ -169,6 +182,10 @@ TciaJob::TciaJob(TciaJobConfig config)
     for (int f = s.first; f <= s.last; ++f) {
       const std::string path = frames_.target_guides_path(f);
       const ImageFileInfo info = inspect_image(path);
+      if (config_.lines.weight > 0 &&
+          std::none_of(info.channel_names.begin(), info.channel_names.end(),
+                       [](const std::string& c) { return c.rfind("line_distance.", 0) == 0; }))
+        throw ValueError(concat("the line term (--lines) needs 'line_distance' in '", path, "'"));
       for (int m = f == s.first ? 2 : 0; m < (f == s.last ? 2 : 4); ++m) {
         const std::string guide = kMotion[m];
         const bool has = std::any_of(info.channel_names.begin(), info.channel_names.end(),
@@ -190,7 +207,8 @@ TciaJob::TciaJob(TciaJobConfig config)
   s << kRecordFormat << ";weights=";
   for (const auto& [name, weight] : active_guides(config_.frames.stylit)) s << name << ":" << weight << ",";
   s << ";" << settings_text(config_.tcia, tcia_option_table())
-    << settings_text(config_.tcia.synthesis, synthesis_option_table()) << "format=" << config_.frames.format << ";"
+    << settings_text(config_.tcia.synthesis, synthesis_option_table())
+    << settings_text(config_.lines, tcia_line_option_table()) << "format=" << config_.frames.format << ";"
     << file_stamp(config_.frames.style) << ";" << file_stamp(frames_.exemplar_path());
   settings_ = s.str();
   std::error_code ec;
@@ -200,6 +218,7 @@ TciaJob::TciaJob(TciaJobConfig config)
 TciaJobConfig TciaJob::checked(TciaJobConfig c) {
   check_frames(c.frames.frames);
   validate_fields(c.tcia, tcia_option_table());
+  validate_fields(c.lines, tcia_line_option_table());
   validate(c.tcia.synthesis);
   c.keys = sorted_keys(std::move(c.keys), c.frames.frames);
   return c;
@@ -251,13 +270,21 @@ Shot TciaJob::load_shot(const TciaSegment& segment, std::deque<Image>& keep) con
     shot.style_guides.push_back(keep.emplace_back(tonemap_guide(frames_.exemplar().get(name).view())).view());
     shot.guide_weights.push_back(weight);
   }
+  const bool lines = config_.lines.weight > 0;
+  if (lines) {
+    shot.guide_names.push_back("line_distance");
+    shot.style_guides.push_back(keep.emplace_back(ink_distance(frames_.style().view(), config_.lines)).view());
+    shot.guide_weights.push_back(config_.lines.weight);
+  }
   for (int f = segment.first; f <= segment.last; ++f) {
     std::vector<std::string> wanted = names;
+    if (lines) wanted.push_back("line_distance");
     const int from = f == segment.first ? 2 : 0, to = f == segment.last ? 2 : 4;
     for (int m = from; m < to; ++m) wanted.push_back(kMotion[m]);
     const GuideFrame g = GuideFrame::read(frames_.target_guides_path(f), wanted);
     ShotFrame frame;
     for (const auto& name : names) frame.guides.push_back(keep.emplace_back(tonemap_guide(g.get(name).view())).view());
+    if (lines) frame.guides.push_back(keep.emplace_back(Image::copy_of(g.get("line_distance").view())).view());
     const Image& first = g.get(names.front());
     ImageView* motion[] = {&frame.velocity_backward, &frame.occlusion_backward, &frame.velocity_forward,
                            &frame.occlusion_forward};

@@ -25,11 +25,16 @@ def write_frame(cache, frame, blob_x, speed, forward=False):
     visible = np.ones((H, W), np.float32)
     visible[:, : int(np.ceil(speed))] = 0  # entered from outside the frame
     guides["occlusion_backward"] = visible
-    if forward:  # V+ and χ+ as well (the coherent method's backward sweeps)
+    if forward:  # V+ and χ+ (the coherent method's backward sweeps), and lines around the blob (eq. 9)
+        from tempera.guides import line_distance
+
         guides["velocity_forward"] = guides["velocity_backward"]
         leaving = np.ones((H, W), np.float32)
         leaving[:, W - int(np.ceil(speed)):] = 0  # about to leave the frame
         guides["occlusion_forward"] = leaving
+        yy, xx = np.mgrid[0:H, 0:W].astype(np.float32)
+        guides["lines"] = (np.abs(np.hypot(xx - blob_x, yy - H / 2) - H / 4) < 0.75).astype(np.float32)
+        guides["line_distance"] = line_distance(guides["lines"], 10.0)
     guides["alpha"] = np.ones((H, W), np.float32)
     return guide_cache.write_frame(cache, frame, guides)
 

@@ -119,6 +119,18 @@ def test_bad_input_names_the_problem(cli_path, shot, extra, code, message):
     assert result.returncode == code and message in result.stderr, result.stderr
 
 
+def test_line_term_runs_from_the_cli_and_is_part_of_the_resume_key(cli_path, shot):
+    result = stylize(cli_path, *args(shot, "lines", "--lines", "4", "--ink", "0.6"))
+    assert result.returncode == 0, result.stderr
+    assert "1 segment(s) stylized" in result.stdout
+    again = stylize(cli_path, *args(shot, "lines", "--lines", "4", "--ink", "0.6"))
+    assert "0 segment(s) stylized, 1 skipped" in again.stdout
+    off = stylize(cli_path, *args(shot, "lines"))
+    assert "1 segment(s) stylized" in off.stdout
+    missing = stylize(cli_path, *args(shot, "lines2", "--lines", "4", cache="no_forward"))
+    assert missing.returncode == 2 and "needs 'line_distance'" in missing.stderr, missing.stderr
+
+
 def test_stylit_refuses_tcia_options_and_tcia_needs_forward_motion(cli_path, shot):
     stylit = [a for a in args(shot, "bad2", "--key", f"4={shot / 'key4.png'}") if a not in ("--method", "tcia")]
     result = stylize(cli_path, *stylit)

@@ -28,10 +28,31 @@ struct KeyFile {
 // "12=key.png" or "12=key.png,mask.png" (the CLI's --key); ValueError naming the text.
 KeyFile parse_key(const std::string& text);
 
+// The distance-transform term for line exemplars (eq. 9): one more guide
+// pair, D(S) of the painting's ink against the guide cache's line_distance
+// D(I), so that ink goes where the frame has lines.
+struct TciaLineOptions {
+  float weight = 0;    // w_dt; 0 = off
+  float d_max = 10;    // must be the guide cache's Line Distance Max
+  float ink = 0.5f;    // luminance below which a painting pixel is ink
+};
+
+inline const auto& tcia_line_option_table() {
+  using T = TciaLineOptions;
+  static const auto table = std::make_tuple(
+      field(&T::weight, "weight", "lines",
+            "w_dt of eq. 9: ink of a line painting goes to the frame's lines (guide cache line_distance); "
+            "0 = off, 4 typical", 0, 1e6),
+      field(&T::d_max, "d_max", "line-d-max", "d_max of D(S), the guide cache's Line Distance Max (10)", 0.1, 1e6),
+      field(&T::ink, "ink", "ink", "luminance below which a painting pixel is ink (0.5)", 0, 1));
+  return table;
+}
+
 struct TciaJobConfig {
   StylizeJobConfig frames;  // painting, guide caches, frames (consecutive), output, guide weights
   std::vector<KeyFile> keys;
   TciaOptions tcia = default_tcia_options();
+  TciaLineOptions lines;
   // Only the segment from frame A to B (a farm task): only its guide frames
   // and bounding keys are read. ValueError listing the shot's segments if
   // A-B is not one.
