@@ -31,7 +31,8 @@ def test_method_choice_and_keyframe_list_in_the_panel(coherent, tmp_path):
     calls = []
     bpy.types.TEMPERA_PT_output.draw(type("FakePanel", (), {"layout": _Recorder(calls)})(), bpy.context)
     props = [name for kind, name in calls if kind == "prop"]
-    assert props[props.index("method") + 1:props.index("method") + 4] == ["painting", "mask", "keyframe_dir"]
+    assert props[props.index("method") + 1:props.index("method") + 5] == ["painting", "mask", "keyframe_dir",
+                                                                          "line_weight"]
     assert ("template_list", "keyframes") in calls
     operators = [name for kind, name in calls if kind == "operator"]
     assert operators.count("tempera.add_keyframe") == 2 and "tempera.import_keyframe" in operators
@@ -82,6 +83,11 @@ def test_add_keyframe_paint_it_and_stylize_coherently(coherent, tmp_path):
         again.step()
     assert [r["status"] for r in again.segment_results] == ["skipped", "skipped"]
     assert "3 already done" in again.summary()
+    settings.line_weight = 4.0  # the line term (eq. 9) on the cache's line distance: both segments redone
+    lines = StylizeRun.from_settings(scene, "ANIMATION")
+    while not lines.finished:
+        lines.step()
+    assert [r["status"] for r in lines.segment_results] == ["stylized", "stylized"]
 
 
 def test_import_key_and_remove(coherent, tmp_path):

@@ -160,6 +160,7 @@ def draw_keyframes(box, settings):
         col.prop(key, "painting")
         col.prop(key, "mask")
     box.prop(settings, "keyframe_dir")
+    box.prop(settings, "line_weight")
 
 
 def draw_output(box, settings):

@@ -277,6 +277,11 @@ class TemperaSettings(PropertyGroup):
                          description="How Stylize Animation paints the shot")
     keyframes: CollectionProperty(type=TemperaKeyframe, name="Keyframes")
     keyframe_index: IntProperty(name="Active Keyframe", default=0, min=0)
+    line_weight: FloatProperty(
+        name="Line Term",
+        description="For line paintings (ink on paper): pulls the painting's ink onto the scene's lines (the "
+        "guide cache's line distance, Bénard 2013 eq. 9); 0 = off, 4 typical",
+        default=0.0, min=0.0, soft_max=10.0)
     keyframe_dir: StringProperty(
         name="Keyframe Folder",
         description="Where Add Keyframe saves the images to paint over ('//' is beside the .blend file)",

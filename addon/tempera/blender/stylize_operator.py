@@ -224,6 +224,7 @@ class CoherentRun(StylizeRun):
         self.keys = [k for k in key_list(scene.tempera) if self.frames[0] <= k[0] <= self.frames[-1]]
         self.segments = tcia.segments(self.frames, [k[0] for k in self.keys])
         self.segment_results = []
+        self.line_weight = float(scene.tempera.line_weight)
 
     @property
     def total(self):
@@ -236,7 +237,8 @@ class CoherentRun(StylizeRun):
         if self.job is None:
             self.job = ShotJob(c["style"], c["exemplar_guides"], c["guides"], self.frames, c["out"],
                                exemplar_frame=c.get("exemplar_frame"), keys=self.keys, weights=c["weights"],
-                               format=c["format"], seed=c["seed"])
+                               format=c["format"], seed=c["seed"],
+                               lines={"weight": self.line_weight, "d_max": self.guides.params["line_d_max"]})
             self.warnings = list(self.job.warnings)
         i = self.index - len(self.frames)
         started = time.monotonic()
