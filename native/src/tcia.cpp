@@ -116,8 +116,9 @@ class Sweeper {
   // target is given per level; the input's is a placeholder).
   std::unique_ptr<Solver> make_solver(int t, bool temporal, int direction = +1) const {
     const ShotFrame& f = shot_.frames[std::size_t(t)];
-    placeholder_ = Image(f.guides.empty() ? shot_.style.width : f.guides[0].width,
-                         f.guides.empty() ? shot_.style.height : f.guides[0].height, shot_.style.channels);
+    // A shot without guides (keys and motion only) takes the frame's size from its motion.
+    const ImageView& sized = f.guides.empty() ? f.velocity_backward : f.guides[0];
+    placeholder_ = Image(sized.width, sized.height, shot_.style.channels);
     SynthesisInput in;
     in.style = shot_.style;
     for (std::size_t g = 0; g < shot_.style_guides.size(); ++g)

@@ -32,6 +32,12 @@ def test_shot_is_coherent_and_reports_progress():
     assert flick < 0.01
 
 
+def test_a_shot_without_guides_has_its_frames_size():
+    style, _, frames = shot(frames=2)
+    out = tcia.stylize_shot(style, [], [dict(f, guides=[]) for f in frames], levels=2, patch_size=7)
+    assert [o.shape for o in out] == [(32, 48, 3)] * 2
+
+
 def test_cancel_and_bad_options():
     style, guides, frames = shot(frames=2)
     import tempera
