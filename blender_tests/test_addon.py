@@ -12,7 +12,8 @@ from conftest import ADDON, INSTALL, disable, enable, is_enabled, registered_tem
 
 EXPECTED_CLASSES = ["TEMPERA_OT_choose_painting", "TEMPERA_OT_painting_template", "TEMPERA_OT_register_painting",
                     "TEMPERA_OT_render_guides", "TEMPERA_OT_stylize", "TEMPERA_PT_output", "TemperaPreferences",
-                    "TemperaSettings"]
+                    "TemperaSettings", "TemperaKeyframe", "TEMPERA_UL_keyframes", "TEMPERA_OT_add_keyframe",
+                    "TEMPERA_OT_import_keyframe", "TEMPERA_OT_remove_keyframe"]
 
 
 
@@ -169,6 +170,10 @@ class _Recorder:
     def template_icon(self, icon_value=0, scale=1.0):
         self.calls.append(("template_icon", icon_value))
 
+    def template_list(self, list_type, list_id, data, prop, active_data, active_prop, **kwargs):
+        assert hasattr(bpy.types, list_type) and prop in data.bl_rna.properties
+        self.calls.append(("template_list", prop))
+
     row = column = box = split = column_flow = _sub
 
 
@@ -179,7 +184,7 @@ def test_output_panel_draws_settings_with_the_frames_by_the_buttons():
     props = [name for kind, name in calls if kind == "prop"]
     labels = [text for kind, text in calls if kind == "label"]
     assert props == ["guide_frame_range", "exemplar_source", "weight_full", "weight_lde", "weight_lse",
-                     "weight_ldde", "weight_ld12e", "quality", "usage", "temporal_weight", "patch_size", "seed",
+                     "weight_ldde", "weight_ld12e", "method", "quality", "usage", "temporal_weight", "patch_size", "seed",
                      "noise_level",
                      "output_dir", "output_format", "make_video", "load_result",
                      "guide_dir", "guide_samples",

@@ -46,6 +46,8 @@ SCENE_NAME = "Demo"
 CAMERA_ORBIT = math.radians(6)  # the camera turns this far around the table over FRAMES
 FRAMES_PER_ROW = 6  # on the comparison sheet
 NOISE_LEVEL = 4  # the noisy variant: Temporal Noise step 4, f = 2.2 px (docs/noisy.md)
+KEY_FRAMES = (2, 11)  # the coherent run's painted keys: segments 1-2, 2-11 and 11-12
+COHERENT = "coherent"  # OUT/coherent/: the coherent method's frames, sheet and video
 
 
 # --------------------------------------------------------------------------- scene
@@ -139,6 +141,59 @@ def comparison_sheet(out, scene):
     return sheet
 
 
+# --------------------------------------------------------------------------- the coherent method
+
+def paint_keys(out):
+    """Two painted keyframes made by the project's own stand-in artist: the
+    hatching that painted the kit's exemplar (tempera.exemplar_paint), drawn
+    over each key frame's render (the guide cache's FULL) where the scene
+    covers the film (alpha; bare paper elsewhere), one seed per frame."""
+    import tempera
+    from tempera import guide_cache
+    from tempera.exemplar_paint import paint_hatching
+
+    keys = out / "keys"
+    keys.mkdir(exist_ok=True)
+    paths = []
+    for frame in KEY_FRAMES:
+        g = guide_cache.read_frame(out / "guides", frame, ["FULL", "alpha"])
+        path = keys / f"key_{frame:04d}.png"
+        tempera.write_image(str(path), paint_hatching(g["FULL"], mask=g["alpha"], seed=frame))
+        paths.append((frame, path))
+    return paths
+
+
+def run_coherent(scene, out):
+    """Stylize Animation again with Method "Temporally Coherent (Bénard
+    2013)" and the two keys imported into the Keyframes list; the guides are
+    current, so only the segments run. Returns (per-frame, coherent) mean flicker."""
+    from tempera import guide_cache, read_image, temporal
+
+    settings = scene.tempera
+    settings.method = "TCIA"
+    settings.noise_level = 0  # the noisy variant is made once, from the per-frame result
+    settings.output_dir = str(out / COHERENT)
+    settings.keyframe_dir = str(out / "keys")
+    settings.load_result = "NONE"  # 'Demo Tempera' keeps playing the per-frame result
+    for frame, path in paint_keys(out):
+        if bpy.ops.tempera.import_keyframe(filepath=str(path), frame=frame) != {"FINISHED"}:
+            raise RuntimeError(f"Import Key of {path} failed")
+    result = bpy.ops.tempera.stylize(mode="ANIMATION")
+    if result != {"FINISHED"}:
+        raise RuntimeError(f"the coherent Stylize Animation ended with {result}; see the messages above")
+
+    def mean_flicker(folder):
+        values = []
+        for f in FRAMES[1:]:
+            g = guide_cache.read_frame(out / "guides", f, ["velocity_backward", "occlusion_backward"])
+            values.append(temporal.flicker(read_image(str(folder / f"frame_{f - 1:04d}.png")),
+                                           read_image(str(folder / f"frame_{f:04d}.png")),
+                                           g["velocity_backward"], g["occlusion_backward"]))
+        return sum(values) / len(values)
+
+    return mean_flicker(out / "frames"), mean_flicker(out / COHERENT / "frames")
+
+
 # --------------------------------------------------------------------------- main
 
 def main():
@@ -175,6 +230,7 @@ def run(out, started):
     result = bpy.ops.tempera.stylize(mode="ANIMATION")
     if result != {"FINISHED"}:
         raise RuntimeError(f"Stylize Animation with Temporal Noise ended with {result}; see the messages above")
+    per_frame, coherent = run_coherent(scene, out)
     blend = out / "demo.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(blend), check_existing=False)
 
@@ -187,6 +243,8 @@ def run(out, started):
     video = out / "stylized.mp4"
     print(f"video:            {video if video.is_file() else '(none: ffmpeg not found)'}")
     print(f"blend file:       {blend} (scene 'Demo' and the sequencer scene 'Demo Tempera')")
+    print(f"coherent:         {out / COHERENT}/frames/frame_####.png (Bénard 2013, keys {out / 'keys'})")
+    print(f"mean flicker:     per-frame {per_frame:.4f}, coherent {coherent:.4f}")
     print(f"total {time.monotonic() - started:.1f} s")
 
 

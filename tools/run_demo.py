@@ -18,6 +18,22 @@ import blender_env
 
 SCENE = blender_env.ROOT / "scenes" / "demo_scene.py"
 FRAMES = 12  # scenes/demo_scene.py renders and stylizes frames 1-12 (its FRAMES)
+KEY_FRAMES = (2, 11)  # its painted keys of the coherent run (its KEY_FRAMES)
+
+
+def check_coherent(out):
+    """What is wrong with the coherent run's frames, or None: each key frame
+    must come out as painted (within 1/255)."""
+    sys.path.insert(0, str(blender_env.ROOT / "addon"))
+    import numpy as np
+    import tempera
+
+    for f in KEY_FRAMES:
+        key = tempera.read_image(str(out / "keys" / f"key_{f:04d}.png"))[:, :, :3]
+        got = tempera.read_image(str(out / "coherent" / "frames" / f"frame_{f:04d}.png"))[:, :, :3]
+        if got.shape != key.shape or np.abs(got - key).max() > 1 / 255 + 1e-6:
+            return f"coherent frame {f} is not its painted key"
+    return None
 
 
 def main():
@@ -42,9 +58,17 @@ def main():
     expected += [out / "frames" / f"frame_{f:04d}.png" for f in range(1, FRAMES + 1)]
     expected += [out / "noisy" / f"frame_{f:04d}.png" for f in range(1, FRAMES + 1)]  # the Temporal Noise variant
     expected += [out / name for name in ("contact_sheet.png", "comparison_sheet.png", "demo.blend")]
+    # The coherent method (Bénard 2013) with two painted keys (scenes/demo_scene.py KEY_FRAMES).
+    expected += [out / "keys" / f"key_{f:04d}.png" for f in KEY_FRAMES]
+    expected += [out / "coherent" / "frames" / f"frame_{f:04d}.png" for f in range(1, FRAMES + 1)]
+    expected += [out / "coherent" / "contact_sheet.png"]
     missing = [str(p) for p in expected if not p.is_file()]
     if missing:
         print(f"demo: missing outputs: {', '.join(missing)}", file=sys.stderr)
+        return 1
+    problem = check_coherent(out)
+    if problem:
+        print(f"demo: {problem}", file=sys.stderr)
         return 1
     print(f"\ndemo finished in {elapsed:.1f} s")
     print(f"  frames           {out / 'frames'}  ({FRAMES} stylized PNG)")
@@ -54,6 +78,7 @@ def main():
     video = out / "stylized.mp4"
     print(f"  video            {video if video.is_file() else '(none: ffmpeg not found)'}")
     print(f"  blend file       {out / 'demo.blend'}  (open it: scene 'Demo Tempera' plays the result)")
+    print(f"  coherent         {out / 'coherent'}  (Bénard 2013 with the keys in {out / 'keys'})")
     return 0
 
 

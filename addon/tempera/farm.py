@@ -10,8 +10,9 @@
 2. `guides A-B`: `tempera render-guides SCENE --frames A-B`, one per chunk of frames (only with SCENE);
 3. `stylize A-B`: `tempera stylize --guides ... --frames A-B --no-video`, one per chunk, after the
    guide chunks it reads. With a temporal weight a frame is pulled towards its predecessor, so a
-   temporal chain must not be cut: one task per segment, and a shot is one segment until the
-   coherent method brings keyframes. Results are then frame for frame those of one machine;
+   temporal chain must not be cut: the whole shot is one task. The coherent method
+   (`--method tcia`) solves a shot as independent segments from key to key (`--key F=PATH`):
+   one task per segment (`--segment A-B`). Results are then frame for frame those of one machine;
 4. `finish`: `tempera stylize` over all frames, which finds every frame current (the resume
    key) and writes the contact sheet and the video.
 
@@ -89,6 +90,35 @@ def chunk_frames(frames, size):
     return [frames[i:i + size] for i in range(0, len(frames), size)]
 
 
+def _option_values(args, name):
+    """The values of `name` in an argv list ("--key V" or "--key=V"), in order."""
+    values = []
+    for i, word in enumerate(args):
+        if word == name and i + 1 < len(args):
+            values.append(args[i + 1])
+        elif word.startswith(name + "="):
+            values.append(word[len(name) + 1:])
+    return values
+
+
+def tcia_segments(frames, stylize_args):
+    """The coherent method's segments [first, ..., last] of a shot: from key
+    to key and to the shot's ends, as `tempera stylize --method tcia` solves
+    them (native/src/tcia_job.cpp); None for per-frame StyLit."""
+    if _option_values(stylize_args, "--method")[-1:] != ["tcia"]:
+        return None
+    keys = set()
+    for text in _option_values(stylize_args, "--key"):
+        number = text.split("=", 1)[0]
+        if not number.lstrip("-").isdigit():
+            raise FarmError(f"--key expects FRAME=PAINTING[,MASK], got {text!r}")
+        keys.add(int(number))
+    bounds = sorted({frames[0], frames[-1]} | {k for k in keys if frames[0] < k < frames[-1]})
+    if len(bounds) == 1:
+        return [frames]
+    return [list(range(a, b + 1)) for a, b in zip(bounds, bounds[1:])]
+
+
 def plan(frames, out, exemplar, *, scene=None, guides=None, exemplar_guides=None, exemplar_scene=None,
          exemplar_frame=1, chunk_size=DEFAULT_CHUNK_SIZE, temporal=None, tempera=("tempera",),
          guide_args=(), stylize_args=(), video=True):
@@ -120,20 +150,24 @@ def plan(frames, out, exemplar, *, scene=None, guides=None, exemplar_guides=None
                               tempera + ["render-guides", str(scene), "--frames", format_frames(chunk),
                                          "--out", guides, *guide_args], frames=chunk))
             guide_tasks.append((set(chunk), name))
-    if temporal is None:
+    segments = tcia_segments(frames, list(stylize_args))
+    if temporal is None and segments is None:
         from .settings import DEFAULT_TEMPORAL_WEIGHT as temporal
-    # Always stated: the chunks must agree with a single run whatever the CLI's default.
+    # Always stated: the chunks must agree with a single run whatever the CLI's default. The
+    # coherent method keeps its own (3) unless one is given.
     common = ["--guides", guides, "--exemplar", str(exemplar), "--exemplar-guides", str(exemplar_guides),
-              "--out", out, "--temporal", repr(float(temporal))]
+              "--out", out] + ([] if temporal is None else ["--temporal", repr(float(temporal))])
     common += list(stylize_args)
-    # A temporal chain is one task (one segment per shot until keyframes exist).
-    pieces = [frames] if temporal else chunk_frames(frames, chunk_size)
+    if segments is not None:  # each task solves one segment of the whole shot
+        pieces = [(p, ["--frames", format_frames(frames), "--segment", f"{p[0]}-{p[-1]}"]) for p in segments]
+    else:  # a temporal chain is one task
+        pieces = [(p, ["--frames", format_frames(p)]) for p in ([frames] if temporal else
+                                                                chunk_frames(frames, chunk_size))]
     stylize_names = []
-    for piece in pieces:
+    for piece, which in pieces:
         name = f"stylize {format_frames(piece)}"
         needs = exemplar_task + [n for covered, n in guide_tasks if covered & set(piece)]
-        tasks.append(Task(name, "stylize", tempera + ["stylize", "--frames", format_frames(piece), *common,
-                                                       "--no-video"], needs, piece))
+        tasks.append(Task(name, "stylize", tempera + ["stylize", *which, *common, "--no-video"], needs, piece))
         stylize_names.append(name)
     tasks.append(Task("finish", "finish",
                       tempera + ["stylize", "--frames", format_frames(frames), *common,

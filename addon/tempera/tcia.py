@@ -4,8 +4,14 @@ the paint stays on the surfaces (native/src/tcia.cpp, docs/engine.md).
 
 Painted keyframes are hard constraints and extra exemplars; lines, ribbons
 and layers are still to come (issue 12).
+
+`ShotJob` runs the method over a guide cache as `tempera stylize --method
+tcia` does (native/src/tcia_job.cpp): the shot in independent segments from
+key to key, each resumable (docs/cli.md).
 """
 from __future__ import annotations
+
+import os
 
 import numpy as np
 
@@ -19,7 +25,7 @@ def options(**values) -> "TciaOptions":
     """TciaOptions from keywords: its own (temporal_weight, coherence_weight,
     coherence_max, sweep_pairs) and engine options (SynthesisOptions names,
     from the method's defaults: 9 x 9 Gaussian window, centre output,
-    histogram usage, 4 levels)."""
+    histogram usage, automatic levels)."""
     return method_options(TciaOptions, _native.tcia_defaults(), values, "coherent-method")
 
 
@@ -44,3 +50,70 @@ def stylize_shot(style, guides, frames, *, keys=(), progress=None, **values):
     k = [(int(key[0]), _image(key[1]), None if len(key) < 3 or key[2] is None else _image(key[2])) for key in keys]
     report = None if progress is None else (lambda x: progress(x) is not False)
     return _native.stylize_shot(_image(style), g, f, k, options(**values), report)
+
+
+def segments(frames, key_frames=()):
+    """The segments [(first, last), ...] of a shot of consecutive `frames`:
+    from key to key and to the shot's ends, as the job solves them."""
+    frames = sorted(int(f) for f in frames)
+    inner = sorted({int(k) for k in key_frames if frames[0] < int(k) < frames[-1]})
+    bounds = [frames[0], *inner] + ([frames[-1]] if frames[-1] != frames[0] else [])
+    if len(bounds) == 1:
+        return [(frames[0], frames[0])]
+    return list(zip(bounds, bounds[1:]))
+
+
+class ShotJob:
+    """The coherent method over a guide cache, segment by segment.
+
+    style, exemplar_guides, exemplar_frame, guides, frames (consecutive), out,
+    format, weights ({guide: weight}, the others keep their default), resume: as tempera.stylize.StylizeJob;
+    keys      [(frame, painting path[, mask path]), ...]
+    segment   (first, last): only that segment (a farm task)
+    lines     {weight, d_max, ink}: the line term of eq. 9 (tcia_job.hpp TciaLineOptions;
+              weight > 0 needs the cache's line_distance)
+    **values  the method's and engine options (tempera.tcia.options)
+
+    Construction checks every file, key and guide (FileNotFoundError,
+    ValueError). ``run_segment(i)`` for i in ``selected``.
+    """
+
+    def __init__(self, style, exemplar_guides, guides, frames, out, *, exemplar_frame=None, keys=(), segment=None,
+                 weights=None, format="png", resume=True, lines=None, **values):
+        config = dict(style=os.fspath(style), exemplar_guides=os.fspath(exemplar_guides), guides=os.fspath(guides),
+                      frames=[int(f) for f in frames], out=os.fspath(out), format=str(format), resume=bool(resume),
+                      exemplar_frame=None if exemplar_frame is None else int(exemplar_frame),
+                      weights={str(k): float(v) for k, v in dict(weights or {}).items()},
+                      keys=[(int(k[0]), os.fspath(k[1]), None if len(k) < 3 or not k[2] else os.fspath(k[2]))
+                            for k in keys],
+                      segment=None if segment is None else (int(segment[0]), int(segment[1])),
+                      lines=dict(lines or {}))
+        self._job = _native.TciaJob(config, options(**values))
+
+    @property
+    def segments(self) -> list:
+        """(first, last, frames it writes) per segment of the shot."""
+        return self._job.segments
+
+    @property
+    def selected(self) -> list:
+        return self._job.selected
+
+    @property
+    def warnings(self) -> list:
+        return self._job.warnings
+
+    def output_path(self, frame: int) -> str:
+        return self._job.output_path(int(frame))
+
+    def run_segment(self, index: int, progress=None) -> dict:
+        """Solves segment `index` (or skips it when current) and writes its
+        frames. ``progress(dict(level, levels, direction, frame, fraction))``
+        after each frame visit; returning False cancels (tempera.Cancelled),
+        nothing written. Returns dict(status "stylized" | "skipped", seconds)."""
+        report = None if progress is None else (lambda d: progress(d) is not False)
+        status, seconds = self._job.run_segment(int(index), report)
+        return {"status": status, "seconds": seconds}
+
+    def write_contact_sheet(self, path, columns: int = 0) -> None:
+        self._job.write_contact_sheet(os.fspath(path), int(columns))

@@ -101,6 +101,40 @@ function execCommand(tempera, args) {
     return author.Command("exec", { exe: words[0], args: words.slice(1).concat(args) });
 }
 
+// The values of `name` in an argument list ("--key V" or "--key=V"), in order.
+function optionValues(args, name) {
+    const values = [];
+    args.forEach((word, i) => {
+        if (word === name && i + 1 < args.length) values.push(args[i + 1]);
+        else if (word.startsWith(name + "=")) values.push(word.slice(name.length + 1));
+    });
+    return values;
+}
+
+// The coherent method's segments (tempera.farm.tcia_segments): from key to key
+// and to the shot's ends; null for per-frame StyLit.
+function tciaSegments(frames, args) {
+    const methods = optionValues(args, "--method");
+    if (methods[methods.length - 1] !== "tcia") return null;
+    const first = frames[0], last = frames[frames.length - 1];
+    const bounds = new Set([first, last]);
+    for (const text of optionValues(args, "--key")) {
+        const number = text.split("=")[0];
+        if (!/^-?[0-9]+$/.test(number)) throw `--key expects FRAME=PAINTING[,MASK], got '${text}'`;
+        const k = parseInt(number, 10);
+        if (k > first && k < last) bounds.add(k);
+    }
+    const sorted = [...bounds].sort((a, b) => a - b);
+    if (sorted.length === 1) return [frames];
+    const out = [];
+    for (let i = 0; i + 1 < sorted.length; ++i) {
+        const piece = [];
+        for (let f = sorted[i]; f <= sorted[i + 1]; ++f) piece.push(f);
+        out.push(piece);
+    }
+    return out;
+}
+
 function compileJob(job) {
     const s = job.settings;
     const frames = parseFrames(s.frames);
@@ -136,17 +170,23 @@ function compileJob(job) {
         }
     }
 
-    // Always stated: the chunks must agree with a single run whatever the CLI's default.
+    const stylizeArgs = splitArgs(s.stylize_args);
+    const segments = tciaSegments(frames, stylizeArgs);
+    // Always stated: the chunks must agree with a single run whatever the CLI's default. The
+    // coherent method keeps its own (3; give --temporal W in stylize_args to change it).
     let common = ["--guides", guides, "--exemplar", s.exemplar, "--exemplar-guides", exemplarGuides,
-                  "--out", s.out, "--temporal", pyFloat(s.temporal)];
-    common = common.concat(splitArgs(s.stylize_args));
-    // A temporal chain must not be cut: one task per segment (the whole shot for now).
-    const pieces = s.temporal ? [frames] : chunkFrames(frames, chunkSize);
+                  "--out", s.out].concat(segments ? [] : ["--temporal", pyFloat(s.temporal)]);
+    common = common.concat(stylizeArgs);
+    // A temporal chain must not be cut: the whole shot is one task; the coherent method's
+    // segments (key to key) are independent: one task each.
+    const pieces = segments ? segments.map((p) => [p, ["--frames", formatFrames(frames), "--segment",
+                                                       `${p[0]}-${p[p.length - 1]}`]])
+        : (s.temporal ? [frames] : chunkFrames(frames, chunkSize)).map((p) => [p, ["--frames", formatFrames(p)]]);
     const stylizeTasks = [];
-    for (const piece of pieces) {
+    for (const [piece, which] of pieces) {
         const range = formatFrames(piece);
         const task = author.Task(`stylize ${range}`, "misc");
-        task.addCommand(execCommand(tempera, ["stylize", "--frames", range].concat(common, ["--no-video"])));
+        task.addCommand(execCommand(tempera, ["stylize"].concat(which, common, ["--no-video"])));
         for (const t of exemplarTasks) task.addDependency(t);
         for (const g of guideTasks) {
             if (piece.some((f) => g.frames.has(f))) task.addDependency(g.task);

@@ -2,6 +2,7 @@
 // background Blender when given .blend files (or takes existing guide caches,
 // as a render farm does), runs the StylizeJob frame by frame with resume, and
 // writes a contact sheet and a video.
+#include <chrono>
 #include <csignal>
 #include <cmath>
 #include <cstdio>
@@ -17,6 +18,7 @@
 #include "tempera/noisy_sequence.hpp"
 #include "tempera/process.hpp"
 #include "tempera/stylize_job.hpp"
+#include "tempera/tcia_job.hpp"
 
 namespace fs = std::filesystem;
 
@@ -67,6 +69,19 @@ const char* kStylizeHelpText =
     "  --no-video              do not encode OUT/stylized.mp4\n"
     "  --no-resume             stylize every frame again, even if current\n"
     "\n"
+    "method:\n"
+    "  --method M              stylit (default: per frame) | tcia (temporally coherent,\n"
+    "                          Benard et al. 2013: the whole shot in forward and backward\n"
+    "                          sweeps along the motion; needs consecutive frames with\n"
+    "                          velocity_forward/backward and occlusion_forward/backward)\n"
+    "  --key F=PATH[,MASK]     tcia: a painted keyframe (repeatable); comes out as painted\n"
+    "                          (where MASK > 0.5 if given) and steers its neighbours\n"
+    "  --segment A-B           tcia: solve only the segment from key A to key B (a farm\n"
+    "                          task); the shot splits at keys into independent segments\n"
+    "@TCIA@"
+    "@LINES@"
+    "  tcia's engine defaults: 9x9 Gaussian window, centre output, histogram usage, automatic levels;\n"
+    "  its --temporal defaults to 3. Resume, Ctrl-C and SIGTERM work per segment.\n"
     "temporal noise (Color Me Noisy, after the coherent frames; docs/noisy.md):\n"
     "  --noise F               low-pass width f in pixels: the coherent frames boil by this amount\n"
     "                          into OUT/noisy/frame_0001.png ... (1.3 calm .. 4.3 lively; 0 = off)\n"
@@ -97,6 +112,8 @@ std::string stylize_help() {
     defaults += (defaults.empty() ? "" : ",") + std::string(g.name) + "=" + format_value(g.weight);
   std::string text = kStylizeHelpText;
   text.replace(text.find("@WEIGHTS@"), 9, defaults);
+  text.replace(text.find("@TCIA@"), 6, flags_help<TciaOptions>(tcia_option_table()));
+  text.replace(text.find("@LINES@"), 7, flags_help<TciaLineOptions>(tcia_line_option_table()));
   return text;
 }
 
@@ -120,8 +137,54 @@ struct Options {
   std::string format = "png";
   double fps = 24;
   bool video = true, resume = true;
+  // The coherent method: its options get the engine flags given (recorded
+  // in order) on its own defaults, and --temporal if given.
+  std::string method = "stylit";
+  std::vector<KeyFile> keys;
+  std::optional<std::pair<int, int>> segment;
+  TciaOptions tcia = default_tcia_options();
+  TciaLineOptions lines;
+  std::vector<std::pair<std::string, std::string>> engine_flags;
+  std::vector<std::string> tcia_flags;
+  bool temporal_given = false;
   BlenderSetup blender = default_blender_setup();
 };
+
+std::pair<int, int> parse_segment(const std::string& text) {
+  const std::vector<int> frames = parse_frames(text);
+  if (text.find(',') != std::string::npos || frames.size() < 2)
+    throw ValueError(concat("--segment expects A-B (from one key to the next), got '", text, "'"));
+  return {frames.front(), frames.back()};
+}
+
+// An engine option (StyLit's, recorded for tcia) or one of tcia's own.
+bool set_engine_flag(Options& o, const std::string& flag, ArgReader& r) {
+  std::string text;
+  auto value = [&] { return text = r.value(flag); };
+  if (set_from_flag(o.stylit.synthesis, synthesis_option_table(), flag.substr(2), value)) {
+    o.engine_flags.emplace_back(flag.substr(2), text);
+    return true;
+  }
+  if (!set_from_flag(o.tcia, tcia_option_table(), flag.substr(2), value) &&
+      !set_from_flag(o.lines, tcia_line_option_table(), flag.substr(2), value))
+    return false;
+  o.tcia_flags.push_back(flag);
+  return true;
+}
+
+void check_method(Options& o) {
+  if (o.method != "stylit" && o.method != "tcia")
+    throw ValueError(concat("unknown --method '", o.method, "' (choose stylit or tcia)"));
+  if (o.method == "stylit") {
+    if (!o.keys.empty() || o.segment || !o.tcia_flags.empty())
+      throw ValueError(concat(!o.keys.empty() ? "--key" : o.segment ? "--segment" : o.tcia_flags.front(),
+                              " needs --method tcia"));
+    return;
+  }
+  for (const auto& [flag, text] : o.engine_flags)
+    set_from_flag(o.tcia.synthesis, synthesis_option_table(), flag, [&] { return text; });
+  if (o.temporal_given) o.tcia.temporal_weight = o.stylit.temporal_weight;
+}
 
 Options parse(const Args& args) {
   Options o;
@@ -139,7 +202,7 @@ Options parse(const Args& args) {
     else if (flag == "--frames") o.frames = parse_frames(o.frames_text = r.value(flag));
     else if (flag == "--out") o.out = r.value(flag);
     else if (flag == "--weights") parse_guide_weights(r.value(flag), o.stylit.weights);
-    else if (flag == "--temporal") o.stylit.temporal_weight = r.number<float>(flag);
+    else if (flag == "--temporal") o.stylit.temporal_weight = r.number<float>(flag), o.temporal_given = true;
     else if (flag == "--quality") o.stylit.quality = parse_quality(r.value(flag));
     else if (flag == "--format") o.format = r.value(flag);
     else if (flag == "--fps") o.fps = r.number<double>(flag);
@@ -149,17 +212,24 @@ Options parse(const Args& args) {
     else if (flag == "--blender") o.blender.blender = r.value(flag);
     else if (flag == "--addon-path") o.blender.addon = r.value(flag);
     else if (flag == "--max-image-pixels") set_max_image_pixels(r.number<std::int64_t>(flag));
+    else if (flag == "--method") o.method = r.value(flag);
+    else if (flag == "--key") o.keys.push_back(parse_key(r.value(flag)));
+    else if (flag == "--segment") o.segment = parse_segment(r.value(flag));
     else if (flag == "--noise-map") o.noise_map = r.value(flag);
     else if (flag == "--noise-reference") o.noise_reference = r.value(flag);
     else if (set_from_flag(o.noisy, noisy_option_table(), flag.substr(2), [&] { return r.value(flag); })) continue;
-    else if (!set_from_flag(o.stylit.synthesis, synthesis_option_table(), flag.substr(2), [&] { return r.value(flag); }))
+    else if (!set_engine_flag(o, flag, r))
       throw ValueError(concat("unknown option '", flag, "' (see tempera stylize --help)"));
   }
+  check_method(o);
   validate(o.stylit.synthesis);
   validate_fields(o.noisy, noisy_option_table());
   const bool noise = o.noisy.noise > 0;
   if (!noise && !(o.noise_map.empty() && o.noise_reference.empty()))
     throw ValueError("--noise-map and --noise-reference need --noise F (the amount of temporal noise)");
+  if (noise && o.segment)
+    throw ValueError("--noise with --segment: run the noise pass once all segments are done "
+                     "(tempera stylize --noise F --noise-reference OUT/frames ...)");
   if (noise && o.noise_reference.empty() && o.format != "png")
     throw ValueError("--noise boils PNG frames: use --format png (the default)");
   if (o.exemplar.empty()) throw ValueError("--exemplar is required (the painting)");
@@ -303,6 +373,52 @@ bool run_noise_pass(const Options& o) {
   return true;
 }
 
+// One line per finished sweep: "segment 1/2 (frames 1-8): level 4/4 forward sweep, 12%, ETA 0:40".
+bool report_sweep(const SweepProgress& p, std::size_t index, std::size_t count, const TciaSegment& s,
+                  std::chrono::steady_clock::time_point start) {
+  const bool sweep_done = p.direction > 0 ? p.frame == s.last : p.frame == s.first;
+  if (sweep_done) {
+    const double spent = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::cout << "segment " << index + 1 << "/" << count << " (frames " << s.first << "-" << s.last << "): level "
+              << p.levels - p.level << "/" << p.levels << (p.direction > 0 ? " forward" : " backward") << " sweep, "
+              << std::lround(100 * p.fraction) << "%, ETA " << clock_text(spent / p.fraction * (1 - p.fraction))
+              << std::endl;
+  }
+  return !g_interrupted;
+}
+
+// The coherent method's segments (all, or the one of --segment); false if interrupted.
+bool run_segments(TciaJob& job, const Options& o) {
+  int stylized = 0, skipped = 0;
+  double seconds = 0;
+  for (std::size_t i : job.selected()) {
+    if (g_interrupted) return false;
+    const TciaSegment& s = job.segments()[i];
+    const auto start = std::chrono::steady_clock::now();
+    SegmentResult r;
+    try {
+      r = job.run_segment(i, [&](const SweepProgress& p) { return report_sweep(p, i, job.segments().size(), s, start); });
+    } catch (const CancelledError&) {
+      return false;
+    }
+    std::cout << "segment " << i + 1 << "/" << job.segments().size() << " (frames " << s.first << "-" << s.last
+              << "): ";
+    if (r.status == "skipped") std::cout << "skipped, already current\n";
+    else std::cout << std::fixed << std::setprecision(2) << r.seconds << " s\n" << std::defaultfloat;
+    (r.status == "skipped" ? skipped : stylized)++;
+    seconds += r.seconds;
+  }
+  std::cout << "tempera stylize: " << stylized << " segment(s) stylized, " << skipped
+            << " skipped (already current) in " << std::fixed << std::setprecision(1) << seconds << " s"
+            << std::defaultfloat << "; results in " << o.out << "\n";
+  return true;
+}
+
+int interrupted_segments() {
+  std::cerr << "tempera stylize: interrupted; finished segments are kept, rerun the same command to resume\n";
+  return 130;
+}
+
 }  // namespace
 
 int run_stylize(const Args& args) {
@@ -314,6 +430,7 @@ int run_stylize(const Args& args) {
   struct sigaction action {};
   action.sa_handler = on_sigint;
   sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);  // a farm's or the panel's cancel
   std::vector<FrameResult> results;
   try {
     const bool guide_map = !o.noise_map.empty() && !fs::is_regular_file(o.noise_map);
@@ -337,6 +454,14 @@ int run_stylize(const Args& args) {
     config.format = o.format;
     config.stylit = o.stylit;
     config.resume = o.resume;
+    if (o.method == "tcia") {
+      TciaJob job({config, o.keys, o.tcia, o.lines, o.segment});
+      for (const auto& w : job.warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
+      if (!run_segments(job, o)) return interrupted_segments();
+      if (!o.segment) write_extras(job.frames_job(), o);  // a segment is a farm task: the finish writes them
+      if (o.noisy.noise > 0 && !run_noise_pass(o)) return interrupted_segments();
+      return 0;
+    }
     StylizeJob job(config);
     for (const auto& w : job.warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
     if (!run_frames(job, results)) return interrupted(results);

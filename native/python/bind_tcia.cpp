@@ -5,6 +5,7 @@
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
 #include "tempera/tcia.hpp"
+#include "tempera/tcia_job.hpp"
 
 namespace py = pybind11;
 using namespace tempera;
@@ -17,9 +18,82 @@ ImageView keep_view(const py::handle& array, const std::string& what, std::vecto
   return py_bridge::view_of(keep.back(), what);
 }
 
+// The job's configuration from tempera.tcia.ShotJob's keywords (checked there).
+TciaJobConfig job_config(const py::dict& d, const TciaOptions& options) {
+  TciaJobConfig c;
+  StylizeJobConfig& f = c.frames;
+  f.style = d["style"].cast<std::string>();
+  f.exemplar_guides = d["exemplar_guides"].cast<std::string>();
+  if (!d["exemplar_frame"].is_none()) f.exemplar_frame = d["exemplar_frame"].cast<int>();
+  f.guides = d["guides"].cast<std::string>();
+  f.frames = d["frames"].cast<std::vector<int>>();
+  f.out = d["out"].cast<std::string>();
+  f.format = d["format"].cast<std::string>();
+  f.resume = d["resume"].cast<bool>();
+  std::string weights;
+  for (const auto& [name, weight] : d["weights"].cast<py::dict>())
+    weights += concat(weights.empty() ? "" : ",", std::string(py::str(name)), "=", py::str(weight).cast<std::string>());
+  parse_guide_weights(weights, f.stylit.weights);
+  active_guides(f.stylit);
+  for (const auto& key : d["keys"].cast<py::list>()) {
+    const auto t = key.cast<py::tuple>();
+    c.keys.push_back({t[0].cast<int>(), t[1].cast<std::string>(), t[2].is_none() ? "" : t[2].cast<std::string>()});
+  }
+  if (!d["segment"].is_none()) c.segment = d["segment"].cast<std::pair<int, int>>();
+  c.tcia = options;
+  py_bridge::set_from_dict(c.lines, tcia_line_option_table(), d["lines"].cast<py::dict>(), "line option");
+  return c;
+}
+
 }  // namespace
 
 void bind_tcia(py::module_& m) {
+  py::class_<TciaJob>(m, "TciaJob", "The coherent method over a guide cache; use tempera.tcia.ShotJob.")
+      .def(py::init([](const py::dict& config, const TciaOptions& options) {
+             TciaJobConfig c = job_config(config, options);
+             py::gil_scoped_release release;  // reads the painting, keys and cache headers
+             return std::make_unique<TciaJob>(std::move(c));
+           }),
+           py::arg("config"), py::arg("options"))
+      .def_property_readonly("segments",
+                             [](const TciaJob& job) {
+                               py::list out;
+                               for (const auto& s : job.segments())
+                                 out.append(py::make_tuple(s.first, s.last, s.writes));
+                               return out;
+                             })
+      .def_property_readonly("selected", &TciaJob::selected)
+      .def_property_readonly("warnings", &TciaJob::warnings)
+      .def("output_path", [](const TciaJob& job, int frame) { return job.frames_job().output_path(frame); })
+      .def("record_path", &TciaJob::record_path)
+      .def(
+          "run_segment",
+          [](TciaJob& job, std::size_t index, const std::function<bool(py::dict)>& progress) {
+            SegmentProgress callback;
+            if (progress)
+              callback = [&](const SweepProgress& p) {
+                py::gil_scoped_acquire acquire;
+                if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // Ctrl-C
+                py::dict d;
+                d["level"] = p.level, d["levels"] = p.levels, d["direction"] = p.direction, d["frame"] = p.frame;
+                d["fraction"] = p.fraction;
+                return progress(d);
+              };
+            SegmentResult r;
+            {
+              py::gil_scoped_release release;
+              r = job.run_segment(index, callback);
+            }
+            return py::make_tuple(r.status, r.seconds);
+          },
+          py::arg("index"), py::arg("progress") = nullptr)
+      .def(
+          "write_contact_sheet",
+          [](const TciaJob& job, const std::string& path, int columns) {
+            py::gil_scoped_release release;
+            job.frames_job().write_contact_sheet(path, columns);
+          },
+          py::arg("path"), py::arg("columns") = 0);
   py_bridge::bind_options_class<TciaOptions>(m, "TciaOptions", tcia_option_table(),
                                              "Options of Bénard et al. 2013 (native/include/tempera/tcia.hpp).")
       .def_readwrite("synthesis", &TciaOptions::synthesis, "engine options (defaults: tcia_defaults())");

@@ -17,7 +17,7 @@ SynthesisOptions tcia_defaults() {
   o.window_sigma = 3.0f;
   o.output = OutputMode::Centre;
   o.usage = PatchUsage::Histogram;
-  o.levels = 4;
+  o.levels = 0;  // automatic: the coarsest side >= 4 patches (4 levels at 0.25 Mpix, 5 at 1 Mpix)
   o.em_iterations = 1;
   o.pm_iterations = 4;  // "3 or 4 full iterations" of parallel PatchMatch (§3.3)
   o.guide_variance = 1.0;
@@ -88,19 +88,20 @@ class Sweeper {
  public:
   Sweeper(const Shot& shot, const TciaOptions& o) : shot_(shot), o_(o) {}
 
-  std::vector<Image> run(const ProgressCallback& progress) {
+  std::vector<Image> run(const SweepCallback& progress) {
     const int frames = int(shot_.frames.size());
     const int levels = make_solver(0, false)->levels();
     std::vector<FrameState> coarse, here(frames);
     const double visits = double(levels) * 2 * o_.sweep_pairs * frames;
     double done = 0;
-    auto report = [&] {
-      if (progress && !progress(++done / visits)) throw CancelledError("stylization cancelled");
+    auto report = [&](int l, int pair, int direction, int t) {
+      if (progress && !progress({l, levels, pair, o_.sweep_pairs, direction, t, ++done / visits}))
+        throw CancelledError("stylization cancelled");
     };
     for (int l = levels - 1; l >= 0; --l) {
       for (int pair = 0; pair < o_.sweep_pairs; ++pair) {
-        for (int t = 0; t < frames; ++t, report()) visit(l, t, +1, pair, coarse, here);
-        for (int t = frames - 1; t >= 0; --t, report()) visit(l, t, -1, pair, coarse, here);
+        for (int t = 0; t < frames; ++t) visit(l, t, +1, pair, coarse, here), report(l, pair, +1, t);
+        for (int t = frames - 1; t >= 0; --t) visit(l, t, -1, pair, coarse, here), report(l, pair, -1, t);
       }
       coarse = std::move(here);
       here.assign(frames, {});
@@ -115,8 +116,9 @@ class Sweeper {
   // target is given per level; the input's is a placeholder).
   std::unique_ptr<Solver> make_solver(int t, bool temporal, int direction = +1) const {
     const ShotFrame& f = shot_.frames[std::size_t(t)];
-    placeholder_ = Image(f.guides.empty() ? shot_.style.width : f.guides[0].width,
-                         f.guides.empty() ? shot_.style.height : f.guides[0].height, shot_.style.channels);
+    // A shot without guides (keys and motion only) takes the frame's size from its motion.
+    const ImageView& sized = f.guides.empty() ? f.velocity_backward : f.guides[0];
+    placeholder_ = Image(sized.width, sized.height, shot_.style.channels);
     SynthesisInput in;
     in.style = shot_.style;
     for (std::size_t g = 0; g < shot_.style_guides.size(); ++g)
@@ -264,9 +266,15 @@ class Sweeper {
 
 }  // namespace
 
-std::vector<Image> stylize_shot(const Shot& shot, const TciaOptions& options, const ProgressCallback& progress) {
+std::vector<Image> stylize_shot_sweeps(const Shot& shot, const TciaOptions& options, const SweepCallback& progress) {
   validate(shot, options);
   return Sweeper(shot, options).run(progress);
+}
+
+std::vector<Image> stylize_shot(const Shot& shot, const TciaOptions& options, const ProgressCallback& progress) {
+  SweepCallback sweeps;
+  if (progress) sweeps = [&](const SweepProgress& p) { return progress(p.fraction); };
+  return stylize_shot_sweeps(shot, options, sweeps);
 }
 
 }  // namespace tempera

@@ -19,19 +19,29 @@ def light_paths(blob_x, h=H, w=W):
     return {"FULL": tint + spec + indirect, "LDE": tint, "LSE": spec, "LDDE": indirect}
 
 
-def write_frame(cache, frame, blob_x, speed):
+def write_frame(cache, frame, blob_x, speed, forward=False):
     guides = light_paths(blob_x)
     guides["velocity_backward"] = np.stack([np.full((H, W), speed, np.float32), np.zeros((H, W), np.float32)], -1)
     visible = np.ones((H, W), np.float32)
     visible[:, : int(np.ceil(speed))] = 0  # entered from outside the frame
     guides["occlusion_backward"] = visible
+    if forward:  # V+ and χ+ (the coherent method's backward sweeps), and lines around the blob (eq. 9)
+        from tempera.guides import line_distance
+
+        guides["velocity_forward"] = guides["velocity_backward"]
+        leaving = np.ones((H, W), np.float32)
+        leaving[:, W - int(np.ceil(speed)):] = 0  # about to leave the frame
+        guides["occlusion_forward"] = leaving
+        yy, xx = np.mgrid[0:H, 0:W].astype(np.float32)
+        guides["lines"] = (np.abs(np.hypot(xx - blob_x, yy - H / 2) - H / 4) < 0.75).astype(np.float32)
+        guides["line_distance"] = line_distance(guides["lines"], 10.0)
     guides["alpha"] = np.ones((H, W), np.float32)
     return guide_cache.write_frame(cache, frame, guides)
 
 
-def make_cache(cache, frames=(1, 2, 3), speed=2.0, start=20.0):
+def make_cache(cache, frames=(1, 2, 3), speed=2.0, start=20.0, forward=False):
     for i, frame in enumerate(frames):
-        write_frame(cache, frame, start + speed * i, speed)
+        write_frame(cache, frame, start + speed * i, speed, forward)
     guide_cache.write_manifest(cache, {"frames": {str(f): {"key": "synthetic"} for f in frames},
                                        "guides": ["FULL", "LDE", "LSE", "LDDE", "velocity_backward",
                                                   "occlusion_backward", "alpha"]})

@@ -52,6 +52,37 @@ def test_temporal_shot_is_one_chain():
     assert stylize[0].command[stylize[0].command.index("--temporal") + 1] == "0.5"
 
 
+TCIA = ["--method", "tcia", "--key", "12=/shared/k12.png", "--key=24=/shared/k24.png,/shared/m24.png"]
+
+
+def test_coherent_shot_is_one_task_per_segment_between_keys():
+    tasks = farm.plan(**dict(SHOT, stylize_args=TCIA))
+    stylize = [t for t in tasks if t.kind == "stylize"]
+    assert [(t.frames[0], t.frames[-1]) for t in stylize] == [(1, 12), (12, 24), (24, 48)]
+    for t in stylize:  # the whole shot's frames and keys, one segment solved
+        c = t.command
+        assert c[c.index("--frames") + 1] == "1-48" and "--temporal" not in c
+        assert c[c.index("--segment") + 1] == f"{t.frames[0]}-{t.frames[-1]}"
+    assert stylize[1].depends == ["exemplar-guides", "guides 9-16", "guides 17-24"]
+    assert "--segment" not in tasks[-1].command and tasks[-1].depends == [t.name for t in stylize]
+    keyless = farm.plan(**dict(SHOT, stylize_args=["--method", "tcia"], temporal=0.7))
+    one = [t for t in keyless if t.kind == "stylize"]
+    assert len(one) == 1 and one[0].command[one[0].command.index("--temporal") + 1] == "0.7"
+    with pytest.raises(farm.FarmError, match="--key expects"):
+        farm.plan(**dict(SHOT, stylize_args=["--method", "tcia", "--key", "x.png"]))
+
+
+@pytest.mark.skipif(shutil.which("node") is None, reason="node not installed")
+def test_flamenco_plans_the_same_segments():
+    settings = dict(FLAMENCO_SETTINGS, temporal=0.5, stylize_args=" ".join(TCIA))
+    script = ("const {compile, summary} = require(process.argv[1]);"
+              "console.log(JSON.stringify(summary(compile(JSON.parse(process.argv[2])).job)));")
+    result = subprocess.run(["node", "-e", script, str(ROOT / "farm" / "flamenco" / "standin.js"),
+                             json.dumps(settings)], capture_output=True, text=True, check=True)
+    ours = farm.plan(**dict(SHOT, stylize_args=TCIA))
+    assert [t["argv"] for t in json.loads(result.stdout)] == [t.command for t in ours]
+
+
 def test_plan_refuses_incomplete_shots():
     with pytest.raises(farm.FarmError, match="exactly one of exemplar_guides"):
         farm.plan("1-4", "/o", "/s.png", guides="/g")

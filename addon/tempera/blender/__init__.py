@@ -7,20 +7,22 @@ and come back when the add-on is enabled again).
 """
 import bpy
 
-from . import job_operator, kit_operators
+from . import job_operator, keyframes, kit_operators
 from .guide_operator import TEMPERA_OT_render_guides
 from .panels import TEMPERA_PT_output
 from .preferences import TemperaPreferences
-from .properties import TemperaSettings
+from .properties import TemperaKeyframe, TemperaSettings
 from .stylize_operator import TEMPERA_OT_stylize
 
 # Registration order: property groups before the pointers and panels using them.
 CLASSES = (
     TemperaPreferences,
+    TemperaKeyframe,
     TemperaSettings,
     TEMPERA_OT_render_guides,
     TEMPERA_OT_stylize,
     *kit_operators.CLASSES,
+    *keyframes.CLASSES,
     TEMPERA_PT_output,
 )
 

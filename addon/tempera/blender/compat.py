@@ -31,6 +31,8 @@ The breaks handled:
 * 4.x: the AOV Output node names its AOV in .aov_name: `set_aov_output_name()`.
 * 5.0: the sequencer's Scene.sequence_editor.sequences became .strips
   (available since 4.4): `sequencer_strips()`.
+* The Image Editor's paint mode: SpaceImageEditor.mode "PAINT" (its
+  ui_mode in versions that split the two): `image_paint_mode()`.
 
 Two breaks of the list in issue 16 need no helper: Tempera reads its
 settings as RNA properties only (never `scene["tempera"]`, which 5.0 no
@@ -175,3 +177,12 @@ def set_aov_output_name(node, name):
 def sequencer_strips(editor):
     """The top-level strips of a sequence editor (.strips since 4.4, .sequences before)."""
     return editor.strips if hasattr(editor, "strips") else editor.sequences
+
+
+def image_paint_mode(space):
+    """Puts an Image Editor space into Paint mode (for the artist to paint a keyframe)."""
+    for prop in ("mode", "ui_mode"):
+        if prop in space.bl_rna.properties and "PAINT" in _enum_ids(space, prop):
+            setattr(space, prop, "PAINT")
+            return True
+    return False

@@ -9,6 +9,7 @@ from bpy.types import Panel
 
 from .. import __version__
 from .guide_operator import TEMPERA_OT_render_guides, cache_status
+from .keyframes import TEMPERA_OT_add_keyframe, TEMPERA_OT_import_keyframe, TEMPERA_OT_remove_keyframe
 from .kit_operators import (TEMPERA_OT_choose_painting, TEMPERA_OT_painting_template, TEMPERA_OT_register_painting,
                             painting_preview)
 from .properties import WEIGHT_PROPERTIES
@@ -131,6 +132,9 @@ def draw_light_paths(box, settings):
 
 def draw_synthesis(box, settings):
     box.label(text="Synthesis", icon="MOD_REMESH")
+    box.prop(settings, "method")
+    if settings.method == "TCIA":
+        draw_keyframes(box, settings)
     col = box.column()
     col.prop(settings, "quality")
     col.prop(settings, "usage")
@@ -154,6 +158,26 @@ def draw_noise(box, settings):
              "GUIDE": "noise_map_guide"}.get(settings.noise_map_source)
     if field:
         col.prop(settings, field)
+
+
+def draw_keyframes(box, settings):
+    """The coherent method's painted keyframes: the list and its buttons."""
+    box.label(text="Keyframes (painted frames the shot follows)")
+    row = box.row()
+    row.template_list("TEMPERA_UL_keyframes", "", settings, "keyframes", settings, "keyframe_index", rows=3)
+    side = row.column(align=True)
+    side.operator(TEMPERA_OT_add_keyframe.bl_idname, text="", icon="ADD")
+    side.operator(TEMPERA_OT_remove_keyframe.bl_idname, text="", icon="REMOVE")
+    row = box.row(align=True)
+    row.operator(TEMPERA_OT_add_keyframe.bl_idname, text="Add Keyframe", icon="KEYFRAME")
+    row.operator(TEMPERA_OT_import_keyframe.bl_idname, text="Import Key", icon="IMPORT")
+    if 0 <= settings.keyframe_index < len(settings.keyframes):
+        key = settings.keyframes[settings.keyframe_index]
+        col = box.column(align=True)
+        col.prop(key, "painting")
+        col.prop(key, "mask")
+    box.prop(settings, "keyframe_dir")
+    box.prop(settings, "line_weight")
 
 
 def draw_output(box, settings):

@@ -1,6 +1,7 @@
 """Per-scene Tempera settings, stored in the .blend file as Scene.tempera."""
 import bpy
-from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
+from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty,
+                       StringProperty)
 from bpy.types import PropertyGroup
 
 from .. import guide_cache
@@ -91,6 +92,27 @@ def _keep_guide_start_before_end(self, _context):
 def _keep_guide_end_after_start(self, _context):
     if self.guide_frame_start > self.guide_frame_end:
         self.guide_frame_start = self.guide_frame_end
+
+
+METHOD_ITEMS = (
+    ("STYLIT", "Per-Frame StyLit", "Each frame painted on its own from the light-path guides (with the temporal "
+     "guide's pull towards the previous frame); frames split anywhere over machines"),
+    ("TCIA", "Temporally Coherent (Bénard 2013)", "The whole shot at once, coarse to fine in forward and backward "
+     "sweeps along the motion, so the paint stays on the surfaces; painted Keyframes come out as painted and "
+     "steer the frames around them (Stylize Frame stays per-frame StyLit)"),
+)
+DEFAULT_KEYFRAME_DIR = "//tempera/keys/"
+
+
+class TemperaKeyframe(PropertyGroup):
+    """A painted keyframe of the coherent method (tempera.blender.keyframes)."""
+
+    frame: IntProperty(name="Frame", description="The frame this painting is of", default=1, min=0,
+                       max=MAX_FRAME)
+    painting: StringProperty(name="Painting", subtype="FILE_PATH", default="",
+                             description="The painted frame (the frame's size); '//' is relative to the .blend file")
+    mask: StringProperty(name="Mask", subtype="FILE_PATH", default="",
+                         description="Optional: where the key is painted (white); empty: the whole frame")
 
 
 class TemperaSettings(PropertyGroup):
@@ -269,3 +291,18 @@ class TemperaSettings(PropertyGroup):
                                           description="The collection that boils (its mask guide)")
     noise_map_guide: StringProperty(name="Map Guide",
                                     description="Name of a guide of the guide cache (an attribute or AOV)")
+
+    # The coherent method (Bénard et al. 2013) and its painted keyframes.
+    method: EnumProperty(name="Method", items=METHOD_ITEMS, default="STYLIT",
+                         description="How Stylize Animation paints the shot")
+    keyframes: CollectionProperty(type=TemperaKeyframe, name="Keyframes")
+    keyframe_index: IntProperty(name="Active Keyframe", default=0, min=0)
+    line_weight: FloatProperty(
+        name="Line Term",
+        description="For line paintings (ink on paper): pulls the painting's ink onto the scene's lines (the "
+        "guide cache's line distance, Bénard 2013 eq. 9); 0 = off, 4 typical",
+        default=0.0, min=0.0, soft_max=10.0)
+    keyframe_dir: StringProperty(
+        name="Keyframe Folder",
+        description="Where Add Keyframe saves the images to paint over ('//' is beside the .blend file)",
+        subtype="DIR_PATH", default=DEFAULT_KEYFRAME_DIR)

@@ -15,6 +15,12 @@ runs them: modal with progress and Esc in the UI, all at once in background):
 
 After the last frame of an animation: a contact sheet, an mp4 (when ffmpeg
 is present) and the result loaded back into Blender (Load Result).
+
+With Method "Temporally Coherent (Bénard 2013)", Stylize Animation's second
+phase is CoherentRun: tempera.tcia.ShotJob, one step per segment between
+painted keyframes (each resumable, Esc stops within a segment and nothing of
+it is written). Stylize Frame stays per-frame StyLit: a quick look, and the
+ground Add Keyframe paints over.
 """
 import os
 import time
@@ -133,11 +139,17 @@ class StylizeRun:
     @classmethod
     def from_settings(cls, scene, mode="ANIMATION"):
         frames = [scene.frame_current] if mode == "FRAME" else guide_frames(scene, scene.tempera)
+        if mode == "ANIMATION" and scene.tempera.method == "TCIA":
+            return CoherentRun(scene, frames, mode)
         return cls(scene, frames, mode)
 
     @property
+    def stylize_steps(self):
+        return len(self.frames)  # one per frame; CoherentRun: one per segment
+
+    @property
     def total(self):
-        return (3 if self.noise else 2) * len(self.frames)
+        return len(self.frames) + self.stylize_steps + (len(self.frames) if self.noise else 0)
 
     @property
     def finished(self):
@@ -149,7 +161,7 @@ class StylizeRun:
 
     @property
     def in_noise_phase(self):
-        return self.index >= 2 * len(self.frames)
+        return self.index >= len(self.frames) + self.stylize_steps
 
     def threaded(self):
         return not self.in_guide_phase  # the solver needs no bpy
@@ -187,14 +199,16 @@ class StylizeRun:
 
         if self.noise_job is None:
             self.noise_job = NoisySequence(**self.noise)
-        result = self.noise_job.run_frame(self.index - 2 * len(self.frames), progress)
+        result = self.noise_job.run_frame(self.index - len(self.frames) - self.stylize_steps, progress)
         self.noise_results.append(result)
         if bpy.app.background:
             print(f"Tempera: noisy frame {result['frame']} {result['status']} in {result['seconds']:.1f} s", flush=True)
 
     def current_frame(self):
-        frames = self.frames
-        return frames[min(self.index, self.total - 1) % len(frames)]
+        index = min(self.index, self.total - 1)
+        if self.in_noise_phase:
+            index -= len(self.frames) + self.stylize_steps
+        return self.frames[index % len(self.frames)]
 
     def failure(self, exc):
         what = "Guides" if self.in_guide_phase else "Temporal Noise" if self.in_noise_phase else "Stylizing"
@@ -246,6 +260,71 @@ class StylizeRun:
             made = sum(r["status"] == "made" for r in self.noise_results)
             parts.append(f"{made} boiled (Temporal Noise) in {self.noise['out']}")
         return f"Tempera: {', '.join(parts)} in {self.config['out']}{tail}"
+
+
+class CoherentRun(StylizeRun):
+    """Guides of every frame, then the coherent method, one segment per step."""
+
+    def __init__(self, scene, frames, mode="ANIMATION"):
+        from .. import tcia
+        from .keyframes import key_list
+
+        super().__init__(scene, frames, mode)
+        if any(b != a + 1 for a, b in zip(self.frames, self.frames[1:])):
+            raise ValueError("The coherent method needs consecutive frames: set the scene's Frame Step to 1.")
+        self.keys = [k for k in key_list(scene.tempera) if self.frames[0] <= k[0] <= self.frames[-1]]
+        self.segments = tcia.segments(self.frames, [k[0] for k in self.keys])
+        self.segment_results = []
+        self.line_weight = float(scene.tempera.line_weight)
+
+    @property
+    def stylize_steps(self):
+        return len(self.segments)
+
+    def _stylize(self, progress):
+        from ..tcia import ShotJob
+
+        c = self.config
+        if self.job is None:
+            self.job = ShotJob(c["style"], c["exemplar_guides"], c["guides"], self.frames, c["out"],
+                               exemplar_frame=c.get("exemplar_frame"), keys=self.keys, weights=c["weights"],
+                               format=c["format"], seed=c["seed"],
+                               lines={"weight": self.line_weight, "d_max": self.guides.params["line_d_max"]})
+            self.warnings = list(self.job.warnings)
+        i = self.index - len(self.frames)
+        started = time.monotonic()
+        result = self.job.run_segment(i, None if progress is None else lambda d: progress(d["fraction"]))
+        if result["status"] == "stylized":
+            self.stylize_seconds += time.monotonic() - started
+        self.segment_results.append(result)
+        for frame in self.job.segments[i][2]:
+            self.results.append({"frame": frame, "path": self.job.output_path(frame), "status": result["status"]})
+        if bpy.app.background:
+            first, last = self.segments[i]
+            print(f"Tempera: segment {i + 1}/{len(self.segments)} (frames {first}-{last}) {result['status']} "
+                  f"in {time.monotonic() - started:.1f} s", flush=True)
+
+    def current_frame(self):
+        if self.in_guide_phase or self.in_noise_phase:
+            return super().current_frame()
+        return self.segments[min(self.index - len(self.frames), len(self.segments) - 1)][0]
+
+    def eta_seconds(self):
+        stylized = [r for r in self.segment_results if r["status"] == "stylized"]
+        left = len(self.segments) - len(self.segment_results)
+        if not stylized or left <= 0:
+            return None
+        return self.stylize_seconds / len(stylized) * left
+
+    def status_text(self):
+        if self.in_guide_phase or self.in_noise_phase:
+            return super().status_text()
+        i = min(len(self.segment_results), len(self.segments) - 1)
+        eta = self.eta_seconds()
+        first, last = self.segments[i]
+        eta_text = "" if eta is None else f", ETA {format_duration(eta)}"
+        return (f"Tempera: coherent segment {i + 1}/{len(self.segments)} (frames {first}-{last}){eta_text} "
+                "(Esc to stop)")
 
 
 def flicker_text(flicker):

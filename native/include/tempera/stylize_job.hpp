@@ -46,6 +46,12 @@ class StylizeJob {
   const std::vector<std::string>& warnings() const { return warnings_; }
   std::string output_path(int frame) const;
   std::string report_path() const;
+  // The painting at the exemplar guides' size, the exemplar's guides and their
+  // file: what the coherent job (tcia_job.hpp) takes from this one.
+  const Image& style() const { return style_; }
+  const GuideFrame& exemplar() const { return exemplar_; }
+  const std::string& exemplar_path() const { return exemplar_path_; }
+  std::string target_guides_path(int frame) const { return target_path(frame); }
 
   // Stylizes frames()[index] (or skips it when its output is current).
   // `progress` returning false cancels: CancelledError, nothing written.

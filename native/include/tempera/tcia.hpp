@@ -19,6 +19,7 @@
 // the random merge leans toward the nearer key. Lines (eq. 9), ribbons, the
 // time-derivative terms (eq. 10) and layers are still to come (issue 12).
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -53,7 +54,11 @@ struct Shot {
 };
 
 struct TciaOptions {
-  float temporal_weight = 1.0f;    // w_tc
+  // w_tc. The paper gives none; 3 is the smallest that keeps every frame of
+  // a 10-frame shot within 1.2x of per-frame patch statistics and the last
+  // third's flicker at the first's (tests/cpp/test_tcia.cpp; 1 let the
+  // shot's last frames wash out).
+  float temporal_weight = 3.0f;
   float coherence_weight = 0.05f;  // w_sc per window pixel: "small" (§3.2)
   float coherence_max = 3.0f;      // r_max in pixels (the paper gives none)
   int sweep_pairs = 1;             // forward + backward sweeps per level (the paper: 1)
@@ -64,7 +69,7 @@ inline const auto& tcia_option_table() {
   using T = TciaOptions;
   static const auto table = std::make_tuple(
       field(&T::temporal_weight, "temporal_weight", "temporal",
-            "w_tc: pull towards the neighbour frame's paint along the motion; 1 typical", 0, 1e6),
+            "w_tc: pull towards the neighbour frame's paint along the motion; 3 typical", 0, 1e6),
       field(&T::coherence_weight, "coherence_weight", "coherence",
             "w_sc: preference for large coherent pieces of the exemplar; 0.05 typical", 0, 1e6),
       field(&T::coherence_max, "coherence_max", "coherence-max", "r_max of spatial coherence, in pixels (3)", 0,
@@ -74,7 +79,7 @@ inline const auto& tcia_option_table() {
 }
 
 // The engine options of the method: 9 x 9 patches in a Gaussian window of
-// sigma 3, output centre (a warp), usage histogram, 4 levels, one search of
+// sigma 3, output centre (a warp), usage histogram, automatic levels (coarsest side >= 4 patches), one search of
 // 4 PatchMatch iterations per visit, exact guides.
 SynthesisOptions tcia_defaults();
 inline TciaOptions default_tcia_options() {
@@ -90,5 +95,21 @@ Image pick_resize(const ImageView& image, int width, int height, float scale = 1
 // The stylized frames of the shot, in order. progress(fraction) returning
 // false cancels (CancelledError).
 std::vector<Image> stylize_shot(const Shot& shot, const TciaOptions& options, const ProgressCallback& progress = {});
+
+// Where the sweeps are, reported after each frame visit: level counts down
+// from levels - 1 (coarsest) to 0, direction is +1 (forward sweep) or -1,
+// frame is the index into Shot::frames just solved.
+struct SweepProgress {
+  int level = 0, levels = 0;
+  int pair = 0, pairs = 0;
+  int direction = +1;
+  int frame = 0;
+  double fraction = 0;  // of all visits of the shot
+};
+using SweepCallback = std::function<bool(const SweepProgress&)>;
+
+// stylize_shot with the sweep position in the progress (the CLI's and the
+// panel's progress lines); returning false cancels (CancelledError).
+std::vector<Image> stylize_shot_sweeps(const Shot& shot, const TciaOptions& options, const SweepCallback& progress);
 
 }  // namespace tempera

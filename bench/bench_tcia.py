@@ -1,0 +1,71 @@
+#!/usr/bin/env python3
+"""Seconds per frame of the coherent method (Bénard et al. 2013, tempera.tcia)
+on a synthetic panning shot, at a given size.
+
+The shot: a camera panning `--speed` px per frame over shaded spheres on a
+table (bench_synthesis.shade_scene: four light-path buffers as guides), so
+V- = V+ = (-speed, 0) everywhere and a band of `speed` pixels enters (χ- = 0)
+and leaves (χ+ = 0) at the edges; the exemplar is one sphere with a
+hatching-like painting (bench_synthesis.hatching_style). The method's default
+options (9 x 9 Gaussian window, automatic levels, one forward and one
+backward sweep per level, 4 PatchMatch iterations per visit).
+
+    PYTHONPATH=addon /usr/bin/python3 bench/bench_tcia.py --mpix 0.25 --frames 4 [--json out.json]
+"""
+import argparse
+import json
+import platform
+import resource
+import time
+
+import numpy as np
+
+from bench_synthesis import hatching_style, shade_scene
+from tempera import tcia
+
+
+def panning_shot(side, frames, speed):
+    """(style, [(name, exemplar guide, weight)], frames) of the coherent method."""
+    wide = side + speed * frames
+    spheres = [(0.2 * wide, 0.35 * side, 0.16 * side, (0.9, 0.85, 0.8)),
+               (0.5 * wide, 0.6 * side, 0.22 * side, (0.8, 0.85, 0.9)),
+               (0.8 * wide, 0.4 * side, 0.18 * side, (0.9, 0.9, 0.8))]
+    world = shade_scene(side, wide, spheres)
+    src = shade_scene(side, side, [(0.5 * side, 0.5 * side, 0.28 * side, (0.9, 0.9, 0.9))])
+    names, weights = ("FULL", "LDE", "LSE", "LDDE"), (1.0, 2.0, 1.0, 0.5)
+    v = np.zeros((side, side, 2), np.float32)
+    v[..., 0] = -speed
+    entering, leaving = np.ones((side, side), np.float32), np.ones((side, side), np.float32)
+    entering[:, side - speed:], leaving[:, :speed] = 0, 0
+    shot = [dict(guides=[np.ascontiguousarray(g[:, speed * t:speed * t + side]) for g in world],
+                 velocity_backward=v, velocity_forward=v, occlusion_backward=entering, occlusion_forward=leaving)
+            for t in range(frames)]
+    return hatching_style(src[0]), list(zip(names, src, weights)), shot
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--mpix", type=float, default=0.25, help="frame size in megapixels (square)")
+    parser.add_argument("--frames", type=int, default=4)
+    parser.add_argument("--speed", type=int, default=3, help="pan in pixels per frame")
+    parser.add_argument("--threads", type=int, default=0)
+    parser.add_argument("--json", help="also write the figures here")
+    args = parser.parse_args()
+    side = int(round((args.mpix * 1e6) ** 0.5))
+    style, guides, frames = panning_shot(side, args.frames, args.speed)
+    started, cpu = time.monotonic(), time.process_time()
+    out = tcia.stylize_shot(style, guides, frames, threads=args.threads)
+    wall, cpu = time.monotonic() - started, time.process_time() - cpu
+    assert len(out) == args.frames
+    result = dict(side=side, mpix=side * side / 1e6, frames=args.frames, wall_s=round(wall, 2), cpu_s=round(cpu, 2),
+                  s_per_frame=round(wall / args.frames, 2),
+                  peak_rss_mb=round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024),
+                  machine=f"{platform.system()} {platform.machine()}, {__import__('os').cpu_count()} cores")
+    print(json.dumps(result, indent=2))
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(result, f, indent=2)
+
+
+if __name__ == "__main__":
+    main()

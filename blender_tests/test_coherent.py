@@ -1,0 +1,126 @@
+"""The coherent method from the panel (Method "Temporally Coherent (Bénard
+2013)"): Add Keyframe from the frame's StyLit result or its render, Import
+Key, the keyframe list, Stylize Animation one segment per step with the key
+coming out as painted, Esc within a segment, and resume."""
+import bpy
+import numpy as np
+import pytest
+from fake_ui import modal_run
+from guide_scene import FRAMES, SIZE
+
+from test_stylize import exemplar, frame_files, scene  # noqa: F401 (fixtures)
+
+
+@pytest.fixture
+def coherent(scene, tmp_path):
+    settings = scene.tempera
+    settings.method = "TCIA"
+    settings.keyframe_dir = str(tmp_path / "keys")
+    settings.make_video = False
+    settings.load_result = "IMAGE"
+    return scene
+
+
+def test_method_choice_and_keyframe_list_in_the_panel(coherent, tmp_path):
+    from test_addon import _Recorder
+    from tempera.blender.properties import METHOD_ITEMS
+
+    assert ("TCIA", "Temporally Coherent (Bénard 2013)") == METHOD_ITEMS[1][:2]
+    bpy.context.window.scene = coherent
+    bpy.ops.tempera.import_keyframe(filepath=__file__, frame=FRAMES[0])
+    calls = []
+    bpy.types.TEMPERA_PT_output.draw(type("FakePanel", (), {"layout": _Recorder(calls)})(), bpy.context)
+    props = [name for kind, name in calls if kind == "prop"]
+    assert props[props.index("method") + 1:props.index("method") + 5] == ["painting", "mask", "keyframe_dir",
+                                                                          "line_weight"]
+    assert ("template_list", "keyframes") in calls
+    operators = [name for kind, name in calls if kind == "operator"]
+    assert operators.count("tempera.add_keyframe") == 2 and "tempera.import_keyframe" in operators
+    coherent.tempera.method = "STYLIT"
+    calls.clear()
+    bpy.types.TEMPERA_PT_output.draw(type("FakePanel", (), {"layout": _Recorder(calls)})(), bpy.context)
+    assert ("template_list", "keyframes") not in calls
+
+
+def test_add_keyframe_paint_it_and_stylize_coherently(coherent, tmp_path):
+    import tempera
+    from tempera.blender.stylize_operator import StylizeRun
+
+    scene, settings = coherent, coherent.tempera
+    key_frame = FRAMES[1]
+    scene.frame_set(key_frame)
+    # No result and no guides yet: a clear error, nothing registered.
+    with pytest.raises(RuntimeError, match=f"Frame {key_frame} has no StyLit result and no guides yet"):
+        bpy.ops.tempera.add_keyframe()
+    assert len(settings.keyframes) == 0
+    assert bpy.ops.tempera.stylize(mode="FRAME") == {"FINISHED"}
+    assert bpy.ops.tempera.add_keyframe() == {"FINISHED"}
+    key_path = tmp_path / "keys" / f"key_{key_frame:04d}.png"
+    stylit = tempera.read_image(str(tmp_path / "out" / "frames" / f"frame_{key_frame:04d}.png"))
+    assert [(k.frame, k.painting) for k in settings.keyframes] == [(key_frame, str(key_path))]
+    np.testing.assert_allclose(tempera.read_image(str(key_path)), stylit[:, :, :3], atol=1 / 255)
+
+    # The artist paints over it in Blender (not saved yet): a red block.
+    image = next(i for i in bpy.data.images if bpy.path.abspath(i.filepath) == str(key_path))
+    pixels = np.array(image.pixels[:], np.float32).reshape(SIZE[1], SIZE[0], 4)
+    pixels[10:30, 10:40, :3] = (0.9, 0.1, 0.1)  # Blender's rows go bottom-up
+    image.pixels[:] = pixels.ravel()
+    assert image.is_dirty
+
+    run = StylizeRun.from_settings(scene, "ANIMATION")
+    assert type(run).__name__ == "CoherentRun" and run.segments == [(FRAMES[0], key_frame), (key_frame, FRAMES[-1])]
+    assert run.total == len(FRAMES) + 2
+    assert bpy.ops.tempera.stylize(mode="ANIMATION") == {"FINISHED"}
+    out = tmp_path / "out" / "frames"
+    painted = tempera.read_image(str(key_path))
+    assert np.abs(painted[SIZE[1] - 30:SIZE[1] - 10, 10:40] - (0.9, 0.1, 0.1)).max() < 2 / 255  # saved first
+    result = tempera.read_image(str(out / f"frame_{key_frame:04d}.png"))
+    assert np.abs(result[:, :, :3] - painted[:, :, :3]).max() <= 1 / 255 + 1e-6  # the key as painted
+    assert (tmp_path / "out" / "contact_sheet.png").is_file()
+
+    again = StylizeRun.from_settings(scene, "ANIMATION")
+    while not again.finished:
+        again.step()
+    assert [r["status"] for r in again.segment_results] == ["skipped", "skipped"]
+    assert "3 already done" in again.summary()
+    settings.line_weight = 4.0  # the line term (eq. 9) on the cache's line distance: both segments redone
+    lines = StylizeRun.from_settings(scene, "ANIMATION")
+    while not lines.finished:
+        lines.step()
+    assert [r["status"] for r in lines.segment_results] == ["stylized", "stylized"]
+
+
+def test_import_key_and_remove(coherent, tmp_path):
+    import tempera
+
+    settings = coherent.tempera
+    painting = tmp_path / "painted_elsewhere.png"
+    tempera.write_image(str(painting), np.full((SIZE[1], SIZE[0], 3), 0.5, np.float32))
+    with pytest.raises(RuntimeError, match="No key painting chosen"):
+        bpy.ops.tempera.import_keyframe(filepath=str(tmp_path / "nothing.png"))
+    assert bpy.ops.tempera.import_keyframe(filepath=str(painting), frame=FRAMES[2]) == {"FINISHED"}
+    assert bpy.ops.tempera.import_keyframe(filepath=str(painting), frame=FRAMES[2]) == {"FINISHED"}  # re-pointed
+    assert [(k.frame, k.painting) for k in settings.keyframes] == [(FRAMES[2], str(painting))]
+    assert bpy.ops.tempera.remove_keyframe() == {"FINISHED"} and len(settings.keyframes) == 0
+
+
+def test_esc_within_a_segment_writes_nothing_then_resume(coherent, tmp_path):
+    from tempera.blender.stylize_operator import TEMPERA_OT_stylize, StylizeRun
+
+    run = StylizeRun.from_settings(coherent, "ANIMATION")
+    for _ in FRAMES:  # the guides
+        run.step()
+
+    def events(op):
+        yield ("TIMER", "NOTHING")  # starts the segment in the worker
+        yield ("ESC", "PRESS")
+
+    results, _log, reports, timers, _op = modal_run(TEMPERA_OT_stylize, coherent, run, events, tick=0.02)
+    assert results[-1] == {"CANCELLED"} and not timers
+    assert "Stopped" in reports[-1][1]
+    assert frame_files(tmp_path / "out" / "frames") == []  # nothing half-written
+    rerun = StylizeRun.from_settings(coherent, "ANIMATION")
+    while not rerun.finished:
+        rerun.step()
+    assert [r["status"] for r in rerun.segment_results] == ["stylized"]
+    assert len(rerun.results) == len(FRAMES)

@@ -1,0 +1,111 @@
+#pragma once
+// The coherent method (Bénard et al. 2013, tcia.hpp) as a job over a guide
+// cache: `tempera stylize --method tcia` and the Blender panel. The shot is
+// always solved as independent segments bounded by consecutive painted keys
+// (and the shot's ends), each segment knowing only its bounding keys (§4.1).
+// So a farm that runs one segment per machine gets, by construction, what
+// one machine gets. Segments are the unit of resume: all frames of a
+// segment are written atomically, then a record with the segment's key and
+// the files' checksums (OUT/tempera_tcia/segment_A-B.txt); a rerun skips
+// segments whose record still matches.
+#include <deque>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tempera/stylize_job.hpp"
+#include "tempera/tcia.hpp"
+
+namespace tempera {
+
+// A painted keyframe on disk: the painting (the frame's size) and an
+// optional mask (first channel > 0.5 = painted) for a partial key.
+struct KeyFile {
+  int frame = 0;
+  std::string painting, mask;
+};
+
+// "12=key.png" or "12=key.png,mask.png" (the CLI's --key); ValueError naming the text.
+KeyFile parse_key(const std::string& text);
+
+// The distance-transform term for line exemplars (eq. 9): one more guide
+// pair, D(S) of the painting's ink against the guide cache's line_distance
+// D(I), so that ink goes where the frame has lines.
+struct TciaLineOptions {
+  float weight = 0;    // w_dt; 0 = off
+  float d_max = 10;    // must be the guide cache's Line Distance Max
+  float ink = 0.5f;    // luminance below which a painting pixel is ink
+};
+
+inline const auto& tcia_line_option_table() {
+  using T = TciaLineOptions;
+  static const auto table = std::make_tuple(
+      field(&T::weight, "weight", "lines",
+            "w_dt of eq. 9: ink of a line painting goes to the frame's lines (guide cache line_distance); "
+            "0 = off, 4 typical", 0, 1e6),
+      field(&T::d_max, "d_max", "line-d-max", "d_max of D(S), the guide cache's Line Distance Max (10)", 0.1, 1e6),
+      field(&T::ink, "ink", "ink", "luminance below which a painting pixel is ink (0.5)", 0, 1));
+  return table;
+}
+
+struct TciaJobConfig {
+  StylizeJobConfig frames;  // painting, guide caches, frames (consecutive), output, guide weights
+  std::vector<KeyFile> keys;
+  TciaOptions tcia = default_tcia_options();
+  TciaLineOptions lines;
+  // Only the segment from frame A to B (a farm task): only its guide frames
+  // and bounding keys are read. ValueError listing the shot's segments if
+  // A-B is not one.
+  std::optional<std::pair<int, int>> segment;
+};
+
+// Frames first..last (inclusive) are solved together; the segment writes
+// `writes` (first..last - 1, and last too for the shot's last segment), so a
+// key shared by two segments has one writer.
+struct TciaSegment {
+  int first = 0, last = 0;
+  std::vector<int> writes;
+};
+
+struct SegmentResult {
+  std::string status;  // "stylized" | "skipped"
+  double seconds = 0;
+};
+
+// Where a segment's sweeps are: SweepProgress with the frame as a frame number.
+using SegmentProgress = std::function<bool(const SweepProgress&)>;
+
+class TciaJob {
+ public:
+  // Validates everything up front (files, guides, keys, sizes).
+  explicit TciaJob(TciaJobConfig config);
+
+  const std::vector<TciaSegment>& segments() const { return segments_; }
+  // The indices of the segments to run: all, or the one of config.segment.
+  const std::vector<std::size_t>& selected() const { return selected_; }
+  const StylizeJob& frames_job() const { return frames_; }
+  const std::vector<std::string>& warnings() const { return frames_.warnings(); }
+  std::string record_path(std::size_t index) const;
+
+  // Solves segment `index` (one of selected()) (or skips it when its record is current) and
+  // writes its frames. `progress` returning false cancels: CancelledError,
+  // nothing written.
+  SegmentResult run_segment(std::size_t index, const SegmentProgress& progress = {});
+
+ private:
+  std::string segment_key(const TciaSegment& segment) const;
+  bool is_current(std::size_t index) const;
+  Shot load_shot(const TciaSegment& segment, std::deque<Image>& keep) const;
+
+  static TciaJobConfig checked(TciaJobConfig config);  // frames consecutive, keys sorted and in the shot
+  bool is_read(int frame) const;                       // in the frames this job reads
+
+  TciaJobConfig config_;
+  std::vector<TciaSegment> segments_;
+  std::vector<std::size_t> selected_;
+  StylizeJob frames_;  // validates the per-frame inputs, names the outputs, writes the contact sheet
+  std::vector<Image> paintings_, masks_;  // per key (masks_ empty for a whole key)
+  std::string settings_;
+};
+
+}  // namespace tempera

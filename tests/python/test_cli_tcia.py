@@ -1,0 +1,142 @@
+"""`tempera stylize --method tcia`: segments at keys, farm split, resume, cancel, threads, errors."""
+import shutil
+import signal
+import subprocess
+
+import numpy as np
+import pytest
+
+import tempera
+from synthetic_cache import H, W, make_cache, make_exemplar
+from test_cli_stylize import stylize
+
+FRAMES = range(1, 8)
+
+
+@pytest.fixture(scope="module")
+def shot(tmp_path_factory):
+    p = tmp_path_factory.mktemp("tcia_cli")
+    make_cache(p / "cache", frames=tuple(FRAMES), forward=True)
+    make_cache(p / "no_forward", frames=tuple(FRAMES))
+    make_exemplar(p / "exemplar", p / "paint.png")
+    # The key: the painting's texture shifted, so the key differs from what the sweeps make alone.
+    paint = tempera.read_image(str(p / "paint.png"))
+    tempera.write_image(str(p / "key4.png"), np.roll(paint, 7, axis=1)[::-1].copy())
+    return p
+
+
+def args(p, out, *extra, cache="cache"):
+    return ("--method", "tcia", "--guides", p / cache, "--exemplar", p / "paint.png", "--exemplar-guides",
+            p / "exemplar", "--frames", "1-7", "--out", p / out, "--levels", "2", "--patch-size", "7",
+            "--no-video", *extra)
+
+
+def frames_of(p, out):
+    return [(p / out / "frames" / f"frame_{f:04d}.png").read_bytes() for f in FRAMES]
+
+
+def run_single(cli_path, shot):
+    if not (shot / "single" / "frames" / "frame_0007.png").is_file():
+        result = stylize(cli_path, *args(shot, "single", "--key", f"4={shot / 'key4.png'}", "--threads", "2"))
+        assert result.returncode == 0, result.stderr
+        assert "segment 1/2 (frames 1-4)" in result.stdout and "segment 2/2 (frames 4-7)" in result.stdout
+        assert "level 2/2 backward sweep, 100%" in result.stdout
+        assert "2 segment(s) stylized, 0 skipped" in result.stdout
+    return frames_of(shot, "single")
+
+
+def test_key_comes_out_as_painted_and_farm_split_equals_single_run(cli_path, shot):
+    single = run_single(cli_path, shot)
+    key = tempera.read_image(str(shot / "key4.png"))
+    out4 = tempera.read_image(str(shot / "single" / "frames" / "frame_0004.png"))
+    assert np.abs(out4 - key).max() <= 1 / 255 + 1e-6
+    # A farm: each segment on its own machine, which has only its own guide frames.
+    for segment in ("4-7", "1-4"):
+        a, b = map(int, segment.split("-"))
+        own = shot / f"cache_{segment}"
+        own.mkdir(exist_ok=True)
+        for f in range(a, b + 1):
+            shutil.copy2(shot / "cache" / f"frame_{f:04d}.exr", own)
+        result = stylize(cli_path, *args(shot, "farm", "--key", f"4={shot / 'key4.png'}", "--segment", segment,
+                                         "--threads", "1", cache=own.name))
+        assert result.returncode == 0, result.stderr
+        assert "1 segment(s) stylized" in result.stdout
+    assert frames_of(shot, "farm") == single
+    assert not (shot / "farm" / "contact_sheet.png").exists()  # a segment is a task; the finish writes it
+    finish = stylize(cli_path, *args(shot, "farm", "--key", f"4={shot / 'key4.png'}"))
+    assert "0 segment(s) stylized, 2 skipped" in finish.stdout, finish.stdout
+    assert (shot / "farm" / "contact_sheet.png").is_file()
+
+
+def test_resume_after_interrupt_equals_uninterrupted_run(cli_path, shot):
+    single = run_single(cli_path, shot)
+    cmd = [str(cli_path), "stylize", *map(str, args(shot, "resumed", "--key", f"4={shot / 'key4.png'}"))]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    for line in proc.stdout:  # the second segment under way
+        if line.startswith("segment 2/2") and "sweep" in line:
+            proc.send_signal(signal.SIGTERM)
+            break
+    proc.stdout.read()
+    assert proc.wait(timeout=120) == 130
+    made = sorted(f.name for f in (shot / "resumed" / "frames").iterdir() if f.is_file())
+    assert made == [f"frame_{f:04d}.png" for f in range(1, 4)]  # segment 1 only, nothing half-written
+    assert not [f for f in (shot / "resumed").rglob(".*")]
+    again = stylize(cli_path, *args(shot, "resumed", "--key", f"4={shot / 'key4.png'}"))
+    assert again.returncode == 0, again.stderr
+    assert "segment 1/2 (frames 1-4): skipped" in again.stdout and "1 segment(s) stylized, 1 skipped" in again.stdout
+    assert frames_of(shot, "resumed") == single
+    # A changed key redoes only the segments it bounds: here both.
+    changed = stylize(cli_path, *args(shot, "resumed", "--key", f"4={shot / 'key4.png'}", "--coherence", "0.1"))
+    assert "2 segment(s) stylized" in changed.stdout
+
+
+def test_any_thread_count_gives_the_same_frames(cli_path, shot):
+    for threads in ("1", "2"):
+        result = stylize(cli_path, *args(shot, f"threads{threads}", "--threads", threads))
+        assert result.returncode == 0, result.stderr
+        assert "segment 1/1 (frames 1-7)" in result.stdout
+    assert frames_of(shot, "threads1") == frames_of(shot, "threads2")
+
+
+@pytest.mark.parametrize("extra, code, message", [
+    (("--key", "4"), 2, "--key expects FRAME=PAINTING[,MASK], got '4'"),
+    (("--key", "x=k.png"), 2, "the frame of --key 'x=k.png'"),
+    (("--key", "4=k.png,"), 2, "--key expects FRAME=PAINTING[,MASK]"),
+    (("--key", "40=KEY"), 2, "keyframe 40 is outside the frames 1-7"),
+    (("--key", "4=KEY", "--key", "4=KEY"), 2, "keyframe 4 is given twice"),
+    (("--key", "4=missing.png"), 1, "painting of keyframe 4 not found: 'missing.png'"),
+    (("--key", "4=SMALL"), 2, f"is {W // 2}x{H // 2} but frame 4's guides are {W}x{H}"),
+    (("--segment", "2-5"), 2, "segment 2-5 is not one of the shot's segments (1-7"),
+    (("--segment", "3"), 2, "--segment expects A-B"),
+    (("--method", "ebsynth"), 2, "unknown --method 'ebsynth'"),
+    (("--sweeps", "0"), 2, "sweep"),
+])
+def test_bad_input_names_the_problem(cli_path, shot, extra, code, message):
+    small = shot / "small.png"
+    tempera.write_image(str(small), np.zeros((H // 2, W // 2, 3), np.float32))
+    extra = [e.replace("KEY", str(shot / "key4.png")).replace("SMALL", str(small)) for e in extra]
+    result = stylize(cli_path, *args(shot, "bad", *extra))
+    assert result.returncode == code and message in result.stderr, result.stderr
+
+
+def test_line_term_runs_from_the_cli_and_is_part_of_the_resume_key(cli_path, shot):
+    result = stylize(cli_path, *args(shot, "lines", "--lines", "4", "--ink", "0.6"))
+    assert result.returncode == 0, result.stderr
+    assert "1 segment(s) stylized" in result.stdout
+    again = stylize(cli_path, *args(shot, "lines", "--lines", "4", "--ink", "0.6"))
+    assert "0 segment(s) stylized, 1 skipped" in again.stdout
+    off = stylize(cli_path, *args(shot, "lines"))
+    assert "1 segment(s) stylized" in off.stdout
+    missing = stylize(cli_path, *args(shot, "lines2", "--lines", "4", cache="no_forward"))
+    assert missing.returncode == 2 and "needs 'line_distance'" in missing.stderr, missing.stderr
+
+
+def test_stylit_refuses_tcia_options_and_tcia_needs_forward_motion(cli_path, shot):
+    stylit = [a for a in args(shot, "bad2", "--key", f"4={shot / 'key4.png'}") if a not in ("--method", "tcia")]
+    result = stylize(cli_path, *stylit)
+    assert result.returncode == 2 and "--key needs --method tcia" in result.stderr
+    result = stylize(cli_path, *args(shot, "bad3", cache="no_forward"))
+    assert result.returncode == 2 and "needs 'velocity_forward'" in result.stderr
+    gappy = [a if a != "1-7" else "1-3,5" for a in args(shot, "bad4")]
+    result = stylize(cli_path, *gappy)
+    assert result.returncode == 2 and "needs consecutive frames" in result.stderr
