@@ -140,3 +140,17 @@ def test_stylit_refuses_tcia_options_and_tcia_needs_forward_motion(cli_path, sho
     gappy = [a if a != "1-7" else "1-3,5" for a in args(shot, "bad4")]
     result = stylize(cli_path, *gappy)
     assert result.returncode == 2 and "needs consecutive frames" in result.stderr
+
+
+def test_temporal_noise_boils_the_coherent_frames(cli_path, shot):
+    single = run_single(cli_path, shot)  # the reference: the same tcia run without noise
+    result = stylize(cli_path, *args(shot, "noisy", "--key", f"4={shot / 'key4.png'}", "--threads", "2",
+                                     "--noise", "2.2"))
+    assert result.returncode == 0, result.stderr
+    assert frames_of(shot, "noisy") == single  # the coherent frames are the method's own
+    noisy = [tempera.read_image(str(shot / "noisy" / "noisy" / f"frame_{f:04d}.png")) for f in FRAMES]
+    coherent = [tempera.read_image(str(shot / "noisy" / "frames" / f"frame_{f:04d}.png")) for f in FRAMES]
+    assert all(np.abs(n - c).mean() > 0.002 for n, c in zip(noisy, coherent))  # every frame boiled
+    segment = stylize(cli_path, *args(shot, "noisy2", "--key", f"4={shot / 'key4.png'}", "--segment", "1-4",
+                                      "--noise", "2.2"))
+    assert segment.returncode == 2 and "--noise with --segment" in segment.stderr, segment.stderr
