@@ -124,3 +124,23 @@ def test_esc_within_a_segment_writes_nothing_then_resume(coherent, tmp_path):
         rerun.step()
     assert [r["status"] for r in rerun.segment_results] == ["stylized"]
     assert len(rerun.results) == len(FRAMES)
+
+
+def test_temporal_noise_after_the_coherent_method(coherent, tmp_path):
+    """Temporal Noise with Method "Temporally Coherent": the segments run,
+    then every frame boils from the coherent frames into OUT/noisy."""
+    import tempera
+    from tempera.blender.stylize_operator import StylizeRun
+
+    coherent.tempera.noise_level = 4  # f = 2.2
+    run = StylizeRun.from_settings(coherent, "ANIMATION")
+    assert type(run).__name__ == "CoherentRun" and run.total == 2 * len(FRAMES) + len(run.segments)
+    while not run.finished:
+        assert run.status_text()
+        run.step()
+    assert [r["status"] for r in run.segment_results] == ["stylized"]
+    assert [r["status"] for r in run.noise_results] == ["made"] * len(FRAMES)
+    for f in FRAMES:
+        frame = tempera.read_image(str(tmp_path / "out" / "frames" / f"frame_{f:04d}.png"))
+        boiled = tempera.read_image(str(tmp_path / "out" / "noisy" / f"frame_{f:04d}.png"))
+        assert boiled.shape == frame.shape and np.abs(boiled - frame).mean() > 0.005, f
