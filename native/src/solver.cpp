@@ -501,6 +501,7 @@ void Solver::build_level(int l, Level& level, const LevelStart* start) const {
     }
     level.space.target_weights = &level.target_weights;
   }
+  quantize_features(level);
   SearchConstraints& cons = level.constraints;
   const int margin = level.space.source_margin();
   const SourceLayout& lay = p.layout[std::size_t(l)];
@@ -536,6 +537,18 @@ void Solver::build_level(int l, Level& level, const LevelStart* start) const {
     for (std::size_t i = 0; i < std::size_t(tw) * th; ++i)
       cons.target_segment.push_back(std::int32_t(std::lround(p.target_label[l].data()[i])));
   cons.finalize();
+}
+
+// Fixed-point features where the patch distance has a fixed-point path:
+// axis-aligned patches with no window and no per-pixel weights.
+void Solver::quantize_features(Level& level) const {
+  const PatchSpace& s = level.space;
+  if (options_.feature_precision != FeaturePrecision::Int16 || s.rotated() || s.window || s.target_weights) return;
+  std::vector<float> offset;
+  float step = 0.0f;
+  fixed_point_range(level.source, level.target, plan_->style_channels, offset, step);
+  level.source.quantize(offset, step);
+  level.target.quantize(offset, step);
 }
 
 void Solver::replace_guide_targets(int l, const LevelStart& start, FeatureImage& target) const {
@@ -601,8 +614,7 @@ OffsetField Solver::cold_start(int l, Level& level, Image& bprime) const {
   }
   FeatureImage source = level.source, target = level.target;
   for (FeatureImage* f : {&source, &target})  // the guide channels alone
-    for (std::size_t i = 0; i < f->data.size(); i += std::size_t(f->stride))
-      std::fill_n(f->data.begin() + std::ptrdiff_t(i), p.style_channels, 0.0f);
+    f->zero_channels(0, p.style_channels);
   PatchSpace guide_space = level.space;
   guide_space.source = &source;
   guide_space.target = &target;

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "tempera/huge_pages.hpp"
 #include "tempera/image.hpp"
 
 namespace tempera {
@@ -16,20 +17,55 @@ namespace tempera {
 struct FeatureImage {
   int width = 0;
   int height = 0;
-  int stride = 0;  // floats per pixel, padded
-  std::vector<float> data;
+  int stride = 0;  // floats (or fixed-point values) per pixel, padded
+  std::vector<float> data;  // float features; empty once quantized
+  // Quantized features (after quantize()): channel c of a pixel holds
+  // round((v - offset[c]) / step), clamped to [0, kFixedMax]. One step for all
+  // channels, so the integer SSD times step^2 is the float SSD: the features
+  // are weighted already, and one absolute precision fits the metric. 12 bits
+  // in int16 keep every patch row's sum exact in int32 lanes (SIMD and scalar
+  // kernels agree to the bit) and halve the bytes a random candidate touches.
+  std::vector<std::int16_t, HugePageAllocator<std::int16_t>> fixed;
+  std::vector<float> offset;
+  float step = 0.0f;
+  static constexpr int kFixedMax = 4095;
 
   FeatureImage() = default;
   FeatureImage(int w, int h, int channels);
   static int padded(int channels) { return (channels + 7) / 8 * 8; }
+  bool quantized() const { return step > 0.0f; }
   float* pixel(int x, int y) { return data.data() + (std::size_t(y) * width + x) * stride; }
   const float* pixel(int x, int y) const { return data.data() + (std::size_t(y) * width + x) * stride; }
+  const std::int16_t* fixed_pixel(int x, int y) const { return fixed.data() + (std::size_t(y) * width + x) * stride; }
+  // Start of pixel (x, y) in whichever storage is in use, and its size.
+  const char* pixel_bytes(int x, int y) const {
+    return quantized() ? reinterpret_cast<const char*>(fixed_pixel(x, y)) : reinterpret_cast<const char*>(pixel(x, y));
+  }
+  int bytes_per_pixel() const { return stride * int(quantized() ? sizeof(std::int16_t) : sizeof(float)); }
   // Writes channels of `image` into feature slots [first, first + image.channels)
   // scaled by `scale` (sqrt of the weight).
   void set_channels(int first, const ImageView& image, float scale);
   // The same with one scale per channel of `image`.
   void set_channels(int first, const ImageView& image, const std::vector<float>& scales);
+  // Sets slots [first, first + count) of every pixel to 0.
+  void zero_channels(int first, int count);
+  // Replaces the float features by fixed-point ones with these channel
+  // offsets (stride values) and step; frees the floats.
+  void quantize(const std::vector<float>& channel_offset, float quant_step);
 };
+
+// Offsets and step that quantize `source` (all channels) and `target`
+// (channels from `target_first` on: the target's style is not known yet and
+// lies in the source's range) without clipping: the per-channel minimum, and
+// the widest channel range / kFixedMax as the step.
+void fixed_point_range(const FeatureImage& source, const FeatureImage& target, int target_first,
+                       std::vector<float>& offset, float& step);
+
+// Exact integer SSD of n int16 values (|a - b| <= kFixedMax), with the kernel
+// the CPU supports (AVX-512BW, AVX2, or scalar); `kernel` forces one, for tests.
+enum class FixedKernel { Best, Scalar, Avx2, Avx512 };
+bool fixed_kernel_supported(FixedKernel kernel);
+std::int64_t fixed_ssd(const std::int16_t* a, const std::int16_t* b, int n, FixedKernel kernel = FixedKernel::Best);
 
 // What a patch comparison needs: the two feature images, the patch radius and,
 // for rotation-aware matching, per-pixel orientation angles (radians; the
