@@ -543,12 +543,14 @@ void Solver::build_level(int l, Level& level, const LevelStart* start) const {
 // axis-aligned patches with no window and no per-pixel weights.
 void Solver::quantize_features(Level& level) const {
   const PatchSpace& s = level.space;
-  if (options_.feature_precision != FeaturePrecision::Int16 || s.rotated() || s.window || s.target_weights) return;
+  if (options_.feature_precision == FeaturePrecision::Float || s.rotated() || s.window || s.target_weights) return;
+  const int max_value =
+      options_.feature_precision == FeaturePrecision::Int8 ? FeatureImage::kFixed8 : FeatureImage::kFixed12;
   std::vector<float> offset;
   float step = 0.0f;
-  fixed_point_range(level.source, level.target, plan_->style_channels, offset, step);
-  level.source.quantize(offset, step);
-  level.target.quantize(offset, step);
+  fixed_point_range(level.source, level.target, plan_->style_channels, max_value, offset, step);
+  level.source.quantize(offset, step, max_value);
+  level.target.quantize(offset, step, max_value);
 }
 
 void Solver::replace_guide_targets(int l, const LevelStart& start, FeatureImage& target) const {

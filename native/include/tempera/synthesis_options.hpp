@@ -45,13 +45,14 @@ struct EnumNames<OutputMode> {
 
 // Precision of the matched features. int16: 12-bit fixed point with one step
 // for all channels (half the bytes per random candidate, exact integer SSD);
-// it applies to axis-aligned, unwindowed, unweighted patches, the others
-// always match in float. float: the v0.1 results, bit for bit.
-enum class FeaturePrecision { Int16, Float };
+// int8: 8 bits (a quarter); both apply to axis-aligned, unwindowed,
+// unweighted patches, the others always match in float. float: the v0.1
+// results, bit for bit.
+enum class FeaturePrecision { Int16, Int8, Float };
 template <>
 struct EnumNames<FeaturePrecision> {
   static constexpr const char* what = "feature precision";
-  static constexpr std::array<const char*, 2> names = {"int16", "float"};
+  static constexpr std::array<const char*, 3> names = {"int16", "int8", "float"};
 };
 
 struct SynthesisOptions {
@@ -125,7 +126,7 @@ inline const auto& synthesis_option_table() {
       field(&S::guide_variance, "guide_variance", "guide-variance",
             "guide variance kept by PCA compression of the guide channels; 1 = exact (slower)", 1e-6, 1),
       field(&S::feature_precision, "feature_precision", "feature-precision",
-            "features matched as int16 (12-bit fixed point: faster, within 1% of float) or float (exact)"),
+            "features matched as int16 (12-bit fixed point), int8 (8-bit: least memory traffic) or float (exact, slowest)"),
       field(&S::axial_orientation, "axial_orientation", "axial-orientation",
             "orientations are axial (mod pi, like strokes) rather than directed (mod 2 pi)"),
       field(&S::budget_coverage, "budget_coverage", "budget-coverage",
