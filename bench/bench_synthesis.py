@@ -245,12 +245,15 @@ def main():
         "rss_before_mb": round(before_mb, 1),
         "final_energy": finest["energy"][-1],
         "guide_error": guide_error(src, tgt, stats["nnf"]),
+        # The error budget's own figure: the fraction of the finest frame that
+        # reversed retrieval placed (the rest keeps its forward match).
+        "budget_coverage": finest["reversed_coverage"],
         "settings": {"em_iterations": args.em_iters, "pm_iterations": args.pm_iters,
                      "guide_variance": args.guide_variance, "threads": args.threads, "seed": args.seed,
                      "feature_precision": args.feature_precision or "default"},
         "guide_channels_matched": stats["guide_channels"],
         "levels": [{k: l[k] for k in ("width", "height", "search_seconds", "usage_seconds", "vote_seconds",
-                                      "usage_rounds", "energy")} for l in stats["levels"]],
+                                      "usage_rounds", "reversed_coverage", "energy")} for l in stats["levels"]],
         "source_coverage": stats["source_coverage"],
         "machine": f"{platform.processor() or platform.machine()}, {__import__('os').cpu_count()} cores",
         "tempera": tempera.__version__,
