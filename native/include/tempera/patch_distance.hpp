@@ -3,8 +3,11 @@
 // feature vector (style channels A'/B' followed by the guide channels A_g/B_g),
 // premultiplied by the square roots of their weights, so one sum of squared
 // differences is the whole weighted energy of StyLit's eq. 8.1. Pixels are
-// interleaved and padded to a multiple of 8 floats: a patch row is one
-// contiguous run of memory that vectorizes without gathers.
+// interleaved and padded to a multiple of 8 values: a patch row is one
+// contiguous run of memory that vectorizes without gathers. The search is
+// bound by memory latency (a random candidate's rows are cache misses), so
+// the features are stored quantized where the distance allows it (see
+// FeatureImage::quantize and the feature_precision option).
 #include <cmath>
 #include <cstdint>
 #include <vector>
