@@ -10,7 +10,8 @@ style). Default engine settings (budget usage, patch 5, automatic levels).
 Prints and optionally writes JSON: wall time, peak memory (max RSS of the
 process, and the engine's own: the peak RSS during synthesize() over the RSS
 before it, with the kernel's peak reset in between), final energy and the
-per-stage timings.
+per-stage timings. (Free heap pages are returned to the system first, so the
+engine cannot reuse them unseen.)
 
     PYTHONPATH=addon /usr/bin/python3 bench/bench_synthesis.py [--size 1024] [--json out.json]
 
@@ -160,6 +161,17 @@ def rss_mb(field="VmRSS"):
     return float("nan")
 
 
+def release_free_heap():
+    """Returns freed heap memory to the system (glibc malloc_trim), so that the
+    RSS before synthesize() holds no free pages the engine could reuse unseen."""
+    import ctypes
+
+    try:
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):
+        pass
+
+
 def reset_peak_rss():
     """Resets VmHWM to the current RSS (Linux >= 4.0); False where not allowed."""
     try:
@@ -226,6 +238,7 @@ def main():
     src, tgt, style = benchmark_scene(s)
     guides = [(a, b, 1.0) for a, b in zip(src, tgt)]
     extra = {"feature_precision": args.feature_precision} if args.feature_precision else {}
+    release_free_heap()
     before_mb = rss_mb()
     peak_reset = reset_peak_rss()
     t0, cpu0 = time.perf_counter(), time.process_time()
