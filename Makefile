@@ -77,8 +77,14 @@ DEMO_RIGID_OUT ?= out/demo-rigid
 demo-rigid: build
 	$(BLENDER) -b --factory-startup --python-exit-code 1 --python scenes/rigid_demo.py -- --out $(DEMO_RIGID_OUT)
 
+# The 1 Mpix run, the 0.25/1/4 Mpix sweep and, with COMPARE=REV (e.g. main), REV side by side.
 bench: build
 	PYTHONPATH=addon $(PYTHON) bench/bench_synthesis.py --size 1024 --json docs/bench_synthesis_1024.json
+	PYTHONPATH=addon $(PYTHON) bench/bench_synthesis.py --sweep --json docs/bench_synthesis_sweep.json
+ifdef COMPARE
+	PYTHONPATH=addon $(PYTHON) bench/bench_synthesis.py --size 1024 --compare $(COMPARE) --repeats 2 \
+	    --json docs/bench_synthesis_compare.json
+endif
 
 bench-tracer: build
 	PYTHONPATH=addon $(PYTHON) bench/bench_tracer.py --size 1024 --samples 64 --json docs/bench_tracer_1024.json

@@ -7,10 +7,19 @@ specular, indirect: four RGB guide pairs) and a hatching-like texture whose
 density follows the source shading stands in for the painted exemplar (RGB
 style). Default engine settings (budget usage, patch 5, automatic levels).
 
-Prints and optionally writes JSON: wall time, peak memory (max RSS), final
-energy and the per-stage timings.
+Prints and optionally writes JSON: wall time, peak memory (max RSS of the
+process, and the engine's own: the peak RSS during synthesize() over the RSS
+before it, with the kernel's peak reset in between), final energy and the
+per-stage timings. (Free heap pages are returned to the system first, so the
+engine cannot reuse them unseen.)
 
     PYTHONPATH=addon /usr/bin/python3 bench/bench_synthesis.py [--size 1024] [--json out.json]
+
+With --sweep it runs 0.25, 1 and 4 Mpix (style and guides scaled together),
+each in its own process, and reports time and memory per size and their
+growth against 1 Mpix:
+
+    PYTHONPATH=addon /usr/bin/python3 bench/bench_synthesis.py --sweep --json sweep.json
 
 With --compare REV it builds the native module of git revision REV in a
 temporary worktree and runs this checkout and REV alternately (--repeats
@@ -132,13 +141,71 @@ def compare(args, rest):
     summary = {}
     for name, results in runs.items():
         summary[name] = {k: statistics.median(r[k] for r in results)
-                         for k in ("wall_seconds", "cpu_seconds", "peak_rss_mb", "final_energy", "guide_error",
-                                   "source_coverage")}
+                         for k in ("wall_seconds", "cpu_seconds", "peak_rss_mb", "engine_peak_mb", "final_energy",
+                                   "guide_error", "source_coverage") if all(k in r for r in results)}
         summary[name]["wall_all"] = [r["wall_seconds"] for r in results]
     a, b = summary["this"], summary[args.compare]
-    summary["ratio_this_over_other"] = {k: a[k] / b[k] for k in ("wall_seconds", "cpu_seconds", "peak_rss_mb",
-                                                                 "final_energy", "guide_error", "source_coverage")}
+    summary["ratio_this_over_other"] = {k: a[k] / b[k] for k in a if k in b and k != "wall_all"}
     print(json.dumps(summary, indent=1))
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(summary, f, indent=1)
+
+
+def rss_mb(field="VmRSS"):
+    """Resident set size (or its peak, VmHWM) of this process in MB, from /proc."""
+    with open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith(field + ":"):
+                return int(line.split()[1]) / 1024
+    return float("nan")
+
+
+def release_free_heap():
+    """Returns freed heap memory to the system (glibc malloc_trim), so that the
+    RSS before synthesize() holds no free pages the engine could reuse unseen."""
+    import ctypes
+
+    try:
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):
+        pass
+
+
+def reset_peak_rss():
+    """Resets VmHWM to the current RSS (Linux >= 4.0); False where not allowed."""
+    try:
+        with open("/proc/self/clear_refs", "w") as f:
+            f.write("5")
+        return True
+    except OSError:
+        return False
+
+
+SWEEP_SIZES = (512, 1024, 2048)  # 0.25, 1 and 4 Mpix
+
+
+def sweep(args, rest):
+    """Each size in its own process; time and memory per size, and growth against 1 Mpix."""
+    import subprocess
+    import sys
+    import tempfile
+    from pathlib import Path
+
+    rows = {}
+    with tempfile.TemporaryDirectory(prefix="tempera-sweep-") as tmp:
+        for size in SWEEP_SIZES:
+            out = Path(tmp) / f"{size}.json"
+            subprocess.run([sys.executable, __file__, *rest, "--size", str(size), "--json", str(out)], check=True,
+                           stdout=subprocess.DEVNULL)
+            rows[size] = json.loads(out.read_text())
+    keys = ("wall_seconds", "cpu_seconds", "peak_rss_mb", "engine_peak_mb")
+    base = rows[1024]
+    summary = {"sizes": {str(s): {k: r[k] for k in (*keys, "final_energy", "guide_error", "source_coverage")}
+                         for s, r in rows.items()},
+               "growth_over_1mpix": {str(s): {k: r[k] / base[k] for k in keys} for s, r in rows.items()},
+               "runs": {str(s): r for s, r in rows.items()}}
+    print(json.dumps({k: summary[k] for k in ("sizes", "growth_over_1mpix")}, indent=1))
     if args.json:
         with open(args.json, "w") as f:
             json.dump(summary, f, indent=1)
@@ -154,19 +221,31 @@ def main():
     parser.add_argument("--em-iters", type=int, default=6)
     parser.add_argument("--pm-iters", type=int, default=2)
     parser.add_argument("--guide-variance", type=float, default=0.999)
+    parser.add_argument("--feature-precision", help="int16 or float (default: the engine's)")
+    parser.add_argument("--sweep", action="store_true", help="0.25, 1 and 4 Mpix, each in its own process")
+    parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--json")
     args = parser.parse_args()
+    rest = ["--usage", args.usage, "--threads", str(args.threads), "--em-iters", str(args.em_iters),
+            "--pm-iters", str(args.pm_iters), "--guide-variance", str(args.guide_variance), "--seed", str(args.seed)]
+    if args.feature_precision:
+        rest += ["--feature-precision", args.feature_precision]
+    if args.sweep:
+        return sweep(args, rest)
     if args.compare:
-        rest = ["--size", str(args.size), "--usage", args.usage, "--threads", str(args.threads), "--em-iters",
-                str(args.em_iters), "--pm-iters", str(args.pm_iters), "--guide-variance", str(args.guide_variance)]
-        return compare(args, rest)
+        return compare(args, ["--size", str(args.size), *rest])
     s = args.size
     src, tgt, style = benchmark_scene(s)
     guides = [(a, b, 1.0) for a, b in zip(src, tgt)]
+    extra = {"feature_precision": args.feature_precision} if args.feature_precision else {}
+    release_free_heap()
+    before_mb = rss_mb()
+    peak_reset = reset_peak_rss()
     t0, cpu0 = time.perf_counter(), time.process_time()
     image, stats = synthesize(style, guides, usage=args.usage, threads=args.threads, em_iterations=args.em_iters,
-                              pm_iterations=args.pm_iters, guide_variance=args.guide_variance)
+                              pm_iterations=args.pm_iters, guide_variance=args.guide_variance, seed=args.seed, **extra)
     wall, cpu = time.perf_counter() - t0, time.process_time() - cpu0
+    engine_peak_mb = (rss_mb("VmHWM") - before_mb) if peak_reset else float("nan")
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     finest = stats["levels"][-1]
     result = {
@@ -175,13 +254,19 @@ def main():
         "wall_seconds": round(wall, 2),
         "cpu_seconds": round(cpu, 2),
         "peak_rss_mb": round(peak_mb, 1),
+        "engine_peak_mb": round(engine_peak_mb, 1),
+        "rss_before_mb": round(before_mb, 1),
         "final_energy": finest["energy"][-1],
         "guide_error": guide_error(src, tgt, stats["nnf"]),
+        # The error budget's own figure: the fraction of the finest frame that
+        # reversed retrieval placed (the rest keeps its forward match).
+        "budget_coverage": finest["reversed_coverage"],
         "settings": {"em_iterations": args.em_iters, "pm_iterations": args.pm_iters,
-                     "guide_variance": args.guide_variance, "threads": args.threads},
+                     "guide_variance": args.guide_variance, "threads": args.threads, "seed": args.seed,
+                     "feature_precision": args.feature_precision or "default"},
         "guide_channels_matched": stats["guide_channels"],
         "levels": [{k: l[k] for k in ("width", "height", "search_seconds", "usage_seconds", "vote_seconds",
-                                      "usage_rounds", "energy")} for l in stats["levels"]],
+                                      "usage_rounds", "reversed_coverage", "energy")} for l in stats["levels"]],
         "source_coverage": stats["source_coverage"],
         "machine": f"{platform.processor() or platform.machine()}, {__import__('os').cpu_count()} cores",
         "tempera": tempera.__version__,
@@ -191,7 +276,7 @@ def main():
         with open(args.json, "w") as f:
             json.dump(result, f, indent=1)
     tempera.write_image(f"/tmp/bench_style_{s}.png", style)
-    tempera.write_image(f"/tmp/bench_out_{s}.png", image)
+    tempera.write_image(f"/tmp/bench_out_{s}_{args.feature_precision or 'default'}.png", image)
 
 
 if __name__ == "__main__":

@@ -1,6 +1,11 @@
 #include "tempera/patch_distance.hpp"
 
+#include <immintrin.h>
+
 #include <algorithm>
+#include <cmath>
+#include <limits>
+#include <type_traits>
 
 #include "tempera/error.hpp"
 
@@ -9,13 +14,16 @@ namespace tempera {
 FeatureImage::FeatureImage(int w, int h, int channels)
     : width(w), height(h), stride(padded(channels)), data(std::size_t(w) * h * padded(channels), 0.0f) {}
 
+void FeatureImage::store(std::size_t i, float v) {
+  const float q = std::clamp(std::nearbyint((v - offset[i % std::size_t(stride)]) / step), 0.0f, float(fixed_max));
+  if (bytes())
+    fixed8[i] = std::uint8_t(q);
+  else
+    fixed[i] = std::int16_t(q);
+}
+
 void FeatureImage::set_channels(int first, const ImageView& image, float scale) {
-  if (image.width != width || image.height != height || first + image.channels > stride)
-    throw ValueError("internal: feature channels do not fit the feature image");
-  const std::size_t n = std::size_t(width) * height;
-  for (std::size_t i = 0; i < n; ++i)
-    for (int c = 0; c < image.channels; ++c)
-      data[i * stride + first + c] = image.data[i * image.channels + c] * scale;
+  set_channels(first, image, std::vector<float>(std::size_t(std::max(0, image.channels)), scale));
 }
 
 void FeatureImage::set_channels(int first, const ImageView& image, const std::vector<float>& scales) {
@@ -23,9 +31,219 @@ void FeatureImage::set_channels(int first, const ImageView& image, const std::ve
       int(scales.size()) != image.channels)
     throw ValueError("internal: feature channels do not fit the feature image");
   const std::size_t n = std::size_t(width) * height;
+  if (quantized()) {
+    for (std::size_t i = 0; i < n; ++i)
+      for (int c = 0; c < image.channels; ++c) store(i * stride + first + c, image.data[i * image.channels + c] * scales[c]);
+    return;
+  }
   for (std::size_t i = 0; i < n; ++i)
     for (int c = 0; c < image.channels; ++c)
       data[i * stride + first + c] = image.data[i * image.channels + c] * scales[c];
+}
+
+void FeatureImage::zero_channels(int first, int count) {
+  const std::size_t n = std::size_t(width) * height;
+  for (std::size_t i = 0; i < n; ++i)
+    for (int c = first; c < first + count; ++c) {
+      if (quantized())
+        store(i * stride + c, 0.0f);
+      else
+        data[i * stride + c] = 0.0f;
+    }
+}
+
+void FeatureImage::quantize(const std::vector<float>& channel_offset, float quant_step, int max_value) {
+  if (int(channel_offset.size()) != stride || !(quant_step > 0.0f) || quantized() ||
+      (max_value != kFixed12 && max_value != kFixed8))
+    throw ValueError("internal: bad feature quantization");
+  offset = channel_offset;
+  step = quant_step;
+  fixed_max = max_value;
+  if (bytes())
+    fixed8.resize(data.size());
+  else
+    fixed.resize(data.size());
+  for (std::size_t i = 0; i < data.size(); ++i) store(i, data[i]);
+  std::vector<float>().swap(data);
+}
+
+void fixed_point_range(const FeatureImage& source, const FeatureImage& target, int target_first, int max_value,
+                       std::vector<float>& offset, float& step) {
+  const int stride = source.stride;
+  if (target.stride != stride) throw ValueError("internal: feature strides differ");
+  std::vector<float> lo(std::size_t(stride), std::numeric_limits<float>::infinity());
+  std::vector<float> hi(std::size_t(stride), -std::numeric_limits<float>::infinity());
+  auto extend = [&](const FeatureImage& f, int first) {
+    for (std::size_t i = 0; i < f.data.size(); i += std::size_t(stride))
+      for (int c = first; c < stride; ++c) {
+        lo[std::size_t(c)] = std::min(lo[std::size_t(c)], f.data[i + std::size_t(c)]);
+        hi[std::size_t(c)] = std::max(hi[std::size_t(c)], f.data[i + std::size_t(c)]);
+      }
+  };
+  extend(source, 0);
+  extend(target, target_first);
+  float range = 0.0f;
+  for (int c = 0; c < stride; ++c) {
+    if (!(lo[std::size_t(c)] <= hi[std::size_t(c)])) lo[std::size_t(c)] = hi[std::size_t(c)] = 0.0f;
+    range = std::max(range, hi[std::size_t(c)] - lo[std::size_t(c)]);
+  }
+  offset = lo;
+  // A flat feature set still needs a positive step.
+  step = range > 0.0f ? range / float(max_value) : 1.0f;
+}
+
+// Fixed-point SSD kernels. Values are at most 12 bits, so a difference fits
+// int16 and a madd pair (2 * 4095^2) an int32 lane; blocks of kBlock values
+// keep a lane below 2^31 before it is summed into int64. All kernels add the
+// same integers, so they agree exactly.
+namespace {
+
+constexpr int kBlock = 1024;
+
+template <class T>
+std::int64_t fixed_ssd_scalar(const T* a, const T* b, int n) {
+  std::int64_t sum = 0;
+  for (int i = 0; i < n; ++i) {
+    const std::int32_t d = std::int32_t(a[i]) - b[i];
+    sum += d * d;
+  }
+  return sum;
+}
+
+[[gnu::target("avx2")]] std::int64_t hsum_epi32(__m256i v) {
+  const __m256i lo = _mm256_cvtepi32_epi64(_mm256_castsi256_si128(v));
+  const __m256i hi = _mm256_cvtepi32_epi64(_mm256_extracti128_si256(v, 1));
+  const __m256i s = _mm256_add_epi64(lo, hi);
+  const __m128i t = _mm_add_epi64(_mm256_castsi256_si128(s), _mm256_extracti128_si256(s, 1));
+  return _mm_cvtsi128_si64(t) + _mm_extract_epi64(t, 1);
+}
+
+[[gnu::target("avx2")]] std::int64_t fixed_ssd_avx2(const std::int16_t* a, const std::int16_t* b, int n) {
+  std::int64_t sum = 0;
+  for (int start = 0; start < n; start += kBlock) {
+    const int end = std::min(n, start + kBlock);
+    __m256i acc = _mm256_setzero_si256();
+    int i = start;
+    for (; i + 16 <= end; i += 16) {
+      const __m256i d = _mm256_sub_epi16(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(a + i)),
+                                         _mm256_loadu_si256(reinterpret_cast<const __m256i*>(b + i)));
+      acc = _mm256_add_epi32(acc, _mm256_madd_epi16(d, d));
+    }
+    if (i + 8 <= end) {
+      const __m128i d = _mm_sub_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(a + i)),
+                                      _mm_loadu_si128(reinterpret_cast<const __m128i*>(b + i)));
+      acc = _mm256_add_epi32(acc, _mm256_zextsi128_si256(_mm_madd_epi16(d, d)));
+      i += 8;
+    }
+    sum += hsum_epi32(acc) + fixed_ssd_scalar(a + i, b + i, end - i);
+  }
+  return sum;
+}
+
+// Bytes: widened to int16 (8 bits square into a madd pair without any risk).
+[[gnu::target("avx2")]] std::int64_t fixed_ssd_avx2(const std::uint8_t* a, const std::uint8_t* b, int n) {
+  std::int64_t sum = 0;
+  for (int start = 0; start < n; start += kBlock) {
+    const int end = std::min(n, start + kBlock);
+    __m256i acc = _mm256_setzero_si256();
+    int i = start;
+    for (; i + 16 <= end; i += 16) {
+      const __m256i d = _mm256_sub_epi16(_mm256_cvtepu8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(a + i))),
+                                         _mm256_cvtepu8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(b + i))));
+      acc = _mm256_add_epi32(acc, _mm256_madd_epi16(d, d));
+    }
+    if (i + 8 <= end) {
+      const __m128i d = _mm_sub_epi16(_mm_cvtepu8_epi16(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(a + i))),
+                                      _mm_cvtepu8_epi16(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(b + i))));
+      acc = _mm256_add_epi32(acc, _mm256_zextsi128_si256(_mm_madd_epi16(d, d)));
+      i += 8;
+    }
+    sum += hsum_epi32(acc) + fixed_ssd_scalar(a + i, b + i, end - i);
+  }
+  return sum;
+}
+
+[[gnu::target("avx512f,avx512bw,avx512vl")]] std::int64_t fixed_ssd_avx512(const std::uint8_t* a, const std::uint8_t* b,
+                                                                           int n) {
+  std::int64_t sum = 0;
+  for (int start = 0; start < n; start += kBlock) {
+    const int end = std::min(n, start + kBlock);
+    __m512i acc = _mm512_setzero_si512();
+    for (int i = start; i < end; i += 32) {
+      const __mmask32 m = end - i >= 32 ? ~__mmask32(0) : (__mmask32(1) << (end - i)) - 1;
+      const __m512i d = _mm512_sub_epi16(_mm512_cvtepu8_epi16(_mm256_maskz_loadu_epi8(m, a + i)),
+                                         _mm512_cvtepu8_epi16(_mm256_maskz_loadu_epi8(m, b + i)));
+      acc = _mm512_add_epi32(acc, _mm512_madd_epi16(d, d));
+    }
+    const __m512i wide = _mm512_add_epi64(_mm512_cvtepi32_epi64(_mm512_castsi512_si256(acc)),
+                                          _mm512_cvtepi32_epi64(_mm512_extracti64x4_epi64(acc, 1)));
+    sum += _mm512_reduce_add_epi64(wide);
+  }
+  return sum;
+}
+
+[[gnu::target("avx512f,avx512bw")]] std::int64_t fixed_ssd_avx512(const std::int16_t* a, const std::int16_t* b,
+                                                                  int n) {
+  std::int64_t sum = 0;
+  for (int start = 0; start < n; start += kBlock) {
+    const int end = std::min(n, start + kBlock);
+    __m512i acc = _mm512_setzero_si512();
+    for (int i = start; i < end; i += 32) {
+      const __mmask32 m = end - i >= 32 ? ~__mmask32(0) : (__mmask32(1) << (end - i)) - 1;
+      const __m512i d = _mm512_sub_epi16(_mm512_maskz_loadu_epi16(m, a + i), _mm512_maskz_loadu_epi16(m, b + i));
+      acc = _mm512_add_epi32(acc, _mm512_madd_epi16(d, d));
+    }
+    const __m512i wide = _mm512_add_epi64(_mm512_cvtepi32_epi64(_mm512_castsi512_si256(acc)),
+                                          _mm512_cvtepi32_epi64(_mm512_extracti64x4_epi64(acc, 1)));
+    sum += _mm512_reduce_add_epi64(wide);
+  }
+  return sum;
+}
+
+template <class T>
+using FixedSsd = std::int64_t (*)(const T*, const T*, int);
+
+template <class T>
+FixedSsd<T> kernel_of(FixedKernel k) {
+  switch (k) {
+    case FixedKernel::Scalar: return fixed_ssd_scalar<T>;
+    case FixedKernel::Avx2: return fixed_ssd_avx2;
+    case FixedKernel::Avx512: return fixed_ssd_avx512;
+    case FixedKernel::Best: break;
+  }
+  if (fixed_kernel_supported(FixedKernel::Avx512)) return fixed_ssd_avx512;
+  if (fixed_kernel_supported(FixedKernel::Avx2)) return fixed_ssd_avx2;
+  return fixed_ssd_scalar<T>;
+}
+
+// Picked once, at load time.
+const FixedSsd<std::int16_t> best_fixed_ssd = kernel_of<std::int16_t>(FixedKernel::Best);
+const FixedSsd<std::uint8_t> best_fixed8_ssd = kernel_of<std::uint8_t>(FixedKernel::Best);
+
+std::int64_t best_ssd(const std::int16_t* a, const std::int16_t* b, int n) { return best_fixed_ssd(a, b, n); }
+std::int64_t best_ssd(const std::uint8_t* a, const std::uint8_t* b, int n) { return best_fixed8_ssd(a, b, n); }
+
+}  // namespace
+
+bool fixed_kernel_supported(FixedKernel kernel) {
+  __builtin_cpu_init();
+  switch (kernel) {
+    case FixedKernel::Avx2: return __builtin_cpu_supports("avx2");
+    case FixedKernel::Avx512:
+      return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+             __builtin_cpu_supports("avx512vl");
+    default: return true;
+  }
+}
+
+std::int64_t fixed_ssd(const std::int16_t* a, const std::int16_t* b, int n, FixedKernel kernel) {
+  if (!fixed_kernel_supported(kernel)) throw ValueError("fixed-point kernel not supported by this CPU");
+  return kernel_of<std::int16_t>(kernel)(a, b, n);
+}
+
+std::int64_t fixed_ssd(const std::uint8_t* a, const std::uint8_t* b, int n, FixedKernel kernel) {
+  if (!fixed_kernel_supported(kernel)) throw ValueError("fixed-point kernel not supported by this CPU");
+  return kernel_of<std::uint8_t>(kernel)(a, b, n);
 }
 
 void sample_bilinear(const float* data, int width, int height, int stride, int channels, float x,
@@ -99,6 +317,28 @@ template <bool Weighted>
   return sum;
 }
 
+// Axis-aligned patches over quantized features: exact integer row sums,
+// scaled by step^2 into the float energy.
+template <class T>
+float distance_fixed(const PatchSpace& s, int sx, int sy, int tx, int ty, float cutoff) {
+  const Window w = clip(s, tx, ty);
+  const int n = (w.dx1 - w.dx0 + 1) * s.source->stride;
+  const double step2 = double(s.source->step) * s.source->step;
+  const double limit = double(cutoff) / step2;
+  auto row = [](const FeatureImage& f, int x, int y) {
+    if constexpr (std::is_same_v<T, std::uint8_t>)
+      return f.fixed8_pixel(x, y);
+    else
+      return f.fixed_pixel(x, y);
+  };
+  std::int64_t sum = 0;
+  for (int dy = w.dy0; dy <= w.dy1; ++dy) {
+    sum += best_ssd(row(*s.source, sx + w.dx0, sy + dy), row(*s.target, tx + w.dx0, ty + dy), n);
+    if (double(sum) >= limit) break;
+  }
+  return float(double(sum) * step2);
+}
+
 // Axis-aligned patches under a window: each pixel's SSD is weighted.
 [[gnu::always_inline]] inline float distance_windowed(const PatchSpace& s, int sx, int sy, int tx, int ty,
                                                       float cutoff) {
@@ -149,6 +389,9 @@ template <bool Weighted>
 // load time, so one binary is fast on new CPUs and still runs on old ones.
 __attribute__((target_clones("avx2", "default")))
 float patch_distance(const PatchSpace& space, int sx, int sy, int tx, int ty, float cutoff) {
+  if (space.source->quantized())
+    return space.source->bytes() ? distance_fixed<std::uint8_t>(space, sx, sy, tx, ty, cutoff)
+                                 : distance_fixed<std::int16_t>(space, sx, sy, tx, ty, cutoff);
   if (space.rotated()) return distance_rotated(space, sx, sy, tx, ty, cutoff);
   if (space.window) return distance_windowed(space, sx, sy, tx, ty, cutoff);
   if (space.target_weights) return distance_aligned<true>(space, sx, sy, tx, ty, cutoff);

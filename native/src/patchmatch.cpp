@@ -59,9 +59,9 @@ struct Matcher {
   // Starts loading the first rows of the source patch at (cx, cy), if valid.
   inline void prefetch(int cx, int cy) const {
     if (cx < margin || cy < margin || cx >= sw - margin || cy >= sh - margin) return;
-    const int r = space.radius, bytes = (2 * r + 1) * space.source->stride * int(sizeof(float));
+    const int r = space.radius, bytes = (2 * r + 1) * space.source->bytes_per_pixel();
     for (int dy = -r; dy <= std::min(r, 1 - r); ++dy) {
-      const char* row = reinterpret_cast<const char*>(space.source->pixel(cx - r, cy + dy));
+      const char* row = space.source->pixel_bytes(cx - r, cy + dy);
       for (int off = 0; off < bytes; off += 64) __builtin_prefetch(row + off);
     }
   }

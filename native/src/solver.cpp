@@ -139,15 +139,23 @@ void validate_input(const SynthesisInput& in) {
 
 // ---- pyramids ----
 
-Image stack_channels(const std::vector<ImageView>& parts) {
+// The channels of `parts` side by side, each part multiplied by its entry of
+// `scales` (empty = 1) while copied: no scaled copy of every guide first.
+Image stack_channels(const std::vector<ImageView>& parts, const std::vector<float>& scales = {}) {
   int channels = 0;
   for (const auto& p : parts) channels += p.channels;
   Image out(parts.front().width, parts.front().height, channels);
   const std::size_t n = out.pixel_count();
   int first = 0;
-  for (const auto& p : parts) {
-    for (std::size_t i = 0; i < n; ++i)
-      std::memcpy(out.data() + i * channels + first, p.data + i * p.channels, sizeof(float) * p.channels);
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    const ImageView& p = parts[k];
+    if (scales.empty()) {
+      for (std::size_t i = 0; i < n; ++i)
+        std::memcpy(out.data() + i * channels + first, p.data + i * p.channels, sizeof(float) * p.channels);
+    } else {
+      for (std::size_t i = 0; i < n; ++i)
+        for (int c = 0; c < p.channels; ++c) out.data()[i * channels + first + c] = p.data[i * p.channels + c] * scales[k];
+    }
     first += p.channels;
   }
   return out;
@@ -162,18 +170,6 @@ Image stack_rows(const std::vector<Image>& parts) {
     std::memcpy(out.pixel(0, y), p.data(), sizeof(float) * p.pixel_count() * p.channels());
     y += p.height();
   }
-  return out;
-}
-
-Image scaled(const ImageView& image, float factor) {
-  Image out = Image::copy_of(image);
-  for (std::size_t i = 0; i < out.pixel_count() * out.channels(); ++i) out.data()[i] *= factor;
-  return out;
-}
-
-std::vector<ImageView> views(const std::vector<Image>& images) {
-  std::vector<ImageView> out;
-  for (const auto& img : images) out.push_back(img.view());
   return out;
 }
 
@@ -304,18 +300,16 @@ Solver::Solver(const SynthesisInput& in, const SynthesisOptions& opt) : plan_(ne
   std::vector<Image> src_guides(ex.size());  // per exemplar, all layers stacked along channels
   Image tgt_guides;
   if (!layers.empty()) {
-    for (std::size_t e = 0; e < ex.size(); ++e) {
-      std::vector<Image> weighted;
-      for (std::size_t g = 0; g < layers.size(); ++g) weighted.push_back(scaled(ex[e].guides[g], std::sqrt(layers[g].weight)));
-      src_guides[e] = stack_channels(views(weighted));
-    }
-    std::vector<Image> weighted;
+    std::vector<float> scales;
+    std::vector<ImageView> targets;
     for (const auto& layer : layers) {
-      weighted.push_back(scaled(layer.target, std::sqrt(layer.weight)));
+      scales.push_back(std::sqrt(layer.weight));
+      targets.push_back(layer.target);
       p.guide_channels.push_back(layer.source.channels);
       p.guide_weights.push_back(layer.weight);
     }
-    tgt_guides = stack_channels(views(weighted));
+    for (std::size_t e = 0; e < ex.size(); ++e) src_guides[e] = stack_channels(ex[e].guides, scales);
+    tgt_guides = stack_channels(targets, scales);
     const bool has_maps = std::any_of(in.target_weight_maps.begin(), in.target_weight_maps.end(),
                                       [](const ImageView& m) { return !m.empty(); });
     if (opt.guide_variance < 1.0 && !has_maps && tgt_guides.channels() > 1) {
@@ -501,6 +495,7 @@ void Solver::build_level(int l, Level& level, const LevelStart* start) const {
     }
     level.space.target_weights = &level.target_weights;
   }
+  quantize_features(level);
   SearchConstraints& cons = level.constraints;
   const int margin = level.space.source_margin();
   const SourceLayout& lay = p.layout[std::size_t(l)];
@@ -536,6 +531,20 @@ void Solver::build_level(int l, Level& level, const LevelStart* start) const {
     for (std::size_t i = 0; i < std::size_t(tw) * th; ++i)
       cons.target_segment.push_back(std::int32_t(std::lround(p.target_label[l].data()[i])));
   cons.finalize();
+}
+
+// Fixed-point features where the patch distance has a fixed-point path:
+// axis-aligned patches with no window and no per-pixel weights.
+void Solver::quantize_features(Level& level) const {
+  const PatchSpace& s = level.space;
+  if (options_.feature_precision == FeaturePrecision::Float || s.rotated() || s.window || s.target_weights) return;
+  const int max_value =
+      options_.feature_precision == FeaturePrecision::Int8 ? FeatureImage::kFixed8 : FeatureImage::kFixed12;
+  std::vector<float> offset;
+  float step = 0.0f;
+  fixed_point_range(level.source, level.target, plan_->style_channels, max_value, offset, step);
+  level.source.quantize(offset, step, max_value);
+  level.target.quantize(offset, step, max_value);
 }
 
 void Solver::replace_guide_targets(int l, const LevelStart& start, FeatureImage& target) const {
@@ -601,8 +610,7 @@ OffsetField Solver::cold_start(int l, Level& level, Image& bprime) const {
   }
   FeatureImage source = level.source, target = level.target;
   for (FeatureImage* f : {&source, &target})  // the guide channels alone
-    for (std::size_t i = 0; i < f->data.size(); i += std::size_t(f->stride))
-      std::fill_n(f->data.begin() + std::ptrdiff_t(i), p.style_channels, 0.0f);
+    f->zero_channels(0, p.style_channels);
   PatchSpace guide_space = level.space;
   guide_space.source = &source;
   guide_space.target = &target;

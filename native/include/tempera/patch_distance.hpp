@@ -3,12 +3,16 @@
 // feature vector (style channels A'/B' followed by the guide channels A_g/B_g),
 // premultiplied by the square roots of their weights, so one sum of squared
 // differences is the whole weighted energy of StyLit's eq. 8.1. Pixels are
-// interleaved and padded to a multiple of 8 floats: a patch row is one
-// contiguous run of memory that vectorizes without gathers.
+// interleaved and padded to a multiple of 8 values: a patch row is one
+// contiguous run of memory that vectorizes without gathers. The search is
+// bound by memory latency (a random candidate's rows are cache misses), so
+// the features are stored quantized where the distance allows it (see
+// FeatureImage::quantize and the feature_precision option).
 #include <cmath>
 #include <cstdint>
 #include <vector>
 
+#include "tempera/huge_pages.hpp"
 #include "tempera/image.hpp"
 
 namespace tempera {
@@ -16,20 +20,67 @@ namespace tempera {
 struct FeatureImage {
   int width = 0;
   int height = 0;
-  int stride = 0;  // floats per pixel, padded
-  std::vector<float> data;
+  int stride = 0;  // floats (or fixed-point values) per pixel, padded
+  std::vector<float> data;  // float features; empty once quantized
+  // Quantized features (after quantize()): channel c of a pixel holds
+  // round((v - offset[c]) / step), clamped to [0, fixed_max]. One step for all
+  // channels, so the integer SSD times step^2 is the float SSD: the features
+  // are weighted already, and one absolute precision fits the metric. 12 bits
+  // in int16 (`fixed`) or 8 bits in bytes (`fixed8`) halve or quarter the
+  // bytes a random candidate touches; integer sums are exact, so the SIMD and
+  // scalar kernels agree to the bit.
+  std::vector<std::int16_t, HugePageAllocator<std::int16_t>> fixed;
+  std::vector<std::uint8_t, HugePageAllocator<std::uint8_t>> fixed8;
+  std::vector<float> offset;
+  float step = 0.0f;
+  int fixed_max = 0;  // 0: float; kFixed12 (int16 storage) or kFixed8 (bytes)
+  static constexpr int kFixed12 = 4095, kFixed8 = 255;
 
   FeatureImage() = default;
   FeatureImage(int w, int h, int channels);
   static int padded(int channels) { return (channels + 7) / 8 * 8; }
-  float* pixel(int x, int y) { return data.data() + (std::size_t(y) * width + x) * stride; }
-  const float* pixel(int x, int y) const { return data.data() + (std::size_t(y) * width + x) * stride; }
+  bool quantized() const { return fixed_max > 0; }
+  bool bytes() const { return fixed_max == kFixed8; }
+  float* pixel(int x, int y) { return data.data() + index(x, y); }
+  const float* pixel(int x, int y) const { return data.data() + index(x, y); }
+  const std::int16_t* fixed_pixel(int x, int y) const { return fixed.data() + index(x, y); }
+  const std::uint8_t* fixed8_pixel(int x, int y) const { return fixed8.data() + index(x, y); }
+  // Start of pixel (x, y) in whichever storage is in use, and its size.
+  const char* pixel_bytes(int x, int y) const {
+    if (!quantized()) return reinterpret_cast<const char*>(pixel(x, y));
+    return bytes() ? reinterpret_cast<const char*>(fixed8_pixel(x, y)) : reinterpret_cast<const char*>(fixed_pixel(x, y));
+  }
+  int bytes_per_pixel() const { return stride * int(!quantized() ? sizeof(float) : bytes() ? 1 : sizeof(std::int16_t)); }
   // Writes channels of `image` into feature slots [first, first + image.channels)
   // scaled by `scale` (sqrt of the weight).
   void set_channels(int first, const ImageView& image, float scale);
   // The same with one scale per channel of `image`.
   void set_channels(int first, const ImageView& image, const std::vector<float>& scales);
+  // Sets slots [first, first + count) of every pixel to 0.
+  void zero_channels(int first, int count);
+  // Replaces the float features by fixed-point ones in [0, max_value]
+  // (kFixed12 or kFixed8) with these channel offsets (stride values) and step;
+  // frees the floats.
+  void quantize(const std::vector<float>& channel_offset, float quant_step, int max_value);
+
+ private:
+  std::size_t index(int x, int y) const { return (std::size_t(y) * width + x) * stride; }
+  void store(std::size_t i, float v);
 };
+
+// Offsets and step that quantize `source` (all channels) and `target`
+// (channels from `target_first` on: the target's style is not known yet and
+// lies in the source's range) into [0, max_value] without clipping: the
+// per-channel minimum, and the widest channel range / max_value as the step.
+void fixed_point_range(const FeatureImage& source, const FeatureImage& target, int target_first, int max_value,
+                       std::vector<float>& offset, float& step);
+
+// Exact integer SSD of n fixed-point values (at most 12 bits), with the kernel
+// the CPU supports (AVX-512BW, AVX2, or scalar); `kernel` forces one, for tests.
+enum class FixedKernel { Best, Scalar, Avx2, Avx512 };
+bool fixed_kernel_supported(FixedKernel kernel);
+std::int64_t fixed_ssd(const std::int16_t* a, const std::int16_t* b, int n, FixedKernel kernel = FixedKernel::Best);
+std::int64_t fixed_ssd(const std::uint8_t* a, const std::uint8_t* b, int n, FixedKernel kernel = FixedKernel::Best);
 
 // What a patch comparison needs: the two feature images, the patch radius and,
 // for rotation-aware matching, per-pixel orientation angles (radians; the

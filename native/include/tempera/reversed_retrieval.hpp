@@ -151,10 +151,10 @@ class ReversedRetrieval {
   void prefetch_target(int qx, int qy) const {
     if (qx < 0 || qy < 0 || qx >= tw_ || qy >= th_) return;
     const int r = space_.radius;
-    const int x0 = std::max(0, qx - r), bytes = (2 * r + 1) * space_.target->stride * int(sizeof(float));
+    const int x0 = std::max(0, qx - r), bytes = (2 * r + 1) * space_.target->bytes_per_pixel();
     for (int dy = -r; dy <= std::min(r, 1 - r); ++dy) {
       if (qy + dy < 0 || qy + dy >= th_) continue;
-      const char* row = reinterpret_cast<const char*>(space_.target->pixel(x0, qy + dy));
+      const char* row = space_.target->pixel_bytes(x0, qy + dy);
       for (int off = 0; off < bytes; off += 64) __builtin_prefetch(row + off);
     }
   }

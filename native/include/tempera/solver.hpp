@@ -91,6 +91,7 @@ class Solver {
   OffsetField cold_start(int level, Level& lv, Image& bprime) const;
   void fix_pixels(int level, const Level& lv, const Image* values, OffsetField& field, Image& bprime) const;
   void set_target_style(Level& lv, const Image& bprime) const;
+  void quantize_features(Level& lv) const;
   void replace_guide_targets(int level, const LevelStart& start, FeatureImage& target) const;
   std::unique_ptr<Plan> plan_;
   SynthesisOptions options_;

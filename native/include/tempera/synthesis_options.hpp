@@ -43,6 +43,18 @@ struct EnumNames<OutputMode> {
   static constexpr std::array<const char*, 4> names = {"mean", "centre", "mode", "random"};
 };
 
+// Precision of the matched features. int16: 12-bit fixed point with one step
+// for all channels (half the bytes per random candidate, exact integer SSD);
+// int8: 8 bits (a quarter); both apply to axis-aligned, unwindowed,
+// unweighted patches, the others always match in float. float: the v0.1
+// results, bit for bit.
+enum class FeaturePrecision { Int16, Int8, Float };
+template <>
+struct EnumNames<FeaturePrecision> {
+  static constexpr const char* what = "feature precision";
+  static constexpr std::array<const char*, 3> names = {"int16", "int8", "float"};
+};
+
 struct SynthesisOptions {
   int patch_size = 5;
   int levels = 0;
@@ -62,6 +74,7 @@ struct SynthesisOptions {
   float histogram_threshold = 2.0f;
   float histogram_sigma = 1.5f;
   double guide_variance = 0.999;
+  FeaturePrecision feature_precision = FeaturePrecision::Int16;
   bool axial_orientation = true;
   double budget_coverage = 0.95;
   int budget_max_rounds = 16;
@@ -112,6 +125,8 @@ inline const auto& synthesis_option_table() {
             "Gaussian blur of the usage histogram, in source pixels; 1.5 typical", 0, 100),
       field(&S::guide_variance, "guide_variance", "guide-variance",
             "guide variance kept by PCA compression of the guide channels; 1 = exact (slower)", 1e-6, 1),
+      field(&S::feature_precision, "feature_precision", "feature-precision",
+            "features matched as int16 (12-bit fixed point), int8 (8-bit: least memory traffic) or float (exact, slowest)"),
       field(&S::axial_orientation, "axial_orientation", "axial-orientation",
             "orientations are axial (mod pi, like strokes) rather than directed (mod 2 pi)"),
       field(&S::budget_coverage, "budget_coverage", "budget-coverage",
