@@ -13,6 +13,7 @@ from fake_ui import modal_run
 
 SCENE = "Rigid method test"
 SIZE = (96, 72)
+FLOOR_Y = SIZE[1] / 2 + 0.9 * SIZE[0] / 3.0  # the floor z = 0 in the image: camera at z 0.9, 3 m wide
 FRAMES = (5, 14)  # around the bounce (frame ~12): guides of 10 frames, two chunks of the method
 
 
@@ -106,9 +107,13 @@ def test_stylize_animation_draws_the_ball_and_resumes(rigid_scene, tmp_path):
         img = tempera.read_image(str(out / f"frame_{f:04d}.png"))
         assert img.shape == (SIZE[1], SIZE[0], 4)
         ys, xs = np.nonzero(img[:, :, 3] > 0.5)
-        cx, cy = ball["centre"][f - 1]
-        assert len(xs) > 20 and abs(xs.mean() - cx) < 3 and abs(ys.mean() - cy) < 4, f  # the ink is on the ball
-    assert f"Tempera frames {FRAMES[0]}" in bpy.data.images  # loaded as today
+        (cx, cy), r = ball["centre"][f - 1], ball["radius"][f - 1]
+        # The ink is on the ball (the contact fix may pull it down onto the
+        # floor at the bounce, never through it).
+        assert len(xs) > 20 and abs(xs.mean() - cx) < 0.6 * r, f
+        assert ys.min() < cy + r and ys.max() > cy - r and ys.max() < FLOOR_Y + 1.5, f
+    image = bpy.data.images["Tempera frames"]  # loaded as today (Load Result: Image)
+    assert image.source == "SEQUENCE" and bpy.path.abspath(image.filepath) == str(out / f"frame_{FRAMES[0]:04d}.png")
     again = StylizeRun.from_settings(rigid_scene, "ANIMATION")
     while not again.finished:
         again.step()

@@ -102,7 +102,9 @@ class RigidJob:
         return self.out / FRAMES_DIR / f"frame_{frame:04d}.png"
 
     def _settings_key(self):
-        parts = [rigid_cli._stamp(self.cache / rigid_tracks.TRACKS_NAME), self.shape, str(self.paper),
+        # The tracks by content: rendering the guides rewrites tracks.json each time, unchanged.
+        tracks = hashlib.sha256((self.cache / rigid_tracks.TRACKS_NAME).read_bytes()).hexdigest()
+        parts = [tracks, self.shape, str(self.paper),
                  json.dumps(self.values, sort_keys=True), ",".join(self.objects)]
         for d in self.examples:
             parts += [rigid_cli._stamp(d / rigid_tracks.TRACKS_NAME)]
