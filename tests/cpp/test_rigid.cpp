@@ -285,7 +285,8 @@ TEST(RigidOracle, OverlapsStitchSmoothly) {
 
 // Overlaps that disagree: two exemplars of different styles (a stretchy
 // fast ball, a slow one that only squashes, over a wide ramp) matched to
-// neighbouring events of a target whose bounces come ever closer. Without
+// neighbouring events of a target (bounces at 10, 26, 38, 49: the first
+// sub-sequence takes the squash-only exemplar, the others the stretchy one). Without
 // the overlap blend the hard cut at the overlap jumps; with it, it does not.
 TEST(RigidMethod, OverlapBlendHidesDisagreeingSubSequences) {
   auto generated = [](const Track& track, const ExemplarStyle& style) {

@@ -46,7 +46,7 @@ from . import results
 
 # Rough stylizing cost per megapixel on a 2-core machine (docs/benchmarks.md).
 STYLIZE_SECONDS_PER_MPIX = {"final": 40.0, "preview": 8.0}
-RIGID_SECONDS_PER_FRAME = 1.0  # per object, at 640 x 360 (bench/bench_rigid.py)
+RIGID_SECONDS_PER_FRAME = 0.2  # per object and frame at 640 x 360, loaded machine (docs/benchmarks.md)
 FRAMES_DIR = "frames"
 CONTACT_SHEET = "contact_sheet.png"
 VIDEO = "stylized.mp4"
