@@ -70,7 +70,7 @@ def stylize(exemplars, target, width, height, progress=None, only=None, **values
     not in `only` (a list of frame indices; None = all). `exemplars` are
     fit_exemplar results; `values` RigidOptions keywords (k, lambda_vel,
     lambda_dir, lambda_rot, symmetry, augment, scales, flip, damp,
-    fold_min_det, contact_fade). progress(frame) returning False cancels
+    fold_min_det, contact_fade, overlap_blend). progress(frame) returning False cancels
     (tempera._native.Cancelled)."""
     options = RigidOptions(**values)
     prepared = [(t, list(m), [_rgba(r, "residual") for r in rs]) for t, m, rs in exemplars]

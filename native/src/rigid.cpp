@@ -210,11 +210,15 @@ std::vector<RigidFrame> synthesize_deformations(const std::vector<RigidExemplar>
     std::vector<std::size_t> holders;
     for (std::size_t i = 0; i < target_subs.size(); ++i)
       if (f >= target_subs[i].first && f <= target_subs[i].last) holders.push_back(i);
+    double beta = 0;  // the next sub-sequence's share in an overlap
+    if (holders.size() > 1) {
+      const SubSequence& next = target_subs[holders[1]];
+      beta = double(f - next.first + 1) / double(target_subs[holders[0]].last - next.first + 2);
+      if (!options.overlap_blend) holders.erase(holders.begin() + (beta < 0.5 ? 1 : 0));
+    }
     RigidFrame a = frame_from_matches(exemplars, nearest[holders[0]], target_subs[holders[0]], f, target, options);
     if (holders.size() > 1) {
       const SubSequence& next = target_subs[holders[1]];
-      const SubSequence& prev = target_subs[holders[0]];
-      const double beta = double(f - next.first + 1) / double(prev.last - next.first + 2);
       const RigidFrame b = frame_from_matches(exemplars, nearest[holders[1]], next, f, target, options);
       a.D = blend({a.D, b.D}, {1 - beta, beta});
       a.xi = (1 - beta) * a.xi + beta * b.xi;

@@ -259,23 +259,58 @@ TEST(RigidOracle, ContactsCloseAtEvents) {
   }
 }
 
-TEST(RigidOracle, OverlapsStitchSmoothly) {
-  const Oracle& o = oracle();
+// (worst D_hat jump at the sub-sequence overlaps, median frame-to-frame jump).
+static std::pair<double, double> overlap_and_median_jumps(const Track& target, const std::vector<RigidFrame>& frames) {
   std::vector<double> jumps;
-  for (std::size_t f = 1; f < o.frames.size(); ++f) {
+  for (std::size_t f = 1; f < frames.size(); ++f) {
     QuadraticMap d;
-    for (std::size_t i = 0; i < 12; ++i) d.d[i] = o.frames[f].D.d[i] - o.frames[f - 1].D.d[i] + QuadraticMap::identity().d[i];
+    for (std::size_t i = 0; i < 12; ++i) d.d[i] = frames[f].D.d[i] - frames[f - 1].D.d[i] + QuadraticMap::identity().d[i];
     jumps.push_back(distance_from_identity(d));
   }
   std::vector<double> sorted = jumps;
   std::sort(sorted.begin(), sorted.end());
-  const double median = sorted[sorted.size() / 2];
-  const auto subs = cut_subsequences(o.target);
+  const auto subs = cut_subsequences(target);
   double worst = 0;
   for (std::size_t i = 0; i + 1 < subs.size(); ++i)
     for (int f = subs[i + 1].first; f <= subs[i].last + 1; ++f) worst = std::max(worst, jumps[std::size_t(f - 1)]);
+  return {worst, sorted[sorted.size() / 2]};
+}
+
+TEST(RigidOracle, OverlapsStitchSmoothly) {
+  const Oracle& o = oracle();
+  const auto [worst, median] = overlap_and_median_jumps(o.target, o.frames);
   std::printf("stitching: worst overlap jump %.4f, median jump %.4f\n", worst, median);
   EXPECT_LE(worst, 1.5 * median);
+}
+
+// Overlaps that disagree: two exemplars of different styles (a stretchy
+// fast ball, a slow one that only squashes, over a wide ramp) matched to
+// neighbouring events of a target (bounces at 10, 26, 38, 49: the first
+// sub-sequence takes the squash-only exemplar, the others the stretchy one). Without
+// the overlap blend the hard cut at the overlap jumps; with it, it does not.
+TEST(RigidMethod, OverlapBlendHidesDisagreeingSubSequences) {
+  auto generated = [](const Track& track, const ExemplarStyle& style) {
+    RigidExemplar e{track, {}};
+    for (int f = 0; f < int(track.frames.size()); ++f) e.maps.push_back(generator_map(track, f, style));
+    return e;
+  };
+  ExemplarStyle stretchy, squashy;
+  stretchy.stretch = 1.5, stretchy.squash = 0.5, stretchy.bend = 0.5;
+  squashy.stretch = 0, squashy.squash = 0.6, squashy.bend = 0, squashy.squash_frames = 6;
+  const std::vector<RigidExemplar> exemplars{
+      generated(bouncing_ball({40, 50}, {4.5, 0}, 18, 1.2, 180, 0.6, 0.05, 48), stretchy),
+      generated(bouncing_ball({40, 120}, {1.5, 0}, 18, 0.5, 180, 0.6, 0.05, 48), squashy)};
+  const Track target = bouncing_ball({290, 120}, {-3.0, 0}, 16, 1.0, 185, 0.8, -0.05, 56);
+  RigidOptions options;
+  options.k = 1, options.scales = 1;
+  const auto blended = overlap_and_median_jumps(target, synthesize_deformations(exemplars, target, options));
+  options.overlap_blend = false;
+  const auto cut = overlap_and_median_jumps(target, synthesize_deformations(exemplars, target, options));
+  std::printf("disagreeing overlaps: worst jump %.4f against median %.4f blended (%.2fx), %.4f against %.4f cut (%.2fx)\n",
+              blended.first, blended.second, blended.first / blended.second, cut.first, cut.second,
+              cut.first / cut.second);
+  EXPECT_GT(cut.first, 1.5 * cut.second);
+  EXPECT_LE(blended.first, 1.5 * blended.second);
 }
 
 TEST(RigidMethod, BadInputIsNamed) {

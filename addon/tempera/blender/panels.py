@@ -135,6 +135,9 @@ def draw_synthesis(box, settings):
     box.prop(settings, "method")
     if settings.method == "TCIA":
         draw_keyframes(box, settings)
+    if settings.method == "RIGID":
+        draw_rigid(box, settings)
+        return  # the StyLit settings below do not apply
     col = box.column()
     col.prop(settings, "quality")
     col.prop(settings, "usage")
@@ -158,6 +161,15 @@ def draw_noise(box, settings):
              "GUIDE": "noise_map_guide"}.get(settings.noise_map_source)
     if field:
         col.prop(settings, field)
+
+
+def draw_rigid(box, settings):
+    """The rigid-body method: the drawn examples, the targets, the result."""
+    col = box.column()
+    col.prop(settings, "rigid_examples")
+    col.prop(settings, "rigid_collection")
+    col.prop(settings, "rigid_shape")
+    col.prop(settings, "rigid_output")
 
 
 def draw_keyframes(box, settings):

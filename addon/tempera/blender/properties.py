@@ -100,6 +100,16 @@ METHOD_ITEMS = (
     ("TCIA", "Temporally Coherent (Bénard 2013)", "The whole shot at once, coarse to fine in forward and backward "
      "sweeps along the motion, so the paint stays on the surfaces; painted Keyframes come out as painted and "
      "steer the frames around them (Stylize Frame stays per-frame StyLit)"),
+    ("RIGID", "Rigid Bodies (hand-drawn)", "The squash, stretch and line of drawn examples carried onto the "
+     "scene's rigid-body simulation (Dvorožňák 2017; needs a baked rigid-body world)"),
+)
+RIGID_SHAPES = (
+    ("circle", "Circle", "The bodies and the drawn examples are balls"),
+    ("box", "Box", "The bodies and the drawn examples are boxes (4-fold symmetric)"),
+)
+RIGID_OUTPUTS = (
+    ("RGBA", "Over the Render", "Transparent RGBA frames of the drawn bodies, to lay over the render"),
+    ("PAPER", "On Paper", "Opaque frames: the drawn bodies on paper"),
 )
 DEFAULT_KEYFRAME_DIR = "//tempera/keys/"
 
@@ -306,3 +316,18 @@ class TemperaSettings(PropertyGroup):
         name="Keyframe Folder",
         description="Where Add Keyframe saves the images to paint over ('//' is beside the .blend file)",
         subtype="DIR_PATH", default=DEFAULT_KEYFRAME_DIR)
+
+    # The rigid-body method (Dvorožňák et al. 2017, docs/rigid_bodies.md).
+    rigid_examples: StringProperty(
+        name="Examples",
+        description="The drawn examples: a folder with a source simulation's tracks.json and its drawn frames "
+        "drawn/NNNN.png (as `tempera rigid --exemplar` takes them), or a folder of such folders; "
+        "'//' is relative to the .blend file",
+        subtype="DIR_PATH", default="")
+    rigid_collection: PointerProperty(
+        name="Targets", type=bpy.types.Collection,
+        description="The rigid bodies to draw; empty: every active body of the scene's rigid-body world")
+    rigid_shape: EnumProperty(name="Shape", items=RIGID_SHAPES, default="circle",
+                              description="The proxy shape of the bodies and of the drawn examples")
+    rigid_output: EnumProperty(name="Result", items=RIGID_OUTPUTS, default="RGBA",
+                               description="What the drawn bodies are drawn on")

@@ -6,7 +6,8 @@ the screen centroid (the origin, which the recommended setup puts at the
 centre of mass), theta (the projected local X axis), the screen radius
 (half the largest dimension, projected at the object's depth), and a warning
 when the object turns about an axis more than 10 degrees from the view
-axis, since the method is 2D. Gravity is projected the same way, in px per
+axis, since the method is 2D; the depth (distance along the view axis, for
+compositing the drawn bodies far to near). Gravity is projected the same way, in px per
 frame^2, for the event finder.
 """
 import math
@@ -45,7 +46,7 @@ def _extract(scene, objects, camera):
     width, height = _size(scene)
     fps = scene.render.fps / scene.render.fps_base
     frames = range(scene.frame_start, scene.frame_end + 1)
-    samples = {o.name: {"c": [], "theta": [], "r": [], "q": []} for o in objects}
+    samples = {o.name: {"c": [], "theta": [], "r": [], "q": [], "depth": []} for o in objects}
     view_axis = None
     gravity = (0.0, 0.0)
     for f in frames:
@@ -65,6 +66,7 @@ def _extract(scene, objects, camera):
             s["theta"].append(math.atan2(tip[1] - c[1], tip[0] - c[0]))
             s["r"].append(math.hypot(rim[0] - c[0], rim[1] - c[1]))
             s["q"].append(m.to_quaternion())
+            s["depth"].append(-(camera.matrix_world.inverted() @ loc).z)
             if f == scene.frame_start and o is objects[0]:
                 g = scene.gravity if scene.use_gravity else Vector((0, 0, 0))
                 fall = _pixel(scene, camera, loc + g * (1.0 / fps) ** 2, width, height)
@@ -86,6 +88,7 @@ def _extract(scene, objects, camera):
             theta.append(theta[-1] + math.remainder(t - theta[-1], 2 * math.pi))
         others = {n: (o["c"], o["r"]) for n, o in samples.items() if n != name}
         tracks[name] = rigid_tracks.make_track(s["c"], theta, s["r"], gravity, others=others)
+        tracks[name]["depth"] = s["depth"]
     return tracks, gravity, warnings
 
 

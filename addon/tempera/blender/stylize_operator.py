@@ -21,6 +21,13 @@ phase is CoherentRun: tempera.tcia.ShotJob, one step per segment between
 painted keyframes (each resumable, Esc stops within a segment and nothing of
 it is written). Stylize Frame stays per-frame StyLit: a quick look, and the
 ground Add Keyframe paints over.
+
+With Method "Rigid Bodies (hand-drawn)", Stylize Animation is RigidRun:
+the guides (which write tracks.json for a rigid-body world), then
+tempera.rigid_job.RigidJob, one step per target object and chunk of frames,
+then the composites by depth, into Output Folder/rigid/frames (each step
+resumable; Esc stops within a step and nothing of it is written). Stylize
+Frame stays per-frame StyLit.
 """
 import os
 import time
@@ -39,6 +46,7 @@ from . import results
 
 # Rough stylizing cost per megapixel on a 2-core machine (docs/benchmarks.md).
 STYLIZE_SECONDS_PER_MPIX = {"final": 40.0, "preview": 8.0}
+RIGID_SECONDS_PER_FRAME = 0.2  # per object and frame at 640 x 360, loaded machine (docs/benchmarks.md)
 FRAMES_DIR = "frames"
 CONTACT_SHEET = "contact_sheet.png"
 VIDEO = "stylized.mp4"
@@ -141,6 +149,8 @@ class StylizeRun:
         frames = [scene.frame_current] if mode == "FRAME" else guide_frames(scene, scene.tempera)
         if mode == "ANIMATION" and scene.tempera.method == "TCIA":
             return CoherentRun(scene, frames, mode)
+        if mode == "ANIMATION" and scene.tempera.method == "RIGID":
+            return RigidRun(scene, frames, mode)
         return cls(scene, frames, mode)
 
     @property
@@ -327,6 +337,115 @@ class CoherentRun(StylizeRun):
                 "(Esc to stop)")
 
 
+RIGID_DIR = "rigid"  # the rigid-body method's folder in the Output Folder
+
+
+class RigidRun(StylizeRun):
+    """Guides of every frame, then the rigid-body method (RigidJob), a step
+    per object and chunk of frames, then its composites."""
+
+    def __init__(self, scene, frames, mode="ANIMATION"):
+        from .rigid_tracks import rigid_body_objects
+
+        settings = scene.tempera
+        self.mode = mode
+        self.frames = list(frames)
+        self.out = output_dir(settings)
+        from ..rigid_job import exemplar_folders
+
+        self.examples = resolve_path(settings.rigid_examples, "rigid-body Examples folder")
+        exemplar_folders(self.examples)  # a named error now, not after the guides
+        bodies = {o.name for o in rigid_body_objects(scene)}
+        if not bodies:
+            raise ValueError("Rigid Bodies needs a rigid-body world with active bodies in the scene.")
+        self.objects = None  # every body the tracks hold
+        if settings.rigid_collection is not None:
+            self.objects = sorted(o.name for o in settings.rigid_collection.all_objects if o.name in bodies)
+            if not self.objects:
+                raise ValueError(f"The collection '{settings.rigid_collection.name}' holds no active rigid body.")
+        self.guides = GuideJob.from_settings(scene, self.frames)
+        self.config = {"out": os.path.join(self.out, RIGID_DIR, FRAMES_DIR), "format": "png", "quality": "final"}
+        self.shape, self.paper = settings.rigid_shape, settings.rigid_output == "PAPER"
+        self.noise = None
+        self.job = None  # the RigidJob, made once the guides (and tracks.json) exist
+        self.index = 0
+        self.results = []
+        self.step_results = []
+        self.stylize_seconds = 0.0
+        self.warnings = []
+
+    def _rigid_job(self):
+        from ..rigid_job import RigidJob
+
+        if self.job is None:
+            self.job = RigidJob(self.guides.folder, self.examples, os.path.join(self.out, RIGID_DIR), self.frames,
+                                objects=self.objects, shape=self.shape, paper=self.paper)
+        return self.job
+
+    @property
+    def stylize_steps(self):
+        # Known once the first rigid step has read the tracks; until then, an estimate.
+        return self.job.total if self.job is not None else len(self.frames)
+
+    @property
+    def in_noise_phase(self):
+        return False  # no Temporal Noise after the rigid-body method
+
+    def _stylize(self, progress):
+        job = self._rigid_job()
+        i = self.index - len(self.frames)
+        started = time.monotonic()
+        result = job.run_step(i, progress)
+        if result["status"] != "kept":
+            self.stylize_seconds += time.monotonic() - started
+        self.step_results.append(result)
+        if result["object"] is None:  # a composite step: these frames are the result
+            self.results += [{"frame": f, "path": str(job.output_path(f)), "status": result["status"]}
+                             for f in result["frames"]]
+        if bpy.app.background:
+            what = result["object"] or "composite"
+            print(f"Tempera: rigid {what} frames {result['frames'][0]}-{result['frames'][-1]} {result['status']} "
+                  f"in {time.monotonic() - started:.1f} s", flush=True)
+
+    def current_frame(self):
+        if self.in_guide_phase or self.job is None:
+            return super().current_frame()
+        return self.job.steps[min(self.index - len(self.frames), self.job.total - 1)][1][0]
+
+    def eta_seconds(self):
+        done = [r for r in self.step_results if r["status"] == "stylized"]
+        left = self.stylize_steps - len(self.step_results)
+        if not done or left <= 0:
+            return None
+        return self.stylize_seconds / len(self.step_results) * left
+
+    def status_text(self):
+        if self.in_guide_phase:
+            return self.guides.status_text()
+        job = self.job
+        if job is None:
+            return "Tempera: rigid bodies, fitting the drawn examples (Esc to stop)"
+        i = min(self.index - len(self.frames), job.total - 1)
+        name, frames = job.steps[i]
+        eta = self.eta_seconds()
+        eta_text = "" if eta is None else f", ETA {format_duration(eta)}"
+        what = f"drawing {name}" if name else "compositing"
+        return (f"Tempera: rigid bodies, {what} frames {frames[0]}-{frames[-1]} (step {i + 1}/{job.total})"
+                f"{eta_text} (Esc to stop)")
+
+    def estimate_seconds(self, scene):
+        return estimate_guide_seconds(scene, self.guides.params, len(self.frames)) + RIGID_SECONDS_PER_FRAME * len(
+            self.frames) * (len(self.objects) if self.objects else 1)
+
+    def summary(self):
+        made = sum(r["status"] != "kept" for r in self.step_results)
+        kept = len(self.step_results) - made
+        left = self.stylize_steps - len(self.step_results) if self.job is not None else self.stylize_steps
+        parts = [f"{made} rigid-body steps done"] + ([f"{kept} already done"] if kept else []) + (
+            [f"{left} not done"] if left > 0 else [])
+        return f"Tempera: {', '.join(parts)} in {self.config['out']}"
+
+
 def flicker_text(flicker):
     """The flicker figure, said so that an artist can read it."""
     verdict = "steady" if flicker < 0.02 else "some flicker" if flicker < 0.05 else "strong flicker"
@@ -377,7 +496,7 @@ class TEMPERA_OT_stylize(JobOperator, Operator):
         paths = [r["path"] for r in (job.noise_results if job.noise else job.results)]
         results.reload_images_under(job.out)  # images already open show this run's pixels
         shown = []
-        if job.mode == "ANIMATION":
+        if job.mode == "ANIMATION" and hasattr(job.job, "write_contact_sheet"):  # StyLit's frames
             sheet = os.path.join(job.out, CONTACT_SHEET)
             job.job.write_contact_sheet(sheet)
             shown.append(f"contact sheet {sheet}")

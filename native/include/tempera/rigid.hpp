@@ -85,6 +85,7 @@ struct RigidOptions {
   bool damp = true;
   float fold_min_det = 0.05f; // least det J the fold guard allows
   int contact_fade = 3;       // frames over which the contact fix fades out
+  bool overlap_blend = true;  // ramp across sub-sequence overlaps; false: a hard cut at their middle
 };
 
 inline const auto& rigid_option_table() {
@@ -105,7 +106,9 @@ inline const auto& rigid_option_table() {
       field(&R::fold_min_det, "fold_min_det", "fold-min-det",
             "least Jacobian determinant the fold guard allows over the object's disc (0.05)", 0, 1),
       field(&R::contact_fade, "contact_fade", "contact-fade",
-            "frames over which the contact fix fades out around an event (3)", 0, 100));
+            "frames over which the contact fix fades out around an event (3)", 0, 100),
+      field(&R::overlap_blend, "overlap_blend", "overlap-blend",
+            "blend overlapping sub-sequences with a linear ramp (off: a hard cut at the overlap's middle)"));
   return table;
 }
 

@@ -1,0 +1,161 @@
+"""The rigid-body method from the panel (Method "Rigid Bodies (hand-drawn)")
+on a tiny baked scene: a ball dropped on a floor, drawn from the generated
+exemplar. Stylize Animation renders the guides (which write tracks.json),
+runs the method a step per object and chunk, composites and loads the
+result; Esc within a step writes nothing of it, and a rerun resumes."""
+import math
+import time
+
+import bpy
+import numpy as np
+import pytest
+from fake_ui import modal_run
+
+SCENE = "Rigid method test"
+SIZE = (96, 72)
+FLOOR_Y = SIZE[1] / 2 + 0.9 * SIZE[0] / 3.0  # the floor z = 0 in the image: camera at z 0.9, 3 m wide
+FRAMES = (5, 14)  # around the bounce (frame ~12): guides of 10 frames, two chunks of the method
+
+
+def _exemplar(folder):
+    from tempera import _native, rigid, rigid_tracks
+
+    track = _native.bouncing_ball((20, 15), (2.0, 0), 8, 0.6, 62, 0.65, 0.05, 24)
+    rigid_tracks.write_tracks(folder, {"Ball": track}, 1, (0, 0.6))
+    (folder / "drawn").mkdir(parents=True)
+    for i, d in enumerate(rigid.generated_exemplar(track, *SIZE, line_width=1.5)):
+        _native.write_image(str(folder / "drawn" / f"{1 + i:04d}.png"), d, [])
+
+
+@pytest.fixture
+def rigid_scene(tmp_path):
+    """A ball dropped 1 m onto a passive floor (baked by frame_set), an
+    orthographic camera along +Y, 16 frames at 96 x 72."""
+    scene = bpy.data.scenes.new(SCENE)
+    shown = bpy.context.window.scene
+    bpy.context.window.scene = scene
+    bpy.ops.mesh.primitive_plane_add(size=20, location=(0, 0, 0))
+    floor = bpy.context.object
+    bpy.ops.rigidbody.world_add()
+    bpy.ops.rigidbody.object_add()
+    floor.rigid_body.type = "PASSIVE"
+    floor.rigid_body.restitution = 0.8
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.3, location=(0, 0, 1.3), segments=16, ring_count=8)
+    ball = bpy.context.object
+    ball.name = "Ball"
+    bpy.ops.rigidbody.object_add()
+    ball.rigid_body.restitution = 0.8
+    ball.rigid_body.collision_shape = "SPHERE"
+    cam = bpy.data.objects.new("RigidCam", bpy.data.cameras.new("RigidCam"))
+    cam.data.type, cam.data.ortho_scale = "ORTHO", 3.0
+    scene.collection.objects.link(cam)
+    cam.location, cam.rotation_euler = (0, -10, 0.9), (math.pi / 2, 0, 0)
+    scene.camera = cam
+    scene.render.resolution_x, scene.render.resolution_y = SIZE
+    scene.render.resolution_percentage = 100
+    scene.frame_start, scene.frame_end = 1, 16
+    scene.rigidbody_world.point_cache.frame_end = 16
+    _exemplar(tmp_path / "examples" / "drop")
+    settings = scene.tempera
+    settings.method = "RIGID"
+    settings.rigid_examples = str(tmp_path / "examples")
+    settings.output_dir, settings.guide_dir = str(tmp_path / "out"), str(tmp_path / "guides")
+    settings.guide_frame_range = "CUSTOM"
+    settings.guide_frame_start, settings.guide_frame_end = FRAMES
+    settings.guide_samples = 4
+    settings.guide_lpe = ""
+    settings.make_video = False
+    settings.load_result = "IMAGE"
+    yield scene
+    bpy.context.window.scene = shown
+    for o in list(scene.objects):
+        bpy.data.objects.remove(o)
+    bpy.data.scenes.remove(scene)
+
+
+def _frames(folder):
+    return sorted(p.name for p in folder.glob("*") if p.name.startswith(("frame_", ".")))
+
+
+def test_method_in_the_panel(rigid_scene):
+    from test_addon import _Recorder
+    from tempera.blender.properties import METHOD_ITEMS
+
+    assert ("RIGID", "Rigid Bodies (hand-drawn)") == METHOD_ITEMS[2][:2]
+    calls = []
+    bpy.types.TEMPERA_PT_output.draw(type("FakePanel", (), {"layout": _Recorder(calls)})(), bpy.context)
+    props = [name for kind, name in calls if kind == "prop"]
+    i = props.index("method")
+    assert props[i + 1:i + 5] == ["rigid_examples", "rigid_collection", "rigid_shape", "rigid_output"]
+    assert "usage" not in props  # StyLit's settings do not apply
+
+
+def test_stylize_animation_draws_the_ball_and_resumes(rigid_scene, tmp_path):
+    import tempera
+    from tempera.blender.stylize_operator import StylizeRun
+
+    run = StylizeRun.from_settings(rigid_scene, "ANIMATION")
+    assert type(run).__name__ == "RigidRun"
+    assert bpy.ops.tempera.stylize(mode="ANIMATION") == {"FINISHED"}
+    frames = list(range(FRAMES[0], FRAMES[1] + 1))
+    out = tmp_path / "out" / "rigid" / "frames"
+    assert _frames(out) == [f"frame_{f:04d}.png" for f in frames]
+    tracks = tempera.rigid_tracks.read_tracks(tmp_path / "guides")
+    ball = tracks["objects"]["Ball"]
+    assert len(ball["depth"]) == 16 and ball["events"]
+    for f in frames:
+        img = tempera.read_image(str(out / f"frame_{f:04d}.png"))
+        assert img.shape == (SIZE[1], SIZE[0], 4)
+        ys, xs = np.nonzero(img[:, :, 3] > 0.5)
+        (cx, cy), r = ball["centre"][f - 1], ball["radius"][f - 1]
+        # The ink is on the ball (the contact fix may pull it down onto the
+        # floor at the bounce, never through it).
+        assert len(xs) > 20 and abs(xs.mean() - cx) < 0.6 * r, f
+        assert ys.min() < cy + r and ys.max() > cy - r and ys.max() < FLOOR_Y + 1.5, f
+    image = bpy.data.images["Tempera frames"]  # loaded as today (Load Result: Image)
+    assert image.source == "SEQUENCE" and bpy.path.abspath(image.filepath) == str(out / f"frame_{FRAMES[0]:04d}.png")
+    again = StylizeRun.from_settings(rigid_scene, "ANIMATION")
+    while not again.finished:
+        again.step()
+    assert {r["status"] for r in again.step_results} == {"kept"}
+    rigid_scene.tempera.rigid_output = "PAPER"
+    paper = StylizeRun.from_settings(rigid_scene, "ANIMATION")
+    while not paper.finished:
+        paper.step()
+    assert tempera.read_image(str(out / f"frame_{FRAMES[0]:04d}.png"))[:, :, 3].min() == 1.0
+
+
+def test_esc_within_a_step_writes_nothing_then_resume(rigid_scene, tmp_path):
+    from tempera.blender.stylize_operator import TEMPERA_OT_stylize, StylizeRun
+
+    run = StylizeRun.from_settings(rigid_scene, "ANIMATION")
+    while run.in_guide_phase:
+        run.step()
+    run.step()  # the first chunk of the ball
+    held = run._rigid_job()
+    stylize = held._stylize
+
+    def held_stylize(name, frames, paths, progress):
+        def wait_for_esc(fraction):  # Esc surely comes within the step, however fast the machine
+            deadline = time.monotonic() + 60
+            while not op_holder[0]._stop and time.monotonic() < deadline:
+                time.sleep(0.01)
+            return progress(fraction)
+        return stylize(name, frames, paths, wait_for_esc)
+
+    held._stylize = held_stylize
+    op_holder = []
+
+    def events(op):
+        op_holder.append(op)
+        yield ("TIMER", "NOTHING")  # starts the second chunk in the worker
+        yield ("ESC", "PRESS")
+
+    results, _log, reports, timers, _op = modal_run(TEMPERA_OT_stylize, rigid_scene, run, events, tick=0.02)
+    assert results[-1] == {"CANCELLED"} and not timers and "Stopped" in reports[-1][1]
+    layers = tmp_path / "out" / "rigid" / "layers" / "Ball"
+    assert _frames(layers) == [f"frame_{f:04d}.png" for f in range(FRAMES[0], FRAMES[0] + 8)]  # the first chunk only
+    rerun = StylizeRun.from_settings(rigid_scene, "ANIMATION")
+    while not rerun.finished:
+        rerun.step()
+    assert [r["status"] for r in rerun.step_results] == ["kept", "stylized", "composited", "composited"]
