@@ -140,7 +140,7 @@ void patchmatch(const PatchSpace& space, const SearchConstraints& cons, OffsetFi
   const bool video = layout && std::any_of(layout->next_frame.begin(), layout->next_frame.end(),
                                            [](int s) { return s >= 0; });
   const std::vector<std::uint8_t>& matched = cons.matched();
-  for (int iter = 0; iter < params.iterations; ++iter) {
+  for (int iter = params.first_iteration; iter < params.first_iteration + params.iterations; ++iter) {
     const OffsetField snapshot = field;  // what other bands see of this band's neighbours
     const Matcher m(space, cons, params, &snapshot);
     const int max_radius = std::max(m.sw, m.sh);

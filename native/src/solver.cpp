@@ -722,19 +722,27 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
   for (const auto& t : terms_)
     if (t->reads_field()) pm.field_terms.push_back(t.get());
   std::vector<TermState> states(terms_.size());
+  const bool refresh_each_iteration =
+      std::any_of(terms_.begin(), terms_.end(), [](const auto& t) { return t->refresh_each_iteration(); });
   for (int it = 0; it < em; ++it) {
     const std::uint64_t stream = std::uint64_t(l) * 1000 + std::uint64_t(it) + 1;
     t0 = Clock::now();
     set_target_style(level, bprime);
     refresh_distances(level.space, level.constraints, field, options_.threads);
-    level.constraints.source_cost.assign(level.constraints.source_valid.size(), 0.0f);
-    for (std::size_t k = 0; k < terms_.size(); ++k)
-      terms_[k]->add_source_costs(context, field, level.constraints.source_cost, states[k]);
-    const bool source_costs = std::any_of(level.constraints.source_cost.begin(), level.constraints.source_cost.end(),
-                               [](float c) { return c != 0.0f; });
-    if (!source_costs) level.constraints.source_cost.clear();
-    patchmatch(level.space, level.constraints, field, pm, stream);
-    level.constraints.source_cost.clear();
+    // One search, split into single iterations when a term's costs follow the field.
+    const int chunk = refresh_each_iteration ? 1 : pm_iters;
+    for (int first = 0; first < pm_iters; first += chunk) {
+      level.constraints.source_cost.assign(level.constraints.source_valid.size(), 0.0f);
+      for (std::size_t k = 0; k < terms_.size(); ++k)
+        terms_[k]->add_source_costs(context, field, level.constraints.source_cost, states[k]);
+      const bool source_costs = std::any_of(level.constraints.source_cost.begin(),
+                                            level.constraints.source_cost.end(), [](float c) { return c != 0.0f; });
+      if (!source_costs) level.constraints.source_cost.clear();
+      PatchMatchParams part = pm;
+      part.first_iteration = first, part.iterations = chunk;
+      patchmatch(level.space, level.constraints, field, part, stream);
+      level.constraints.source_cost.clear();
+    }
     stats.search_seconds += seconds_since(t0);
     t0 = Clock::now();
     for (const auto& t : terms_) {

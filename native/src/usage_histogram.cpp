@@ -40,6 +40,8 @@ class UsageHistogram final : public EnergyTerm {
  public:
   UsageHistogram(float weight, float threshold, float sigma) : weight_(weight), threshold_(threshold), sigma_(sigma) {}
   const char* name() const override { return "histogram"; }
+  // Eq. 8 is evaluated against the current M_t (§3.3: at every iteration).
+  bool refresh_each_iteration() const override { return true; }
   void add_source_costs(const LevelContext& c, const OffsetField& field, std::vector<float>& cost,
                         TermState& state) const override {
     const int sw = c.space->source->width, sh = c.space->source->height;

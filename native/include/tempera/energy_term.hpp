@@ -52,6 +52,10 @@ class EnergyTerm {
   // Adds this term's cost per source pixel into `cost` (atlas size).
   virtual void add_source_costs(const LevelContext&, const OffsetField&, std::vector<float>& /*cost*/,
                                 TermState& /*state*/) const {}
+  // Whether add_source_costs() is to be re-evaluated after every PatchMatch
+  // iteration rather than once per search: costs held through a whole search
+  // make every target leave a hotspot for the same next-best patch at once.
+  virtual bool refresh_each_iteration() const { return false; }
   // Whether pair_cost() is used.
   virtual bool reads_field() const { return false; }
   // Extra cost of matching target (tx, ty) to source (sx, sy), given the

@@ -59,6 +59,10 @@ struct PatchMatchParams {
   // Terms that read the field (EnergyTerm::reads_field), with their context.
   std::vector<const EnergyTerm*> field_terms;
   const LevelContext* context = nullptr;
+  // Index of the first iteration (scan direction and random stream): a search
+  // split into single iterations, e.g. to refresh usage costs in between,
+  // equals the unsplit one.
+  int first_iteration = 0;
 };
 
 // Random valid source for every active target pixel, with distances.
