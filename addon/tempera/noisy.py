@@ -19,8 +19,9 @@ TESTED_NOISE = (1.3, 1.6, 1.9, 2.2, 2.6, 3.1, 3.6, 4.3)
 
 def options(**values) -> "NoisyOptions":
     """NoisyOptions from keywords: its own (noise, lattice_spacing, shift_min,
-    shift_max, deform) and engine options (SynthesisOptions names, starting
-    from Color Me Noisy's defaults: patch 7, mode voting, 4 EM x 2 PM)."""
+    shift_max, deform, consistency, rotations, reflections) and engine options
+    (SynthesisOptions names, starting from Color Me Noisy's defaults: patch 7,
+    mode voting, 4 EM x 2 PM)."""
     return method_options(NoisyOptions, _native.noisy_defaults(), values, "Color Me Noisy")
 
 

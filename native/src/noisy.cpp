@@ -49,7 +49,49 @@ Image deform_exemplar(const ImageView& style, const NoisyOptions& o, int frame) 
   return warp_by_map(style, mls_backward_map(lattice, style.width, style.height).view());
 }
 
+Image dihedral_copy(const ImageView& image, int k) {
+  Image out = Image::copy_of(image);
+  if (k & 1)
+    for (int y = 0; y < out.height(); ++y)
+      for (int x = 0; x < out.width() / 2; ++x)
+        for (int c = 0; c < out.channels(); ++c) std::swap(out.at(x, y, c), out.at(out.width() - 1 - x, y, c));
+  for (int turn = 0; turn < (k >> 1) % 4; ++turn) {
+    Image turned(out.height(), out.width(), out.channels());  // (x, y) -> (h - 1 - y, x)
+    for (int y = 0; y < out.height(); ++y)
+      for (int x = 0; x < out.width(); ++x)
+        for (int c = 0; c < out.channels(); ++c) turned.at(out.height() - 1 - y, x, c) = out.at(x, y, c);
+    out = std::move(turned);
+  }
+  return out;
+}
+
 namespace {
+
+// The dihedral copies besides the exemplar itself that the options ask for.
+std::vector<int> dihedral_copies(const NoisyOptions& o) {
+  std::vector<int> k;
+  for (int c = 1; c < 8; ++c)
+    if (((c & 1) == 0 || o.reflections) && ((c >> 1) == 0 || o.rotations)) k.push_back(c);
+  return k;
+}
+
+// Rotations and reflections of P (eq. 1) as further exemplars: each copy
+// turns the exemplar and its guide sources alike (a box blur commutes with
+// them, so the low-frequency sources stay h_f * copy).
+void add_dihedral_exemplars(SynthesisInput& in, const NoisyOptions& o, std::vector<Image>& keep) {
+  const std::vector<int> copies = dihedral_copies(o);
+  keep.reserve(copies.size() * (1 + in.guides.layers().size()));  // the views below must not move
+  for (int k : copies) {
+    Exemplar e;
+    keep.push_back(dihedral_copy(in.style, k));
+    e.style = keep.back().view();
+    for (const GuideLayer& layer : in.guides.layers()) {
+      keep.push_back(dihedral_copy(layer.source, k));
+      e.guides.push_back(keep.back().view());
+    }
+    in.exemplars.push_back(e);
+  }
+}
 
 // The level at which a pixel with width f_p joins the synthesis: the
 // coarsest whose f_bar <= f_p; -1 below 1 (the pixel copies R).
@@ -126,6 +168,8 @@ Image noisy_frame(const ImageView& style, const ImageView& reference, int frame,
   in.reference = reference;
   std::vector<Image> low_frequency_images;  // kept alive for the guides' views
   if (o.consistency > 0) add_low_frequency_guides(in, exemplar.view(), reference, o, f, noise_map, low_frequency_images);
+  std::vector<Image> dihedral_images;  // kept alive for the exemplars' views
+  add_dihedral_exemplars(in, o, dihedral_images);
   SynthesisOptions opt = o.synthesis;
   opt.levels = noisy_levels(f);
   opt.level_ratio = kRatio;

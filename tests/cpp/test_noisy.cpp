@@ -120,3 +120,46 @@ TEST(Noisy, BadInputNamesTheProblem) {
   EXPECT_THROW(noisy_frame(style.view(), style.view(), 1, fast(-1)), ValueError);
   EXPECT_THROW(noisy_frame(style.view(), style.view(), 1, fast(2), map.view()), ValueError);
 }
+
+TEST(Noisy, DihedralCopiesTurnAndMirror) {
+  const Image img = noise_image(5, 3, 2, 11);
+  const Image mirrored = dihedral_copy(img.view(), 1), turned = dihedral_copy(img.view(), 2);
+  EXPECT_EQ(turned.width(), 3);
+  EXPECT_EQ(turned.height(), 5);
+  for (int y = 0; y < 3; ++y)
+    for (int x = 0; x < 5; ++x) {
+      EXPECT_EQ(mirrored.at(4 - x, y, 1), img.at(x, y, 1));
+      EXPECT_EQ(turned.at(2 - y, x, 1), img.at(x, y, 1));  // a quarter turn clockwise
+    }
+  const Image round = dihedral_copy(dihedral_copy(img.view(), 6).view(), 2);  // 3 turns then 1
+  for (std::size_t i = 0; i < img.pixel_count() * 2; ++i) ASSERT_EQ(round.data()[i], img.data()[i]);
+}
+
+TEST(Noisy, RotationsAndReflectionsChangeTheFrameAndStayDeterministic) {
+  // A striped medium (stripes along x): with its turns and mirrors the source
+  // set also holds stripes along y, which the plain exemplar does not.
+  Image style(64, 64, 3);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x)
+      for (int c = 0; c < 3; ++c) style.at(x, y, c) = (y / 3) % 2 ? 0.9f : 0.1f + 0.1f * float((x * 7 + c) % 3);
+  const Image reference = dihedral_copy(Image::copy_of(style.view()).view(), 2);  // R with stripes along y
+  Image r(48, 40, 3);
+  for (int y = 0; y < 40; ++y)
+    for (int x = 0; x < 48; ++x)
+      for (int c = 0; c < 3; ++c) r.at(x, y, c) = reference.at(x + 4, y + 6, c);
+  NoisyOptions plain = fast(2.2f), turned = fast(2.2f);
+  turned.rotations = turned.reflections = true;
+  const Image a = noisy_frame(style.view(), r.view(), 4, plain), b = noisy_frame(style.view(), r.view(), 4, turned);
+  double diff = 0, err_a = 0, err_b = 0;
+  for (std::size_t i = 0; i < a.pixel_count() * 3; ++i) {
+    diff += std::abs(a.data()[i] - b.data()[i]);
+    err_a += std::abs(a.data()[i] - r.data()[i]);
+    err_b += std::abs(b.data()[i] - r.data()[i]);
+  }
+  EXPECT_GT(diff / (a.pixel_count() * 3), 0.01);
+  EXPECT_LT(err_b, err_a);  // the turned copies fit R's stripes
+  NoisyOptions one = turned;
+  one.synthesis.threads = 1;
+  const Image again = noisy_frame(style.view(), r.view(), 4, one);
+  for (std::size_t i = 0; i < b.pixel_count() * 3; ++i) ASSERT_EQ(again.data()[i], b.data()[i]);
+}

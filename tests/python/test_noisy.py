@@ -4,7 +4,7 @@ shapes stay, the MLS pre-deformation and the low-frequency term matter."""
 import numpy as np
 import pytest
 
-from tempera import noisy, temporal
+from tempera import noisy, synthesis, temporal
 
 FRAMES = 32  # a static R repeated 32 times, as in the issue
 
@@ -65,6 +65,39 @@ def test_without_deformation_there_is_less_noise(inputs, sweep):
     gives a floating texture, not noise."""
     rigid = run(inputs, 1.3, frames=12, deform=False)
     assert energy(rigid) < energy(sweep[1.3][:12])
+
+
+def patch_energy(image, style, w=7):
+    """The patch term of eq. 2 as the engine measures it: the mean squared
+    distance of image's w x w patches (every other one) to their nearest
+    patch of style, by brute force (independent of the engine's search)."""
+    def patches(a, step):
+        v = np.lib.stride_tricks.sliding_window_view(a, (w, w, a.shape[2]))[::step, ::step, 0]
+        return v.reshape(-1, w * w * a.shape[2]).astype(np.float32)
+
+    t, s = patches(image, 2), patches(style, 1)
+    d = (t * t).sum(1)[:, None] + (s * s).sum(1)[None, :] - 2 * t @ s.T
+    return float(np.maximum(d.min(1), 0).mean())
+
+
+def test_the_medium_is_kept(inputs):
+    """Medium kept: the finest-level energy of a noisy frame (its patches'
+    distance to the undeformed S) is at most 1.25x that of the same frame
+    without noise, R, here a plain synthesis of S (so R is the engine's
+    best fit of S at that size, as a coherent pass makes it). Measured
+    (docs/noisy.md): 1.24 at f = 1.3, 1.22 at 2.2 and 3.1; 4.3 gives 1.29
+    and is not asserted. An unsolved finest level (1 EM x 1 PM) gives 1.46."""
+    style, _ = inputs
+    reference, _ = synthesis.synthesize(style, target_shape=(48, 64), patch_size=7, threads=2, seed=3)
+    kept = patch_energy(reference, style)
+
+    def ratio(f, **kw):
+        return np.mean([patch_energy(noisy.noisy_frame(style, reference, i, noise=f, threads=2, **kw), style)
+                        for i in range(2)]) / kept
+
+    for f in (1.3, 2.2, 3.1):
+        assert ratio(f) <= 1.25, f
+    assert ratio(2.2, em_iterations=1, pm_iterations=1) > 1.25  # the test notices a finest level left unsolved
 
 
 def test_a_full_noise_map_changes_nothing(inputs):

@@ -19,6 +19,8 @@
 //    PatchMatch iterations at each pyramid level"), 7 x 7 patches,
 //    weighted-mode voting, no usage control (§4);
 //  - a fresh random seed per frame, mix(seed, frame), so reruns repeat;
+//  - optional rotations and reflections of P (eq. 1): the exemplar's dihedral
+//    copies join the source set as further exemplars;
 //  - a local noise map f_p (§3.3): pixel p joins the synthesis at the first
 //    level whose f_bar <= f_p and copies R before; f_p < 1 copies R outright.
 #include <cstdint>
@@ -36,6 +38,8 @@ struct NoisyOptions {
   float shift_min = 15, shift_max = 25;
   bool deform = true;          // the MLS pre-deformation (off only for the paper's ablation)
   float consistency = 2.75f;    // weight of the low-frequency term (eq. 2) as a guide pair
+  bool rotations = false;      // the exemplar's quarter turns join the source set (eq. 1: P "rotated")
+  bool reflections = false;    // its mirror images too (with rotations: all 8 dihedral copies)
   SynthesisOptions synthesis;  // patch 7, mode voting, 4 EM x 2 PM per level, usage none (noisy_defaults())
 };
 
@@ -52,7 +56,11 @@ inline const auto& noisy_option_table() {
       field(&N::shift_max, "shift_max", "shift-max", "largest move of an MLS lattice node, px at 1 Mpix (25)", 0, 10000),
       field(&N::deform, "deform", "deform", "pre-deform the exemplar every frame (off only for comparisons)"),
       field(&N::consistency, "consistency", "consistency",
-            "weight of the low-frequency term |h_f*R - h_f*T|^2: how firmly the large shapes stay R's (2.75)", 0, 1e6));
+            "weight of the low-frequency term |h_f*R - h_f*T|^2: how firmly the large shapes stay R's (2.75)", 0, 1e6),
+      field(&N::rotations, "rotations", "rotations",
+            "also copy patches from the exemplar turned by 90, 180 and 270 degrees (for media without a direction)"),
+      field(&N::reflections, "reflections", "reflections",
+            "also copy patches from the exemplar's mirror image (and its turns, with rotations)"));
   return table;
 }
 
@@ -72,6 +80,10 @@ std::uint64_t noisy_frame_seed(std::uint64_t seed, int frame);
 
 // The exemplar `style` deformed for frame `frame` (the MLS pre-deformation).
 Image deform_exemplar(const ImageView& style, const NoisyOptions& options, int frame);
+
+// The dihedral copy `k` of an image: bit 0 mirrors x, bits 1-2 count the
+// quarter turns clockwise after it (k = 0: the image itself).
+Image dihedral_copy(const ImageView& image, int k);
 
 // One noisy frame. `reference` is R_i (any size; the exemplar's channels);
 // `noise_map` (optional, R's size, 1 channel) holds f_p per pixel.
