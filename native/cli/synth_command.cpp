@@ -1,9 +1,9 @@
 // `tempera synth`: guided synthesis on image files, with options that people
 // who know ebsynth recognise.
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <optional>
+#include <sstream>
 
 #include "cli_args.hpp"
 #include "tempera/error.hpp"
@@ -11,6 +11,7 @@
 #include "tempera/patch_usage.hpp"
 #include "tempera/paths.hpp"
 #include "tempera/synthesis.hpp"
+#include "tempera/text_file.hpp"
 
 namespace tempera::cli {
 namespace {
@@ -57,7 +58,7 @@ Image read_input(const std::string& spec) {
 Image read_mask(const std::string& path) { return extract_channels(read_input(path).view(), 0, 1); }
 
 void write_stats(const std::string& path, const SynthesisResult& r, const SynthesisOptions& opt) {
-  std::ofstream out(path + ".tmp");
+  std::ostringstream out;
   out << "{\n  \"usage\": \"" << patch_usage_name(opt.usage) << "\",\n  \"seconds\": " << r.seconds
       << ",\n  \"source_coverage\": " << r.source_coverage << ",\n  \"guide_channels\": " << r.guide_channels
       << ",\n  \"kept_guide_variance\": " << r.kept_guide_variance << ",\n  \"levels\": [\n";
@@ -70,15 +71,7 @@ void write_stats(const std::string& path, const SynthesisResult& r, const Synthe
     out << "]}" << (i + 1 < r.levels.size() ? "," : "") << "\n";
   }
   out << "  ]\n}\n";
-  out.close();
-  if (!out) throw IoError(concat("cannot write stats file '", path, "'"));
-  std::error_code ec;
-  std::filesystem::rename(path + ".tmp", path, ec);
-  if (ec) {
-    const std::string why = ec.message();
-    std::filesystem::remove(path + ".tmp", ec);
-    throw IoError(concat("cannot move the stats file into place at '", path, "': ", why));
-  }
+  write_text_atomically(path, out.str(), "the stats file");
 }
 
 }  // namespace

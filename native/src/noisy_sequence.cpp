@@ -9,6 +9,7 @@
 #include "tempera/file_keys.hpp"
 #include "tempera/image_io.hpp"
 #include "tempera/stylit.hpp"
+#include "tempera/text_file.hpp"
 
 namespace fs = std::filesystem;
 
@@ -20,16 +21,6 @@ std::string read_text(const fs::path& path) {
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
-}
-
-void write_text_atomically(const fs::path& path, const std::string& text) {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp);
-    out << text;
-    if (!out) throw IoError(concat("cannot write '", tmp.string(), "'"));
-  }
-  fs::rename(tmp, path);
 }
 
 fs::path key_path(const std::string& out, int frame) {
@@ -112,7 +103,7 @@ NoisyFrameResult NoisySequence::run_frame(std::size_t index, const ProgressCallb
                                 progress);
   fs::create_directories(key_file.parent_path());
   write_image(result.path, out.view());  // atomic
-  write_text_atomically(key_file, k);
+  write_text_atomically(key_file.string(), k, "the resume key");
   result.status = "made";
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;

@@ -23,6 +23,7 @@
 #include "tempera/file_keys.hpp"
 #include "tempera/image_io.hpp"
 #include "tempera/paths.hpp"
+#include "tempera/text_file.hpp"
 
 namespace fs = std::filesystem;
 
@@ -207,32 +208,17 @@ std::map<int, ReportEntry> read_report(const std::string& path, std::vector<std:
 
 
 void write_report(const std::string& path, const std::string& settings, const std::map<int, ReportEntry>& entries) {
-  const fs::path target(path);
-  const fs::path temp = target.parent_path() / temporary_name(target.filename().string(), "");
-  {
-    std::ofstream out(temp);
-    out << "{\n  \"format\": " << json_string(kReportFormat) << ",\n  \"settings\": " << json_string(settings)
-        << ",\n  \"frames\": {";
-    std::size_t i = 0;
-    for (const auto& [frame, e] : entries)
-      out << (i++ ? ",\n" : "\n") << "    \"" << frame << "\": {\"key\": " << json_string(e.key)
-          << ", \"file\": " << json_string(e.file) << ", \"flicker\": " << json_number(e.flicker)
-          << ", \"source_coverage\": " << json_number(e.source_coverage) << ", \"size\": " << e.digest.size
-          << ", \"checksum\": " << json_string(e.digest.checksum) << "}";
-    out << "\n  }\n}\n";
-    if (!out) {
-      std::error_code ec;
-      fs::remove(temp, ec);
-      throw IoError(concat("cannot write the job report '", path, "'"));
-    }
-  }
-  std::error_code ec;
-  fs::rename(temp, target, ec);
-  if (ec) {
-    const std::string why = ec.message();  // before remove() resets ec ("...: Success")
-    fs::remove(temp, ec);
-    throw IoError(concat("cannot move the job report into place at '", path, "': ", why));
-  }
+  std::ostringstream out;
+  out << "{\n  \"format\": " << json_string(kReportFormat) << ",\n  \"settings\": " << json_string(settings)
+      << ",\n  \"frames\": {";
+  std::size_t i = 0;
+  for (const auto& [frame, e] : entries)
+    out << (i++ ? ",\n" : "\n") << "    \"" << frame << "\": {\"key\": " << json_string(e.key)
+        << ", \"file\": " << json_string(e.file) << ", \"flicker\": " << json_number(e.flicker)
+        << ", \"source_coverage\": " << json_number(e.source_coverage) << ", \"size\": " << e.digest.size
+        << ", \"checksum\": " << json_string(e.digest.checksum) << "}";
+  out << "\n  }\n}\n";
+  write_text_atomically(path, out.str(), "the job report");
 }
 
 // Temporary files (".<name>.tmp<pid>-<random>...") of writers killed with -9.

@@ -12,6 +12,7 @@
 #include "tempera/image_io.hpp"
 #include "tempera/option_table.hpp"
 #include "tempera/paths.hpp"
+#include "tempera/text_file.hpp"
 
 namespace fs = std::filesystem;
 
@@ -117,27 +118,6 @@ Image ink_distance(const ImageView& style, const TciaLineOptions& o) {
       ink.at(x, y, 0) = lum < o.ink ? 1.0f : 0.0f;
     }
   return line_distance(ink.view(), o.d_max);
-}
-
-void write_text_atomically(const std::string& path, const std::string& text) {
-  const fs::path target(path);
-  const fs::path temp = target.parent_path() / temporary_name(target.filename().string(), "");
-  {
-    std::ofstream out(temp);
-    out << text;
-    if (!out) {
-      std::error_code ec;
-      fs::remove(temp, ec);
-      throw IoError(concat("cannot write the segment record '", path, "'"));
-    }
-  }
-  std::error_code ec;
-  fs::rename(temp, target, ec);
-  if (ec) {
-    const std::string why = ec.message();
-    fs::remove(temp, ec);
-    throw IoError(concat("cannot move the segment record into place at '", path, "': ", why));
-  }
 }
 
 }  // namespace
@@ -332,7 +312,7 @@ SegmentResult TciaJob::run_segment(std::size_t index, const SegmentProgress& pro
     const FileDigest d = file_digest(path);
     record << fs::path(path).filename().string() << " " << d.size << " " << d.checksum << "\n";
   }
-  write_text_atomically(record_path(index), record.str());
+  write_text_atomically(record_path(index), record.str(), "the segment record");
   result.status = "stylized";
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;
