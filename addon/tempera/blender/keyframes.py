@@ -13,12 +13,12 @@ import os
 
 import bpy
 import numpy as np
-from bpy.props import BoolProperty, IntProperty, StringProperty
+from bpy.props import IntProperty
 from bpy.types import Operator, UIList
 
 from . import compat, results
 from .guide_operator import resolve_guide_dir
-from .kit_operators import IMAGE_GLOB
+from .kit_operators import ImageFileChooser
 
 LOW_CONTRAST = 0.4  # the render's tones squeezed around mid grey: a ground to paint on, not a picture
 
@@ -139,26 +139,17 @@ class TEMPERA_OT_add_keyframe(Operator):
         return {"FINISHED"}
 
 
-class TEMPERA_OT_import_keyframe(Operator):
+class TEMPERA_OT_import_keyframe(ImageFileChooser, Operator):
     """Register a keyframe painted elsewhere (the frame's size) for the current frame"""
 
     bl_idname = "tempera.import_keyframe"
     bl_label = "Import Key"
     bl_options = {"REGISTER", "UNDO"}
 
-    filepath: StringProperty(subtype="FILE_PATH", options={"SKIP_SAVE"})
     frame: IntProperty(name="Frame", default=-1, options={"SKIP_SAVE"}, description="-1: the current frame")
-    filter_image: BoolProperty(default=True, options={"HIDDEN", "SKIP_SAVE"})
-    filter_folder: BoolProperty(default=True, options={"HIDDEN", "SKIP_SAVE"})
-    filter_glob: StringProperty(default=IMAGE_GLOB, options={"HIDDEN", "SKIP_SAVE"})
-
-    def invoke(self, context, _event):
-        context.window_manager.fileselect_add(self)
-        return {"RUNNING_MODAL"}
 
     def execute(self, context):
-        if not os.path.isfile(self.filepath):
-            self.report({"ERROR"}, f"No key painting chosen ('{self.filepath}' is not a file)")
+        if not self.chosen("key painting"):
             return {"CANCELLED"}
         frame = context.scene.frame_current if self.frame < 0 else self.frame
         add_key(context.scene.tempera, frame, self.filepath)

@@ -51,12 +51,9 @@ def _kit_folder(settings):
     return os.path.join(output_dir(settings), KIT_FOLDER)
 
 
-class TEMPERA_OT_choose_painting(Operator):
-    """Choose your painted exemplar (image files only)"""
-
-    bl_idname = "tempera.choose_painting"
-    bl_label = "Choose Painting"
-    bl_options = {"REGISTER", "UNDO"}
+class ImageFileChooser:
+    """Mix-in of the operators that take one image file from the file browser
+    (image files only): invoke opens the browser, execute checks the choice."""
 
     filepath: StringProperty(subtype="FILE_PATH", options={"SKIP_SAVE"})
     filter_image: BoolProperty(default=True, options={"HIDDEN", "SKIP_SAVE"})
@@ -67,9 +64,23 @@ class TEMPERA_OT_choose_painting(Operator):
         context.window_manager.fileselect_add(self)
         return {"RUNNING_MODAL"}
 
+    def chosen(self, what):
+        """True if filepath is a file; else reports that no `what` was chosen."""
+        if os.path.isfile(self.filepath):
+            return True
+        self.report({"ERROR"}, f"No {what} chosen ('{self.filepath}' is not a file)")
+        return False
+
+
+class TEMPERA_OT_choose_painting(ImageFileChooser, Operator):
+    """Choose your painted exemplar (image files only)"""
+
+    bl_idname = "tempera.choose_painting"
+    bl_label = "Choose Painting"
+    bl_options = {"REGISTER", "UNDO"}
+
     def execute(self, context):
-        if not os.path.isfile(self.filepath):
-            self.report({"ERROR"}, f"No painting chosen ('{self.filepath}' is not a file)")
+        if not self.chosen("painting"):
             return {"CANCELLED"}
         settings = context.scene.tempera
         settings.exemplar_source = "CUSTOM"
@@ -118,7 +129,7 @@ class TEMPERA_OT_painting_template(Operator):
         return {"FINISHED"}
 
 
-class TEMPERA_OT_register_painting(Operator):
+class TEMPERA_OT_register_painting(ImageFileChooser, Operator):
     """Register a photo or scan of the painted template (made with Painting Template): it is aligned by
     its four marks and becomes the exemplar's painting (Exemplar is set to Custom)"""
 
@@ -126,16 +137,8 @@ class TEMPERA_OT_register_painting(Operator):
     bl_label = "Register Photo"
     bl_options = {"REGISTER", "UNDO"}
 
-    filepath: StringProperty(subtype="FILE_PATH", options={"SKIP_SAVE"})
-    filter_image: BoolProperty(default=True, options={"HIDDEN", "SKIP_SAVE"})
-    filter_folder: BoolProperty(default=True, options={"HIDDEN", "SKIP_SAVE"})
-    filter_glob: StringProperty(default=IMAGE_GLOB, options={"HIDDEN", "SKIP_SAVE"})
     flatten: BoolProperty(name="Even Out Lighting", default=True,
                           description="Divide by the paper's colour as photographed: even lighting, white paper")
-
-    def invoke(self, context, _event):
-        context.window_manager.fileselect_add(self)
-        return {"RUNNING_MODAL"}
 
     def execute(self, context):
         from ..painting_template import read_kit_json
