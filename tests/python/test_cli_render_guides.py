@@ -2,6 +2,7 @@
 rendered by the CLI through background Blender, without touching the file."""
 import hashlib
 import os
+import shutil
 import subprocess
 from pathlib import Path
 
@@ -152,3 +153,43 @@ def test_ctrl_c_keeps_the_finished_frames(cli_path, user_blend, tmp_path):
                           "--ld12e-samples", "2")
     assert again.returncode == 0 and f"{len(kept)} already current" in again.stdout, again.stdout[-1500:]
     assert not list(out.glob(".tempera-render-*"))
+
+
+# A library whose exit-time teardown crashes Blender: the state Blender is in
+# when the wheel's native module brought second copies of the libraries it
+# already loaded (their statics are destroyed twice at exit).
+CRASH_AT_EXIT_C = r"""
+#include <signal.h>
+#include <string.h>
+#include <unistd.h>
+__attribute__((destructor)) static void crash_at_exit(void) {
+  char exe[4096] = {0};
+  if (readlink("/proc/self/exe", exe, sizeof exe - 1) > 0 && strstr(exe, "blender")) raise(SIGSEGV);
+}
+"""
+
+
+@pytest.mark.skipif(shutil.which("cc") is None, reason="no C compiler")
+def test_blender_ends_without_the_libraries_teardown(cli_path, user_blend, tmp_path):
+    """The wheel farm's bug: Debian's Blender 3.4 died with SIGSEGV after
+    "Blender quit", in the teardown of libraries loaded twice, with every
+    guide written. The guide renderer ends Blender without that teardown,
+    and cleans up what Blender's quit would have (its session folder)."""
+    source = tmp_path / "crash_at_exit.c"
+    source.write_text(CRASH_AT_EXIT_C)
+    library = tmp_path / "crash_at_exit.so"
+    subprocess.run(["cc", "-shared", "-fPIC", "-o", str(library), str(source)], check=True)
+    private_tmp = tmp_path / "tmp"  # the system's temporary folder of this run alone (others share /tmp)
+    private_tmp.mkdir()
+    out = tmp_path / "g"
+    result = subprocess.run([str(cli_path), "render-guides", str(user_blend), "--frames", "1-2", "--out", str(out),
+                             "--samples", "2", "--ld12e-samples", "2"], capture_output=True, text=True, timeout=300,
+                            env=dict(os.environ, TEMPERA_BLENDER=BLENDER, TMPDIR=str(private_tmp),
+                                     LD_PRELOAD=str(library)))
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
+    assert "rendered 2 frame(s)" in result.stdout
+    assert "Saved:" in result.stdout  # Blender's own lines, still buffered in C when it ended, are kept
+    manifest = guide_cache.read_manifest(out)
+    for f in (1, 2):
+        assert guide_cache.is_frame_current(out, manifest, f, manifest["frames"][str(f)]["key"])
+    assert list(private_tmp.iterdir()) == []  # no session folder of Blender's left, no crash report

@@ -116,13 +116,12 @@ def test_killing_a_worker_mid_shot_loses_no_finished_frame(installed, tmp_path):
 
 
 @pytest.mark.skipif(shutil.which("blender") is None, reason="Blender not installed")
-@pytest.mark.xfail(strict=False, reason=(
-    "open bug found 2026-12-02: Debian's Blender 3.4 often segfaults while quitting after a guide chunk "
-    "(every guide already written) when two chunks of one .blend render at once; under investigation"))
 def test_farm_renders_guides_from_a_blend_in_chunks(installed, tmp_path):
     """The scene form: exemplar and guide chunks rendered by background Blender
     through the wheel's CLI, then the stylize chunks; the frames equal a
-    single-process stylize of the same guide caches."""
+    single-process stylize of the same guide caches. Blender 3.4 used to die
+    with SIGSEGV after "Blender quit" here (the wheel's libraries loaded beside
+    its own; tempera.blender.render_guides_main.quit_at_once)."""
     import tempera
 
     root = Path(__file__).resolve().parents[2]

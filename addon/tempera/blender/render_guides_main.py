@@ -7,8 +7,13 @@ message on any problem. The .blend on disk is never written.
         -- --frames 1-24 --out DIR [--scene NAME] [--samples N] [--lpe EXPR ...] ...
 """
 import argparse
+import ctypes
+import os
+import shutil
 import sys
 import time
+import traceback
+from pathlib import Path
 
 import bpy
 
@@ -50,8 +55,23 @@ def parse_args(argv):
 
 
 def main():
+    """Renders the guides, then ends Blender at once with the exit status of
+    the run (see quit_at_once)."""
+    try:
+        status = render()
+    except Exception:  # a bug: said as Blender says it, and the status --python-exit-code 1 gives
+        traceback.print_exc()
+        status = 1
+    quit_at_once(status)
+
+
+def render():
+    """The run; returns its exit status (0, or EXIT_* after the error line)."""
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-    args = parse_args(argv)
+    try:
+        args = parse_args(argv)
+    except SystemExit as exc:  # argparse: --help (0) or a bad option, after the usage line (2)
+        return exc.code if isinstance(exc.code, int) else EXIT_BAD_VALUE
     try:
         frames = parse_frames(args.frames)
         scene = bpy.data.scenes.get(args.scene) if args.scene else bpy.context.scene
@@ -73,13 +93,36 @@ def main():
             print(f"tempera render-guides: warning: {warning}", flush=True)
     except (GuideRenderError, ValueError) as exc:
         print(f"tempera render-guides: error: {exc}", file=sys.stderr, flush=True)
-        sys.exit(EXIT_BAD_VALUE)
+        return EXIT_BAD_VALUE
     except OSError as exc:
         print(f"tempera render-guides: error: {exc}", file=sys.stderr, flush=True)
-        sys.exit(EXIT_FILE_ERROR)
+        return EXIT_FILE_ERROR
     except KeyboardInterrupt:
         print("tempera render-guides: interrupted; the frames finished so far are in the cache, rerun the same "
               "command to render the rest", file=sys.stderr, flush=True)
-        sys.exit(EXIT_INTERRUPTED)
+        return EXIT_INTERRUPTED
     print(f"tempera render-guides: rendered {len(report['rendered'])} frame(s), "
           f"{len(report['skipped'])} already current; manifest {report['manifest']}", flush=True)
+    return 0
+
+
+def quit_at_once(status):
+    """Ends this Blender with `status` without running the shared libraries'
+    exit-time destructors, once every file is written and closed.
+
+    The wheel's native module brings its own copies (hashed sonames) of
+    OpenImageIO and its ~230 dependencies into a Blender that already loaded
+    the system's (Debian's Blender 3.4: gdcm, gnutls, OpenEXR, TBB, ...).
+    Symbol interposition binds both copies' static objects to one of them,
+    so at exit they are destroyed twice and Blender often dies with SIGSEGV
+    after "Blender quit" (tests/wheel/test_dask_farm.py, two chunks at a
+    time). Blender's own quit does nothing else for a background run that
+    never saves: it removes its session temporary folder, done here too.
+    """
+    sys.stdout.flush()
+    sys.stderr.flush()
+    ctypes.CDLL(None).fflush(None)  # Blender's own printf lines (render stats) still in C's buffers
+    session = Path(bpy.app.tempdir)
+    if session.name.startswith("blender_"):  # its own mkdtemp folder, never the system's /tmp it falls back to
+        shutil.rmtree(session, ignore_errors=True)
+    os._exit(status)
