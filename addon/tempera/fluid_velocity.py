@@ -242,39 +242,81 @@ def _matrix(name, matrix):
     return m
 
 
-def gas_domain_samples(velocity_grid, density_grid, resolution, bounds_min, bounds_max, matrix_world,
-                       fps, time_scale=1.0):
-    """(points, velocities per frame, weights) of a Mantaflow gas domain's
-    voxels, all in world space.
+class DomainGrid:
+    """A Mantaflow domain's grid: resolution (X, Y, Z), its corners in the
+    domain object's space, the object's matrix_world, and the length of a
+    frame in Mantaflow time units (2.5 * time_scale / fps,
+    MANTAFLOW_TIME_UNITS_PER_SECOND)."""
 
-    velocity_grid: 3 * X * Y * Z floats (x fastest, as Blender's
-    FluidDomainSettings.velocity_grid), in cells per Mantaflow time unit;
-    density_grid: X * Y * Z floats; resolution: (X, Y, Z); bounds_min/max:
-    the corners of the grid in the domain object's space; matrix_world: the
-    domain object's. A frame is 2.5 * time_scale / fps time units
-    (MANTAFLOW_TIME_UNITS_PER_SECOND), a cell is (bounds_max - bounds_min) /
-    resolution in object space."""
-    res = np.asarray(resolution, np.int64)
-    if res.shape != (3,) or np.any(res < 1):
-        raise ValueError(f"resolution must be 3 positive whole numbers, got {resolution!r}")
-    count = int(np.prod(res))
-    vel = np.asarray(velocity_grid, np.float64).reshape(-1)
+    def __init__(self, resolution, bounds_min, bounds_max, matrix_world, fps, time_scale=1.0):
+        self.res = np.asarray(resolution, np.int64)
+        if self.res.shape != (3,) or np.any(self.res < 1):
+            raise ValueError(f"resolution must be 3 positive whole numbers, got {resolution!r}")
+        self.matrix = _matrix("matrix_world", matrix_world)
+        self.low, high = np.asarray(bounds_min, np.float64), np.asarray(bounds_max, np.float64)
+        if self.low.shape != (3,) or high.shape != (3,) or np.any(high <= self.low):
+            raise ValueError(f"bounds must be two 3D corners with min < max, got {bounds_min!r}, {bounds_max!r}")
+        self.cell = (high - self.low) / self.res
+        self.frame_length = (MANTAFLOW_TIME_UNITS_PER_SECOND * _positive("time_scale", time_scale)
+                             / _positive("fps (frames per second)", fps))
+
+    def count(self):
+        return int(np.prod(self.res))
+
+    def velocities(self, velocity_grid):
+        """The grid's velocities (X * Y * Z, 3), x fastest, as object-space displacements per frame."""
+        vel = np.asarray(velocity_grid, np.float64).reshape(-1)
+        if vel.size != 3 * self.count():
+            raise ValueError(f"a {' x '.join(map(str, self.res))} grid needs {3 * self.count()} velocity values, "
+                             f"got {vel.size}")
+        return vel.reshape(-1, 3) * self.cell * self.frame_length
+
+    def voxel_centres(self):
+        """Object-space voxel centres (X * Y * Z, 3), x fastest."""
+        z, y, x = np.meshgrid(*(np.arange(n) for n in self.res[::-1]), indexing="ij")
+        return self.low + (np.stack([x, y, z], axis=-1).reshape(-1, 3) + 0.5) * self.cell
+
+    def sample(self, field, local_points):
+        """Trilinear interpolation of a per-voxel field (X * Y * Z, C) at
+        object-space points (N, 3), clamped to the voxel centres."""
+        grid = np.asarray(field).reshape(self.res[2], self.res[1], self.res[0], -1)
+        index = np.clip((local_points - self.low) / self.cell - 0.5, 0, self.res - 1)
+        i0 = np.minimum(np.floor(index).astype(np.int64), self.res - 1)
+        i1, t = np.minimum(i0 + 1, self.res - 1), index - i0
+        out = np.zeros((len(local_points), grid.shape[3]))
+        for corner in range(8):
+            pick = [(corner >> axis) & 1 for axis in range(3)]
+            ix, iy, iz = (np.where(pick[a], i1[:, a], i0[:, a]) for a in range(3))
+            share = np.prod([np.where(pick[a], t[:, a], 1 - t[:, a]) for a in range(3)], axis=0)
+            out += share[:, None] * grid[iz, iy, ix]
+        return out
+
+    def to_world(self, local_points, local_velocities):
+        m = self.matrix
+        return local_points @ m[:3, :3].T + m[:3, 3], local_velocities @ m[:3, :3].T
+
+
+def gas_domain_samples(velocity_grid, density_grid, grid):
+    """(points, velocities per frame, weights) of a Mantaflow gas domain's
+    voxels (DomainGrid `grid`), all in world space. velocity_grid: 3 * X * Y
+    * Z floats (x fastest, as Blender's FluidDomainSettings.velocity_grid), in
+    cells per Mantaflow time unit; density_grid: X * Y * Z floats."""
     dens = np.asarray(density_grid, np.float64).reshape(-1)
-    if vel.size != 3 * count or dens.size != count:
-        raise ValueError(f"a {res[0]} x {res[1]} x {res[2]} grid needs {3 * count} velocity and {count} density "
-                         f"values, got {vel.size} and {dens.size}")
-    m = _matrix("matrix_world", matrix_world)
-    low, high = np.asarray(bounds_min, np.float64), np.asarray(bounds_max, np.float64)
-    if low.shape != (3,) or high.shape != (3,) or np.any(high <= low):
-        raise ValueError(f"bounds must be two 3D corners with min < max, got {bounds_min!r}, {bounds_max!r}")
-    cell = (high - low) / res
-    z, y, x = np.meshgrid(*(np.arange(n) for n in res[::-1]), indexing="ij")
-    local = low + (np.stack([x, y, z], axis=-1).reshape(-1, 3) + 0.5) * cell
-    frame_length = (MANTAFLOW_TIME_UNITS_PER_SECOND * _positive("time_scale", time_scale)
-                    / _positive("fps (frames per second)", fps))
-    local_velocity = vel.reshape(-1, 3) * cell * frame_length  # object space, per frame
-    points = local @ m[:3, :3].T + m[:3, 3]
-    return points, local_velocity @ m[:3, :3].T, np.maximum(np.nan_to_num(dens), 0.0)
+    if dens.size != grid.count():
+        raise ValueError(f"a {' x '.join(map(str, grid.res))} grid needs {grid.count()} density values, "
+                         f"got {dens.size}")
+    points, velocities = grid.to_world(grid.voxel_centres(), grid.velocities(velocity_grid))
+    return points, velocities, np.maximum(np.nan_to_num(dens), 0.0)
+
+
+def liquid_grid_samples(vertices, velocity_grid, grid):
+    """(points, velocities per frame, weights of 1) of a liquid mesh's
+    vertices (N, 3, object space) moving with the domain's velocity grid
+    (interpolated at each vertex): what a baked cache gives, whose liquid
+    mesh reads back with a velocity attribute of zeros (Blender 3.4 writes no
+    mesh velocity files)."""
+    v = _array("vertices", vertices, (3,))
+    return (*grid.to_world(v, grid.sample(grid.velocities(velocity_grid), v)), np.ones(len(v)))
 
 
 def mesh_samples(vertices, velocity, matrix_world, domain_size, fps, time_scale=1.0):
