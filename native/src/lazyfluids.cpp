@@ -199,35 +199,28 @@ Image motion_blur_along_flow(const ImageView& image, const ImageView& flow, floa
   return out;
 }
 
-FluidFrameResult stylize_fluid_frame(const FluidFrameInput& in, const LazyFluidsOptions& o,
-                                     const ProgressCallback& progress) {
-  validate(o);
+namespace {
+
+void check_frame_input(const FluidFrameInput& in) {
   require_channels(in.style, 4, "exemplar (RGBA)");
   require_channels(in.previous_style, 4, "previous exemplar frame (RGBA)");
   require_same_size(in.style, "exemplar", in.previous_style, "previous exemplar frame");
   require_channels(in.target_alpha, 1, "target alpha");
-  const bool temporal = !in.advected.empty() && o.temporal_weight > 0;
   if (!in.advected.empty()) require_same_size(in.target_alpha, "target alpha", in.advected, "advected previous frame");
+}
 
-  FluidFrameResult result;
-  const AlphaSegments target = alpha_segments(in.target_alpha, segment_options(o));
-  result.target_labels = target.labels;
-  result.temporal_weights = temporal ? temporal_weights(in.target_alpha, in.advected, o.temporal_weight)
-                                     : Image(in.target_alpha.width, in.target_alpha.height, 1, 0.0f);
-  const bool any_target = std::any_of(target.inside.data(), target.inside.data() + target.inside.pixel_count(),
-                                      [](float v) { return v > 0.5f; });
-  if (!any_target) {  // nothing to synthesize: a transparent frame
-    result.image = Image(in.target_alpha.width, in.target_alpha.height, 4, 0.0f);
-    return result;
-  }
-
-  std::deque<Image> keep;
+// Eq. 5.9 on the engine: the RGBA style, the blurred-alpha guide (η), the
+// temporal guide weighted by λ_q, segments and masks; rotated copies of the
+// exemplar as further sources. Images it makes live in `keep`.
+SynthesisInput fluid_synthesis_input(const FluidFrameInput& in, const AlphaSegments& target,
+                                     const FluidFrameResult& result, bool temporal, const LazyFluidsOptions& o,
+                                     std::deque<Image>& keep) {
   const Exemplar main = source_exemplar(in.style, in.previous_style, temporal, o, 0, keep);
-  const Image advected = temporal ? scale_alpha(in.advected, std::sqrt(o.alpha_weight)) : Image();
   SynthesisInput si;
   si.style = main.style;
   si.guides.add("blurred_alpha", main.guides[0], target.blurred.view(), o.alpha_guide_weight);
   if (temporal) {
+    const Image& advected = keep.emplace_back(scale_alpha(in.advected, std::sqrt(o.alpha_weight)));
     si.guides.add("advected_previous", main.guides[1], advected.view(), 1.0f);
     si.target_weight_maps = {ImageView{}, result.temporal_weights.view()};
   }
@@ -238,7 +231,28 @@ FluidFrameResult stylize_fluid_frame(const FluidFrameInput& in, const LazyFluids
   if (o.rotations)
     for (int turns = 1; turns < 4; ++turns)
       si.exemplars.push_back(source_exemplar(in.style, in.previous_style, temporal, o, turns, keep));
+  return si;
+}
 
+}  // namespace
+
+FluidFrameResult stylize_fluid_frame(const FluidFrameInput& in, const LazyFluidsOptions& o,
+                                     const ProgressCallback& progress) {
+  validate(o);
+  check_frame_input(in);
+  const bool temporal = !in.advected.empty() && o.temporal_weight > 0;
+  FluidFrameResult result;
+  const AlphaSegments target = alpha_segments(in.target_alpha, segment_options(o));
+  result.target_labels = target.labels;
+  result.temporal_weights = temporal ? temporal_weights(in.target_alpha, in.advected, o.temporal_weight)
+                                     : Image(in.target_alpha.width, in.target_alpha.height, 1, 0.0f);
+  result.image = Image(in.target_alpha.width, in.target_alpha.height, 4, 0.0f);
+  const float* inside = target.inside.data();
+  if (std::none_of(inside, inside + target.inside.pixel_count(), [](float v) { return v > 0.5f; }))
+    return result;  // nothing to synthesize: a transparent frame
+
+  std::deque<Image> keep;
+  const SynthesisInput si = fluid_synthesis_input(in, target, result, temporal, o, keep);
   SynthesisOptions engine = o.synthesis;
   engine.style_channel_weights.resize(4, 1.0f);  // alpha_weight owns the alpha channel's
   engine.style_channel_weights[kAlpha] = o.alpha_weight;

@@ -188,25 +188,31 @@ FrameResult LazyFluidsJob::run_frame(std::size_t index, const ProgressCallback& 
     return result;
   }
   const auto t0 = std::chrono::steady_clock::now();
-  const std::size_t m = exemplar_.size();
   const Image alpha = Image::copy_of(GuideFrame::read(guide_path(f), {"alpha"}).get("alpha").view());
+  // The exact float state, never the 8-bit output: resumed == uninterrupted.
+  const Image advected = index == 0 ? Image() : advect_output(read_image(state_path(f - 1)).view(), read_flow(f - 1).view());
+  const std::size_t m = exemplar_.size();
   FluidFrameInput in;
   in.style = exemplar_[index % m].view();
   in.previous_style = exemplar_[index == 0 ? 0 : (index - 1) % m].view();
   in.target_alpha = alpha.view();
-  Image advected;
-  if (index > 0) {
-    // The exact float state, never the 8-bit output: resumed == uninterrupted.
-    const Image previous = read_image(state_path(f - 1));
-    advected = advect_output(previous.view(), read_flow(f - 1).view());
-    in.advected = advected.view();
-  }
+  if (index > 0) in.advected = advected.view();
   const FluidFrameResult frame = stylize_fluid_frame(in, config_.options, progress);
-  const Image output = config_.options.motion_blur > 0
-                           ? motion_blur_along_flow(frame.image.view(), read_flow(f).view(), config_.options.motion_blur)
-                           : Image::copy_of(frame.image.view());
-  write_image(state_path(f), frame.image.view());  // atomic, float
-  write_image(output_path(f), output.view());
+  write_frame(index, frame.image);
+  result.status = "stylized";
+  result.source_coverage = frame.synthesis.source_coverage;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return result;
+}
+
+// The state, the output (motion-blurred when asked) and then the record,
+// each atomically: a crash leaves either no record or a matching one.
+void LazyFluidsJob::write_frame(std::size_t index, const Image& state) const {
+  const int f = config_.frames[index];
+  const float blur = config_.options.motion_blur;
+  const Image output = blur > 0 ? motion_blur_along_flow(state.view(), read_flow(f).view(), blur) : Image();
+  write_image(state_path(f), state.view());
+  write_image(output_path(f), blur > 0 ? output.view() : state.view());
   std::ostringstream record;
   record << kRecordFormat << "\n" << frame_key(index) << "\n";
   for (const std::string& path : {output_path(f), state_path(f)}) {
@@ -214,10 +220,6 @@ FrameResult LazyFluidsJob::run_frame(std::size_t index, const ProgressCallback& 
     record << d.size << " " << d.checksum << "\n";
   }
   write_text_atomically(record_path(f), record.str(), "the frame record");
-  result.status = "stylized";
-  result.source_coverage = frame.synthesis.source_coverage;
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return result;
 }
 
 void LazyFluidsJob::write_contact_sheet(const std::string& path, int columns) const {

@@ -53,6 +53,7 @@ class LazyFluidsJob {
   std::string frame_key(std::size_t index) const;
   bool is_current(std::size_t index) const;
   Image read_flow(int frame) const;
+  void write_frame(std::size_t index, const Image& state) const;
 
   LazyFluidsJobConfig config_;
   std::vector<std::string> warnings_, exemplar_files_;
