@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <chrono>
 #include <deque>
 
 #include "tempera/error.hpp"
 #include "tempera/patch_distance.hpp"  // sample_bilinear
 #include "tempera/pyramid.hpp"
+#include "tempera/solver.hpp"
 
 namespace tempera {
 
@@ -234,6 +236,30 @@ SynthesisInput fluid_synthesis_input(const FluidFrameInput& in, const AlphaSegme
   return si;
 }
 
+// The engine's coarse-to-fine solve, or with a warm start only the finest
+// level from the previous frame's field advected along F^{t-1} (the
+// semi-Lagrangian stand-in for V-, as for the advected output).
+SynthesisResult solve(const SynthesisInput& si, const SynthesisOptions& engine, const FluidFrameInput& in,
+                      bool warm, const ProgressCallback& progress) {
+  if (!warm) return synthesize(si, engine, progress);
+  const auto t0 = std::chrono::steady_clock::now();
+  const Solver solver(si, engine);
+  if (in.previous_field->width != in.target_alpha.width || in.previous_field->height != in.target_alpha.height)
+    throw ValueError(concat("the previous frame's field is ", in.previous_field->width, "x", in.previous_field->height,
+                            " but the target alpha is ", in.target_alpha.width, "x", in.target_alpha.height));
+  const OffsetField start = solver.advect(*in.previous_field, 0, in.flow_previous);
+  LevelResult level = solver.solve_level(0, {&start}, progress);
+  SynthesisResult r;
+  r.image = std::move(level.image);
+  r.field = std::move(level.field);
+  r.layout = solver.layout(0);
+  r.source_coverage = level.stats.source_coverage;
+  r.levels = {level.stats};
+  r.guide_channels = solver.guide_channels();
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
 }  // namespace
 
 FluidFrameResult stylize_fluid_frame(const FluidFrameInput& in, const LazyFluidsOptions& o,
@@ -257,7 +283,9 @@ FluidFrameResult stylize_fluid_frame(const FluidFrameInput& in, const LazyFluids
   engine.style_channel_weights.resize(4, 1.0f);  // alpha_weight owns the alpha channel's
   engine.style_channel_weights[kAlpha] = o.alpha_weight;
   engine.levels = fluid_levels(alpha_segments(channel(in.style, kAlpha).view(), segment_options(o)), target, engine);
-  result.synthesis = synthesize(si, engine, progress);
+  const bool warm = o.warm_start && in.previous_field && !in.previous_field->x.empty();
+  if (warm) require_channels(in.flow_previous, 2, "previous flow");
+  result.synthesis = solve(si, engine, in, warm, progress);
   result.image = Image::copy_of(result.synthesis.image.view());
   clear_outside(result.image, target.labels);
   return result;
@@ -273,6 +301,7 @@ std::vector<Image> stylize_fluid_sequence(const std::vector<ImageView>& exemplar
     throw ValueError(concat(alphas.size(), " target alpha frames but ", flows.size(), " flow frames"));
   const std::size_t n = alphas.size(), m = exemplar.size();
   std::vector<Image> raw, out;
+  OffsetField previous_field;
   for (std::size_t t = 0; t < n; ++t) {
     require_same_size(alphas[t], concat("target alpha ", t).c_str(), flows[t], concat("flow ", t).c_str());
     FluidFrameInput in;
@@ -281,8 +310,11 @@ std::vector<Image> stylize_fluid_sequence(const std::vector<ImageView>& exemplar
     in.target_alpha = alphas[t];
     const Image advected = t == 0 ? Image() : advect_output(raw.back().view(), flows[t - 1]);
     in.advected = advected.empty() ? ImageView{} : advected.view();
+    if (t > 0) in.previous_field = &previous_field, in.flow_previous = flows[t - 1];
     auto report = [&](double f) { return !progress || progress((double(t) + f) / double(n)); };
-    raw.push_back(std::move(stylize_fluid_frame(in, o, report).image));
+    FluidFrameResult frame = stylize_fluid_frame(in, o, report);
+    previous_field = std::move(frame.synthesis.field);
+    raw.push_back(std::move(frame.image));
     out.push_back(motion_blur_along_flow(raw.back().view(), flows[t], o.motion_blur));
   }
   return out;

@@ -346,6 +346,39 @@ TEST(LazyFluids, TemporalTermHalvesTheWarpErrorAndTransportsAtTheFlowSpeed) {
   EXPECT_EQ(carried, 0);  // λ = 0: nothing carries the texture
 }
 
+// The warm start solves only the finest level from the advected field: the
+// texture must still be carried at the flow speed, every segment's usage
+// stay K or K+1, and the warp error stay near the cold start's.
+TEST(LazyFluids, WarmStartKeepsTransportUsageAndCoherence) {
+  const Image exemplar = smoke_exemplar(24, 4);
+  const int w = 72, h = 40, n = 6;
+  const Image flow = constant_flow(w, h, 2, 0), still = disc(w, h, 35.5f, 19.5f, 17);
+  const std::vector<ImageView> s(std::size_t(n), still.view()), f(std::size_t(n), flow.view());
+  const std::vector<Image> alphas(std::size_t(n), still);
+  LazyFluidsOptions o = test_options();
+  const auto cold = stylize_fluid_sequence({exemplar.view()}, s, f, o);
+  o.warm_start = true;
+  const auto warm = stylize_fluid_sequence({exemplar.view()}, s, f, o);
+  for (int t = 1; t < n; ++t) EXPECT_NEAR(phase_correlation_shift(warm[t - 1], warm[t]).first, 2.0, 0.5) << t;
+  const double e_cold = warp_error(cold, alphas, flow), e_warm = warp_error(warm, alphas, flow);
+  RecordProperty("warp_error_cold", std::to_string(e_cold));
+  RecordProperty("warp_error_warm", std::to_string(e_warm));
+  EXPECT_LE(e_warm, 1.25 * e_cold);
+  // One warm frame by itself: the usage rule still holds.
+  OffsetField previous;
+  FluidFrameInput in;
+  in.style = in.previous_style = exemplar.view();
+  in.target_alpha = still.view();
+  previous = stylize_fluid_frame(in, o).synthesis.field;
+  const Image advected = advect_output(cold[0].view(), flow.view());
+  in.advected = advected.view();
+  in.previous_field = &previous;
+  in.flow_previous = flow.view();
+  const FluidFrameResult r = stylize_fluid_frame(in, o);
+  ASSERT_EQ(r.synthesis.levels.size(), 1u);  // the finest level only
+  for (const UsageCheck& c : check_usage(exemplar, r, 2)) EXPECT_TRUE(c.counts_ok && c.remainder_ok);
+}
+
 TEST(LazyFluids, RejectsBadInputWithClearErrors) {
   const Image exemplar = smoke_exemplar(20, 5);
   FluidFrameInput in;
