@@ -25,7 +25,7 @@ LazyFluidsOptions = _native.LazyFluidsOptions
 def options(**values) -> "LazyFluidsOptions":
     """LazyFluidsOptions from keywords: its own (temporal_weight λ,
     alpha_guide_weight η, alpha_weight, alpha_radius, alpha_lower,
-    alpha_upper, rotations, motion_blur) and engine options (SynthesisOptions
+    alpha_upper, rotations, motion_blur, warm_start) and engine options (SynthesisOptions
     names, from the method's defaults: 5 x 5 patches, uniform usage)."""
     return method_options(LazyFluidsOptions, _native.lazyfluids_defaults(), values, "lazyfluids")
 

@@ -138,7 +138,7 @@ def stylize(cli_path, *args):
 
 def test_cli_runs_resumes_and_rejects_bad_input(cli_path, cache):
     base = ("--guides", cache / "cache", "--exemplar", cache / "smoke.png", "--frames", "1-2", "--out", cache / "cli",
-            "--em-iters", "2", "--motion-blur", "3", "--rotations")
+            "--em-iters", "2", "--motion-blur", "3", "--rotations", "--warm-start")
     first = stylize(cli_path, *base)
     assert first.returncode == 0, first.stderr
     assert (cache / "cli" / "frames" / "frame_0002.png").is_file() and (cache / "cli" / "contact_sheet.png").is_file()
