@@ -89,30 +89,33 @@ Image diffuse_fill(const ImageView& values, const ImageView& known, const ImageV
   // Red-black successive over-relaxation with the optimal factor for the
   // mask's extent (Young): converges in about that many sweeps where plain
   // Jacobi would need its square. Neighbours outside the mask are left out
-  // (a zero-flux border). Each colour's updates read only the other colour:
-  // deterministic for any thread count.
+  // (a zero-flux border). One thread per fill (flow_from_masks runs frames
+  // in parallel), in a fixed order: deterministic.
   const int extent = std::max(w, h);
   const float omega = 2.0f / (1.0f + std::sin(3.14159265f / float(extent)));
   const int sweeps = std::min(kMaxSweeps, extent + 20);
+  std::vector<std::size_t> free[2];  // the unknown inside pixels, by colour
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = std::size_t(y) * w + x;
+      if (inside(mask, i) && k.data()[i] <= 0) free[(x + y) % 2].push_back(i);
+    }
   for (int sweep = 0; sweep < sweeps; ++sweep)
-    for (int colour = 0; colour < 2; ++colour)
-      parallel_for(h, 1, [&](int y) {  // one thread: flow_from_masks runs frames in parallel
-        for (int x = (y + colour) % 2; x < w; x += 2) {
-          const std::size_t i = std::size_t(y) * w + x;
-          if (!inside(mask, i) || k.data()[i] > 0) continue;
-          float sum[2] = {0, 0};
-          int n = 0;
-          const int nb[4][2] = {{x - 1, y}, {x + 1, y}, {x, y - 1}, {x, y + 1}};
-          for (const auto& q : nb) {
-            if (q[0] < 0 || q[1] < 0 || q[0] >= w || q[1] >= h) continue;
-            const std::size_t j = std::size_t(q[1]) * w + q[0];
-            if (!inside(mask, j)) continue;
-            sum[0] += cur.data()[2 * j], sum[1] += cur.data()[2 * j + 1], ++n;
-          }
-          if (!n) continue;
-          for (int c = 0; c < 2; ++c) cur.data()[2 * i + c] += omega * (sum[c] / n - cur.data()[2 * i + c]);
+    for (const auto& pixels : free)
+      for (std::size_t i : pixels) {
+        const int x = int(i % std::size_t(w)), y = int(i / std::size_t(w));
+        float sum[2] = {0, 0};
+        int n = 0;
+        const int nb[4][2] = {{x - 1, y}, {x + 1, y}, {x, y - 1}, {x, y + 1}};
+        for (const auto& q : nb) {
+          if (q[0] < 0 || q[1] < 0 || q[0] >= w || q[1] >= h) continue;
+          const std::size_t j = std::size_t(q[1]) * w + q[0];
+          if (!inside(mask, j)) continue;
+          sum[0] += cur.data()[2 * j], sum[1] += cur.data()[2 * j + 1], ++n;
         }
-      });
+        if (!n) continue;
+        for (int c = 0; c < 2; ++c) cur.data()[2 * i + c] += omega * (sum[c] / n - cur.data()[2 * i + c]);
+      }
   for (std::size_t i = 0; i < mask.pixel_count(); ++i)
     if (!inside(mask, i)) cur.data()[2 * i] = cur.data()[2 * i + 1] = 0;
   return cur;

@@ -323,6 +323,27 @@ TEST(Fluidymation, TemporalTermKeepsFramesCloser) {
   EXPECT_LT(difference(coherent[2].image, coherent[1].image), difference(alone.image, coherent[1].image));
 }
 
+// m(q) as printed (smoothstep of the distance mismatch) switches the
+// temporal term off wherever the match keeps pace with the target's
+// boundary, i.e. almost everywhere; 1 - m keeps it there and releases only
+// the lagging pixels. So the default, release, flickers less.
+TEST(Fluidymation, ReleaseModulationFlickersLessThanAsPrinted) {
+  const SmallShot shot;
+  auto flicker = [&](TemporalModulation m) {
+    FluidymationOptions o = small_options();
+    o.modulation = m;
+    const std::vector<FluidFrame> f = stylize_fluid_sequence(shot.seq(), o);
+    double sum = 0;
+    int n = 0;
+    for (std::size_t j = 1; j < f.size(); ++j)
+      for (std::size_t q = 0; q < f[j].image.pixel_count(); ++q)
+        if (shot.target[j - 1].data()[q] > 0.5f)
+          for (int c = 0; c < 3; ++c) sum += std::abs(f[j].image.data()[3 * q + c] - f[j - 1].image.data()[3 * q + c]), ++n;
+    return sum / n;
+  };
+  EXPECT_LT(flicker(TemporalModulation::Release), flicker(TemporalModulation::Printed));
+}
+
 TEST(Fluidymation, BadInputIsAValueError) {
   const SmallShot shot;
   FluidSequence s = shot.seq();
