@@ -115,6 +115,9 @@ def test_media_job_runs_earlier_frames_first_and_rejects_bad_input(tmp_path):
     assert not job.flow_from_guides
     assert job.run_frame(2)["status"] == "stylized"
     assert job.run_frame(0)["status"] == "skipped"
+    both = fluidymation.MediaJob(exemplar, cache, [1, 2, 3], tmp_path / "both", bidirectional=True, **FAST)
+    assert [both.run_frame(i)["status"] for i in range(3)] == ["stylized"] * 3
+    assert np.allclose(read_image(both.output_path(3))[..., 3], disc(7 + 3.0), atol=1 / 255)
     with pytest.raises(ValueError, match="consecutive"):
         fluidymation.MediaJob(exemplar, cache, [1, 3], tmp_path / "bad")
     with pytest.raises(ValueError, match="mask.OB_Nope"):
