@@ -7,6 +7,7 @@ import pytest
 
 import tempera
 from tempera import fluidymation, guide_cache, read_image, write_image
+from conftest import assert_releases_gil
 
 SIZE = 40
 
@@ -60,6 +61,13 @@ def test_stylize_sequence_paints_inside_the_masks_only():
         assert f["image"][target > 0.5].mean() > 0.2
         assert np.all(f["nnf"][target <= 0.5, 0] == -1)
     assert np.all(frames[0]["time_shift"] == 0)
+
+
+def test_the_solve_releases_the_gil():
+    ex = ink_frames()
+    targets = [disc(7 + 1.5 * j) for j in range(3)]
+    assert_releases_gil(lambda: fluidymation.stylize_sequence([e[..., :3] for e in ex], [e[..., 3] for e in ex],
+                                                              targets, em_iterations=12, **FAST))
 
 
 def test_bad_values_are_value_errors():
