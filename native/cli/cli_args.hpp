@@ -24,6 +24,10 @@ class ArgReader {
     if (f.rfind("--", 0) != 0) throw ValueError(concat("unexpected argument '", f, "'"));
     return f;
   }
+  // The next argument if it is not a flag (an optional value), else null.
+  const std::string* optional_value() const {
+    return pos_ < args_.size() && args_[pos_].rfind("--", 0) != 0 ? &args_[pos_] : nullptr;
+  }
   std::string value(const std::string& flag) {
     if (pos_ >= args_.size()) throw ValueError(concat(flag, " needs a value"));
     return args_[pos_++];
@@ -51,6 +55,9 @@ int run_noisy(const Args& args);
 // `stylize --method fluidymation` (fluidymation_command.cpp).
 bool wants_fluidymation(const Args& args);
 int run_stylize_fluidymation(const Args& args);
+// `tempera stylize --method lazyfluids` (lazyfluids_command.cpp).
+bool wants_lazyfluids(const Args& args);
+int run_lazyfluids(const Args& args);
 
 // Which Blender renders guides, and where it finds the tempera package.
 struct BlenderSetup {
