@@ -134,6 +134,21 @@ def test_media_job_runs_earlier_frames_first_and_rejects_bad_input(tmp_path):
         fluidymation.MediaJob(tmp_path / "none", cache, [1, 2], tmp_path / "bad")
 
 
+def test_media_job_takes_rgb_frames_with_a_mask_folder(tmp_path):
+    _, cache = make_inputs(tmp_path, frames=2)
+    rgb, masks = tmp_path / "rgb", tmp_path / "masks"
+    rgb.mkdir(), masks.mkdir()
+    for i, f in enumerate(ink_frames()):
+        write_image(str(rgb / f"f{i:02d}.png"), np.ascontiguousarray(f[..., :3]))
+        write_image(str(masks / f"m{i:02d}.png"), np.ascontiguousarray(f[..., 3:]))
+    job = fluidymation.MediaJob(rgb, cache, [1, 2], tmp_path / "out", exemplar_masks=masks, format="exr", **FAST)
+    assert [job.run_frame(i)["status"] for i in range(2)] == ["stylized"] * 2
+    out = read_image(job.output_path(2))
+    assert out.shape == (SIZE, SIZE, 4) and np.all(out[disc(8.5) <= 0.5, :3] == 0)
+    with pytest.raises(ValueError, match="no alpha"):
+        fluidymation.MediaJob(rgb, cache, [1, 2], tmp_path / "bad")
+
+
 def test_cli_runs_and_exits_2_on_bad_input(tmp_path, cli_path):
     exemplar, cache = make_inputs(tmp_path, frames=2)
     base = [str(cli_path), "stylize", "--method", "fluidymation", "--guides", str(cache), "--exemplar",
