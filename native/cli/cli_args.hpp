@@ -52,6 +52,9 @@ int run_synth(const Args& args);
 int run_render_guides(const Args& args);
 int run_stylize(const Args& args);
 int run_noisy(const Args& args);
+// `stylize --method fluidymation` (fluidymation_command.cpp).
+bool wants_fluidymation(const Args& args);
+int run_stylize_fluidymation(const Args& args);
 // `tempera stylize --method lazyfluids` (lazyfluids_command.cpp).
 bool wants_lazyfluids(const Args& args);
 int run_lazyfluids(const Args& args);
