@@ -30,6 +30,7 @@ KINDS = ("smoke", "fire")
 INK_THRESHOLD = 0.5  # the masks: pigment concentration above this
 PAPER = np.array([0.955, 0.94, 0.9])
 INK_ABSORPTION = np.array([2.3, 1.7, 0.55])  # Beer-Lambert per channel: an indigo ink
+HORIZONTAL_SQUEEZE = {"smoke": 1.0, "fire": 2.5}
 MAX_SIDE = 4096
 MIN_SIDE = 16
 
@@ -139,9 +140,10 @@ class _Plume:
         w, h = self.width, self.height
         up = 1.0 - self.y / h  # 0 at the source (bottom), 1 at the top
         sway = (self.sway(self.x * 0 + self.x0, self.y, phase) - 0.5) * 2
-        centre = self.x0 + w * 0.22 * up ** 1.5 * sway
+        centre = self.x0 + w * 0.14 * up ** 1.5 * sway
         warp = 0.9 * self.detail.cell * (self.warp(self.x, self.y, phase) - 0.5)
-        detail = self.detail(self.x + warp, self.y - warp, phase)
+        # Fire's noise is squeezed sideways: tall thin tongues.
+        detail = self.detail(HORIZONTAL_SQUEEZE[self.kind] * (self.x + warp), self.y - warp, phase)
         if self.kind == "smoke":
             return self._smoke(up, centre, detail)
         return self._fire(up, centre, detail)
@@ -155,10 +157,10 @@ class _Plume:
         return _rgba(_ramp(SMOKE_RAMP, lit), alpha)
 
     def _fire(self, up, centre, detail):
-        width = self.width * np.maximum(0.03, 0.17 - 0.1 * up)
-        envelope = np.exp(-((self.x - centre) / width) ** 2) * _smoothstep(0.0, 0.15, up) * _smoothstep(0.85, 0.3, up)
+        width = self.width * np.maximum(0.03, 0.2 - 0.14 * up)
+        envelope = np.exp(-((self.x - centre) / width) ** 2) * _smoothstep(0.0, 0.15, up) * _smoothstep(0.95, 0.35, up)
         # The noise carves the flame into tongues, more the higher up.
-        heat = np.clip(1.25 * envelope - (1 - detail) * (0.2 + 2.6 * up), 0.0, 1.0)
+        heat = np.clip(1.4 * envelope - (1 - detail) ** 1.5 * (0.3 + 2.2 * up), 0.0, 1.0)
         alpha = _smoothstep(0.04, 0.8, heat)
         return _rgba(_ramp(FIRE_RAMP, heat), alpha)
 
@@ -229,7 +231,7 @@ class _InkDrop:
         cell = max(4.0, side / 16)
         self.paper = _Fbm(rng, width, math.ceil(height / cell) * cell, cell, octaves=4)(x, y, 0.0)
         self.grain = _Fbm(rng, width, math.ceil(height / 4) * 4, 4.0, octaves=2)(x, y, 0.0)
-        self.pigment = np.clip(0.8 + 0.5 * (self.paper - 0.5), 0.7, 1.0) * (self.front(0.0) > 0)
+        self.pigment = np.clip(0.8 + 0.5 * (self.paper - 0.5), 0.7, 1.0) * (self.front(0.0) > -0.5)
 
     def wobble(self, t):
         angles = self.HARMONICS[:, None, None] * self.theta + (self.phase + self.drift * t)[:, None, None]
@@ -266,7 +268,7 @@ class _InkDrop:
         inside = np.maximum(self.front(t), 0.0)
         rim = np.exp(-inside / 2.5)
         age = np.maximum(t - (self.r - self.r0) / self.speed, 0.0)  # frames since the front passed
-        granulation = 1 + (1 - np.exp(-age / 6)) * 0.9 * (0.5 - self.grain)
+        granulation = 1 + (1 - np.exp(-age / 6)) * 0.6 * (0.5 - self.grain)
         density = self.pigment * wet * (0.55 + 0.9 * rim) * granulation * (0.85 + 0.3 * self.paper)
         paper = PAPER * (1 - 0.05 * (self.grain - 0.5))[..., None]
         rgb = paper * np.exp(-density[..., None] * INK_ABSORPTION)
