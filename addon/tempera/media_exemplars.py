@@ -242,7 +242,7 @@ class _InkDrop:
 
     def front(self, t):
         """Signed distance inside the wet front (px, > 0 wet) at time t (frames)."""
-        outline = self.radius(t) * (1 + self.wobble(t)) + 10.0 * (self.paper - 0.5)  # paper soaks unevenly
+        outline = self.radius(t) * (1 + self.wobble(t)) + 6.0 * (self.paper - 0.5)  # paper soaks unevenly
         return outline - self.r
 
     def step(self, t, dt):
