@@ -79,7 +79,8 @@ demo-rigid: build
 	$(BLENDER) -b --factory-startup --python-exit-code 1 --python scenes/rigid_demo.py -- --out $(DEMO_RIGID_OUT)
 
 # The fluid demos (docs/media_exemplars.md): the chimney-smoke shot (scenes/chimney_smoke.py) and the
-# growing-ink shot (scenes/growing_ink.py) in background Blender, and the project's own exemplars.
+# growing-ink shot (scenes/growing_ink.py) in background Blender and the project's own exemplars, then
+# LazyFluids on the smoke and Fluidymation on the ink, composited over the plate and the paper.
 DEMO_FLUIDS_OUT ?= out/demo-fluids
 TEMPERA_PY := PYTHONPATH=addon TEMPERA_CLI=$(CURDIR)/$(BUILD)/bin/tempera $(PYTHON) -m tempera
 demo-fluids: build
@@ -89,6 +90,17 @@ demo-fluids: build
 	    --out $(DEMO_FLUIDS_OUT)/ink
 	$(TEMPERA_PY) exemplar smoke --out $(DEMO_FLUIDS_OUT)/exemplars/smoke --size 128x128 --frames 24
 	$(TEMPERA_PY) exemplar ink --out $(DEMO_FLUIDS_OUT)/exemplars/ink --size 160x160 --frames 24 --speed 2
+	$(BUILD)/bin/tempera stylize --method lazyfluids --guides $(DEMO_FLUIDS_OUT)/chimney/guides \
+	    --exemplar $(DEMO_FLUIDS_OUT)/exemplars/smoke --frames 13-36 --out $(DEMO_FLUIDS_OUT)/chimney/lazyfluids
+	$(PYTHON) tools/composite_over.py --over $(DEMO_FLUIDS_OUT)/chimney/lazyfluids/frames \
+	    --under $(DEMO_FLUIDS_OUT)/chimney/plate --frames 13-36 --out $(DEMO_FLUIDS_OUT)/chimney/composite \
+	    --video $(DEMO_FLUIDS_OUT)/chimney/chimney_smoke.mp4
+	$(BUILD)/bin/tempera stylize --method fluidymation --guides $(DEMO_FLUIDS_OUT)/ink/guides \
+	    --exemplar $(DEMO_FLUIDS_OUT)/exemplars/ink --exemplar-masks $(DEMO_FLUIDS_OUT)/exemplars/ink/masks \
+	    --target-mask mask.OB_Ink --frames 1-24 --out $(DEMO_FLUIDS_OUT)/ink/fluidymation
+	$(PYTHON) tools/composite_over.py --over $(DEMO_FLUIDS_OUT)/ink/fluidymation \
+	    --under $(DEMO_FLUIDS_OUT)/ink/paper.png --frames 1-24 --out $(DEMO_FLUIDS_OUT)/ink/composite \
+	    --video $(DEMO_FLUIDS_OUT)/ink/growing_ink.mp4
 
 # The 1 Mpix run, the 0.25/1/4 Mpix sweep and, with COMPARE=REV (e.g. main), REV side by side.
 bench: build

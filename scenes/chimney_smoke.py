@@ -15,7 +15,6 @@ seconds), then writes, for the shot's frames SHOT:
   OUT/beauty/frame_NNNN.png: the same with Cycles' smoke, to compare;
 * OUT/chimney.blend: the baked scene (its cache in OUT/cache/).
 """
-import argparse
 import math
 import sys
 from pathlib import Path
@@ -27,7 +26,6 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "addon"))
 sys.path.insert(0, str(ROOT / "scenes"))
 import scene_kit  # noqa: E402
-from tempera.blender.guide_render import render_guides  # noqa: E402
 
 RESOLUTION = (256, 192)
 SIMULATED = range(1, 38)  # the plume needs the first frames to rise; the guides also render SHOT[-1] + 1
@@ -151,14 +149,9 @@ def render_frames(scene, folder, hidden=()):
     for obj in hidden:
         obj.hide_render = True
     scene.render.film_transparent = False
-    scene.cycles.samples = PLATE_SAMPLES
-    scene.cycles.use_denoising = False  # Debian's Blender has no OpenImageDenoise
-    scene.render.image_settings.file_format = "PNG"
     try:
         for frame in SHOT:
-            scene.frame_set(frame)
-            scene.render.filepath = str(folder / f"frame_{frame:04d}.png")
-            bpy.ops.render.render(write_still=True)
+            scene_kit.render_png(scene, folder / f"frame_{frame:04d}.png", PLATE_SAMPLES, frame)
     finally:
         for obj in hidden:
             obj.hide_render = False
@@ -170,20 +163,15 @@ def render_smoke_guides(scene, house, out):
     for obj in house:
         obj.hide_render = True
     try:
-        render_guides(scene, SHOT, out / "guides", {"samples": GUIDE_SAMPLES, "ld12e_samples": 4},
-                      lambda done, total, message: print(f"chimney: guides {done}/{total} {message}", flush=True))
+        scene_kit.render_shot_guides(scene, SHOT, out / "guides", {"samples": GUIDE_SAMPLES, "ld12e_samples": 4},
+                                     "chimney")
     finally:
         for obj in house:
             obj.hide_render = False
 
 
 def main():
-    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-    parser = argparse.ArgumentParser(prog="scenes/chimney_smoke.py")
-    parser.add_argument("--out", default=str(ROOT / "out" / "chimney"))
-    args = parser.parse_args(argv)
-    out = Path(args.out).resolve()
-    out.mkdir(parents=True, exist_ok=True)
+    out = scene_kit.script_out_dir("scenes/chimney_smoke.py", ROOT / "out" / "chimney")
     scene = bpy.context.scene
     house, domain = build(scene, out / "cache")
     bake(scene, domain)

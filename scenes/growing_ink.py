@@ -11,7 +11,6 @@ target mask of Fluidymation) and its `velocity_forward` / `velocity_backward`
 animated, so the Vector pass follows its outline), OUT/paper.png (the paper
 alone, the background of the stylized ink) and OUT/ink.blend.
 """
-import argparse
 import math
 import sys
 from pathlib import Path
@@ -23,7 +22,6 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "addon"))
 sys.path.insert(0, str(ROOT / "scenes"))
 import scene_kit  # noqa: E402
-from tempera.blender.guide_render import render_guides  # noqa: E402
 
 RESOLUTION = (256, 192)
 SHOT = range(1, 25)  # 24 frames, one second at 24 fps
@@ -100,26 +98,17 @@ def build(scene):
 def render_paper(scene, ink, out):
     """OUT/paper.png: the sheet without the ink."""
     ink.hide_render = True
-    scene.cycles.samples = GUIDE_SAMPLES
-    scene.cycles.use_denoising = False  # Debian's Blender has no OpenImageDenoise
-    scene.render.image_settings.file_format = "PNG"
-    scene.render.filepath = str(out / "paper.png")
-    bpy.ops.render.render(write_still=True)
+    scene_kit.render_png(scene, out / "paper.png", GUIDE_SAMPLES)
     ink.hide_render = False
 
 
 def main():
-    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-    parser = argparse.ArgumentParser(prog="scenes/growing_ink.py")
-    parser.add_argument("--out", default=str(ROOT / "out" / "ink"))
-    args = parser.parse_args(argv)
-    out = Path(args.out).resolve()
-    out.mkdir(parents=True, exist_ok=True)
+    out = scene_kit.script_out_dir("scenes/growing_ink.py", ROOT / "out" / "ink")
     scene = bpy.context.scene
     _, ink = build(scene)
     bpy.ops.wm.save_as_mainfile(filepath=str(out / "ink.blend"))
-    render_guides(scene, SHOT, out / "guides", {"samples": GUIDE_SAMPLES, "ld12e_samples": 4, "masks": "objects"},
-                  lambda done, total, message: print(f"ink: guides {done}/{total} {message}", flush=True))
+    scene_kit.render_shot_guides(scene, SHOT, out / "guides",
+                                 {"samples": GUIDE_SAMPLES, "ld12e_samples": 4, "masks": "objects"}, "ink")
     render_paper(scene, ink, out)
     print(f"ink: frames {SHOT[0]}-{SHOT[-1]} in {out}")
 

@@ -13,9 +13,9 @@ naming it.
 from __future__ import annotations
 
 import argparse
-import sys
 
 from . import media_exemplars
+from .command import run_command
 
 DEFAULT_SIZE = (256, 256)
 DEFAULT_FRAMES = 24
@@ -62,11 +62,4 @@ def run(args):
 
 
 def main(argv=None):
-    try:
-        return run(_parser().parse_args(argv))
-    except KeyboardInterrupt:
-        print("tempera exemplar: cancelled", file=sys.stderr)
-        return 130
-    except (ValueError, OSError) as exc:
-        print(f"tempera exemplar: {exc}", file=sys.stderr)
-        return 2
+    return run_command("tempera exemplar", lambda: run(_parser().parse_args(argv)))
