@@ -96,13 +96,12 @@ class _Fbm:
             c = self.cell / 2 ** k
             self.lattices.append(rng.random((time_cells, int(round(period / c)), int(math.ceil(width / c)) + 2)))
 
-    def __call__(self, x, y, phase, rise=1.0):
-        """Noise in [0, 1] at pixel coordinates (x, y) and loop phase in [0, 1);
-        `rise` periods of upward drift per loop (a whole number keeps the loop)."""
+    def __call__(self, x, y, phase):
+        """Noise in [0, 1] at pixel coordinates (x, y) and loop phase in [0, 1)."""
         total, norm = 0.0, 0.0
         for k, lattice in enumerate(self.lattices):
             c, amplitude = self.cell / 2 ** k, 0.5 ** k
-            y_drift = y + rise * self.period * phase
+            y_drift = y + self.period * phase
             total = total + amplitude * _lattice_noise(lattice, x / c, y_drift / c, phase * lattice.shape[0])
             norm += amplitude
         return total / norm
@@ -129,7 +128,8 @@ class _Plume:
         rng = np.random.default_rng(seed)
         self.width, self.height, self.kind = width, height, kind
         base = max(8.0, min(width, height) / 4)
-        period = math.ceil(height / base) * base  # a whole number of cells at every octave
+        # A whole number of cells of every octave of all three noises (the coarsest: 2 * base).
+        period = math.ceil(height / (2 * base)) * 2 * base
         self.detail = _Fbm(rng, width, period, base, octaves=5)
         self.warp = _Fbm(rng, width, period, base * 2, octaves=2)
         self.sway = _Fbm(rng, width, period, base * 2, octaves=1)
