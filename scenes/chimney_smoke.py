@@ -8,8 +8,8 @@ Builds the scene, bakes the gas domain (resolution DOMAIN_RESOLUTION, a few
 seconds), then writes, for the shot's frames SHOT:
 * OUT/guides/: the guide cache of the smoke alone (the house hidden), through
   the add-on's guide render (tempera.blender.guide_render): `alpha` is the
-  smoke's coverage, the target X_a of LazyFluids (Cycles' Vector pass is 0 on
-  volumes: the flow comes from the fluid_velocity guide where it exists);
+  smoke's coverage, the target X_a of LazyFluids, and `fluid_velocity` its
+  flow, from the domain's grids (Cycles' Vector pass is 0 on volumes);
 * OUT/plate/frame_NNNN.png: the house without the smoke (Cycles, PLATE_SAMPLES),
   the background the stylized smoke is composited over, and
   OUT/beauty/frame_NNNN.png: the same with Cycles' smoke, to compare;
