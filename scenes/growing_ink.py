@@ -64,8 +64,10 @@ def add_blot(scene):
         grown.keyframe_insert("value", frame=frame)
         ink.scale = (scale, scale, 1.0)
         ink.keyframe_insert("scale", frame=frame)
-    for data in (ink.animation_data, ink.data.shape_keys.animation_data):
-        for fcurve in data.action.fcurves:
+    from tempera.blender import compat
+
+    for animated in (ink, ink.data.shape_keys):
+        for fcurve in compat.action_fcurves(animated):
             for key in fcurve.keyframe_points:
                 key.interpolation = "LINEAR"
     return ink
