@@ -142,3 +142,20 @@ def test_ink_mask_by_threshold_finds_the_simulated_pigment():
     assert not me.ink_mask(np.full((8, 8, 3), 0.9)).any()
     with pytest.raises(ValueError, match="expected an"):
         me.ink_mask(np.zeros((8, 8)))
+
+
+def test_ink_edges_are_darker_than_the_inside():
+    """Watercolour's darker rim: the optical density next to the front
+    exceeds the density well inside it."""
+    rgb, masks = me.ink_video(128, 128, 16, 2.0, seed=4)
+    frame, mask = rgb[-1], masks[-1].astype(bool)
+    density = -np.log(np.clip(frame, 1e-4, None) / me.PAPER).mean(axis=2)
+    inside = mask.copy()
+    for _ in range(2):  # two pixels in from the front
+        inside[1:-1, 1:-1] &= inside[:-2, 1:-1] & inside[2:, 1:-1] & inside[1:-1, :-2] & inside[1:-1, 2:]
+    rim = mask & ~inside
+    deep = inside.copy()
+    for _ in range(8):
+        deep[1:-1, 1:-1] &= deep[:-2, 1:-1] & deep[2:, 1:-1] & deep[1:-1, :-2] & deep[1:-1, 2:]
+    assert rim.sum() > 50 and deep.sum() > 50
+    assert density[rim].mean() > 1.2 * density[deep].mean()
