@@ -2,7 +2,8 @@
 #   make demo    install deps, build, stylize the bundled demo scene in background Blender
 #   make test    install deps, build, run C++, Python, in-Blender (3.4, 4.2, 4.5, 5.0), wheel/farm
 #                and Flamenco tests
-# Other targets: deps, build, kit, addon-zip, wheel, extension, demo-rigid, bench, bench-tracer, sanitize, clean.
+# Other targets: deps, build, kit, addon-zip, wheel, extension, demo-rigid, demo-fluids, bench, bench-tracer,
+#                sanitize, clean.
 
 PYTHON   := /usr/bin/python3
 BLENDER  ?= blender
@@ -28,7 +29,7 @@ KIT_SOURCES := scenes/exemplar_kit.py scenes/scene_kit.py addon/tempera/exemplar
                addon/tempera/blender/guide_render.py addon/tempera/guide_cache.py
 DEMO_OUT ?= out/demo
 
-.PHONY: all deps build kit addon-zip wheel extension test demo demo-rigid bench bench-tracer sanitize fuzz clean
+.PHONY: all deps build kit addon-zip wheel extension test demo demo-rigid demo-fluids bench bench-tracer sanitize fuzz clean
 
 all: build
 
@@ -76,6 +77,30 @@ demo: build addon-zip
 DEMO_RIGID_OUT ?= out/demo-rigid
 demo-rigid: build
 	$(BLENDER) -b --factory-startup --python-exit-code 1 --python scenes/rigid_demo.py -- --out $(DEMO_RIGID_OUT)
+
+# The fluid demos (docs/media_exemplars.md): the chimney-smoke shot (scenes/chimney_smoke.py) and the
+# growing-ink shot (scenes/growing_ink.py) in background Blender and the project's own exemplars, then
+# LazyFluids on the smoke and Fluidymation on the ink, composited over the plate and the paper.
+DEMO_FLUIDS_OUT ?= out/demo-fluids
+TEMPERA_PY := PYTHONPATH=addon TEMPERA_CLI=$(CURDIR)/$(BUILD)/bin/tempera $(PYTHON) -m tempera
+demo-fluids: build
+	$(BLENDER) -b --factory-startup --python-exit-code 1 --python scenes/chimney_smoke.py -- \
+	    --out $(DEMO_FLUIDS_OUT)/chimney
+	$(BLENDER) -b --factory-startup --python-exit-code 1 --python scenes/growing_ink.py -- \
+	    --out $(DEMO_FLUIDS_OUT)/ink
+	$(TEMPERA_PY) exemplar smoke --out $(DEMO_FLUIDS_OUT)/exemplars/smoke --size 128x128 --frames 24
+	$(TEMPERA_PY) exemplar ink --out $(DEMO_FLUIDS_OUT)/exemplars/ink --size 160x160 --frames 24 --speed 2
+	$(BUILD)/bin/tempera stylize --method lazyfluids --guides $(DEMO_FLUIDS_OUT)/chimney/guides \
+	    --exemplar $(DEMO_FLUIDS_OUT)/exemplars/smoke --frames 13-36 --out $(DEMO_FLUIDS_OUT)/chimney/lazyfluids
+	$(PYTHON) tools/composite_over.py --over $(DEMO_FLUIDS_OUT)/chimney/lazyfluids/frames \
+	    --under $(DEMO_FLUIDS_OUT)/chimney/plate --frames 13-36 --out $(DEMO_FLUIDS_OUT)/chimney/composite \
+	    --video $(DEMO_FLUIDS_OUT)/chimney/chimney_smoke.mp4
+	$(BUILD)/bin/tempera stylize --method fluidymation --guides $(DEMO_FLUIDS_OUT)/ink/guides \
+	    --exemplar $(DEMO_FLUIDS_OUT)/exemplars/ink --exemplar-masks $(DEMO_FLUIDS_OUT)/exemplars/ink/masks \
+	    --target-mask mask.OB_Ink --frames 1-24 --out $(DEMO_FLUIDS_OUT)/ink/fluidymation
+	$(PYTHON) tools/composite_over.py --over $(DEMO_FLUIDS_OUT)/ink/fluidymation \
+	    --under $(DEMO_FLUIDS_OUT)/ink/paper.png --frames 1-24 --out $(DEMO_FLUIDS_OUT)/ink/composite \
+	    --video $(DEMO_FLUIDS_OUT)/ink/growing_ink.mp4
 
 # The 1 Mpix run, the 0.25/1/4 Mpix sweep and, with COMPARE=REV (e.g. main), REV side by side.
 bench: build

@@ -186,3 +186,37 @@ def render_exr(scene, path, frame=None):
 
 def view_layer_name(scene):
     return scene.view_layers[0].name
+
+
+# --------------------------------------------------------------------------- shot scripts
+
+def script_out_dir(prog, default):
+    """The folder of a shot script's `-- --out DIR` (made, absolute)."""
+    import argparse
+    import sys
+
+    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    parser = argparse.ArgumentParser(prog=prog)
+    parser.add_argument("--out", default=str(default))
+    out = Path(parser.parse_args(argv).out).resolve()
+    out.mkdir(parents=True, exist_ok=True)
+    return out
+
+
+def render_shot_guides(scene, frames, folder, params, label):
+    """The guide cache of `frames` through the add-on's guide render, its progress printed after `label`."""
+    from tempera.blender.guide_render import render_guides
+
+    return render_guides(scene, frames, folder, params,
+                         lambda done, total, message: print(f"{label}: guides {done}/{total} {message}", flush=True))
+
+
+def render_png(scene, path, samples, frame=None):
+    """One Cycles frame (no denoising: Debian's Blender has no OpenImageDenoise) as a PNG."""
+    scene.cycles.samples = samples
+    scene.cycles.use_denoising = False
+    scene.render.image_settings.file_format = "PNG"
+    if frame is not None:
+        scene.frame_set(frame)
+    scene.render.filepath = str(path)
+    bpy.ops.render.render(write_still=True)

@@ -3,7 +3,8 @@
 
 `tempera farm ...` and `tempera stylize --scheduler ADDRESS ...` run a shot on
 a Dask cluster (tempera.farm); `tempera rigid ...` runs the rigid-body method
-on a guide cache's tracks (tempera.rigid_cli); every other command is the
+on a guide cache's tracks (tempera.rigid_cli); `tempera exemplar ...` writes one of the
+project's own smoke/fire/ink exemplars (tempera.exemplar_cli); every other command is the
 native batch CLI
 (tempera_native/bin/tempera: synth, stylize, render-guides), run with this
 package as the add-on that `render-guides` hands to Blender.
@@ -45,6 +46,10 @@ def main(argv=None):
         from .rigid_cli import main as rigid_main
 
         return rigid_main(argv[1:])
+    if argv[:1] == ["exemplar"]:
+        from .exemplar_cli import main as exemplar_main
+
+        return exemplar_main(argv[1:])
     try:
         cli = native_cli()
     except FileNotFoundError as exc:

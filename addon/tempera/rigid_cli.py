@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from . import _native, rigid, rigid_tracks
+from .command import run_command
 
 PAPER = (0.97, 0.96, 0.92)
 OPTION_TABLES = (rigid.RigidOptions.table(), rigid.QuadraticFitOptions.table())
@@ -156,11 +157,4 @@ def run(args):
 
 def main(argv=None):
     args = _parser().parse_args(argv)
-    try:
-        return run(args)
-    except KeyboardInterrupt:
-        print("tempera rigid: cancelled; rerun the same command to resume", file=sys.stderr)
-        return 130
-    except (ValueError, OSError) as exc:
-        print(f"tempera rigid: {exc}", file=sys.stderr)
-        return 2
+    return run_command("tempera rigid", lambda: run(args), "cancelled; rerun the same command to resume")

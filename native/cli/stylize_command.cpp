@@ -426,8 +426,8 @@ int interrupted_segments() {
 }  // namespace
 
 int run_stylize(const Args& args) {
-  if (wants_fluidymation(args)) return run_stylize_fluidymation(args);
   if (wants_lazyfluids(args)) return run_lazyfluids(args);
+  if (wants_fluidymation(args)) return run_stylize_fluidymation(args);
   if (ArgReader(args, "stylize").wants_help() || args.empty()) {
     std::cout << stylize_help();
     return args.empty() ? 2 : 0;
