@@ -39,3 +39,15 @@ PANEL_TEMPORAL_WEIGHT = 0.5
 DEFAULT_QUALITY = _native.stylit_defaults()["quality"]
 QUALITY_PRESETS = ("preview", "final")
 OUTPUT_FORMATS = ("png", "exr")
+
+# The fluid methods' options the panel shows, rows as in the native option
+# tables (name -> default, min, max): LazyFluids (thesis §5.5: λ = 0.2, no
+# rotations, no motion blur) and Fluidymation (one forward pass, as in the paper).
+LAZYFLUIDS_PANEL = {
+    "lambda": {"default": 0.2, "min": 0.0, "max": 1.0},
+    "rotations": {"default": False},
+    "motion_blur": {"default": 0.0, "min": 0.0, "max": 16.0},
+}
+FLUIDYMATION_PANEL = {
+    "bidirectional": {"default": False},
+}
