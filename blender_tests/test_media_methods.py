@@ -7,12 +7,11 @@ render in a sequencer scene; Esc within a frame writes nothing of it, and
 a rerun resumes."""
 import shutil
 import subprocess
-import time
 
 import bpy
 import numpy as np
 import pytest
-from fake_ui import modal_run
+from fake_ui import esc_within_next_step
 from guide_scene import FRAMES, SIZE, build_scene, remove_scene
 
 SCENE = "Media methods test"
@@ -183,25 +182,12 @@ def test_esc_within_a_frame_writes_nothing_then_resume(media_scene, tmp_path):
     while run.in_guide_phase:
         run.step()
     run.step()  # the first frame
-    op_holder = []
     run_frame = run.job.run_frame
 
-    def held_run_frame(index, progress=None):
-        def wait_for_esc(fraction):  # Esc surely comes within the frame, however fast the machine
-            deadline = time.monotonic() + 60
-            while not op_holder[0]._stop and time.monotonic() < deadline:
-                time.sleep(0.01)
-            return progress(fraction)
-        return run_frame(index, wait_for_esc)
+    def hold(wrap):
+        run.job.run_frame = lambda index, progress=None: run_frame(index, wrap(progress))
 
-    run.job.run_frame = held_run_frame
-
-    def events(op):
-        op_holder.append(op)
-        yield ("TIMER", "NOTHING")  # starts the second frame in the worker
-        yield ("ESC", "PRESS")
-
-    results, _log, reports, timers, _op = modal_run(TEMPERA_OT_stylize, media_scene, run, events, tick=0.02)
+    results, _log, reports, timers, _op = esc_within_next_step(TEMPERA_OT_stylize, media_scene, run, hold)
     assert results[-1] == {"CANCELLED"} and not timers and "Stopped" in reports[-1][1]
     written = sorted(p.name for p in (tmp_path / "out" / "lazyfluids").rglob("frame_*.png"))
     assert written == [f"frame_{FRAMES[0]:04d}.png"]  # the first frame only, nothing half-written
