@@ -142,8 +142,9 @@ def draw_synthesis(box, settings):
         draw_rigid(box, settings)
         return  # the StyLit settings below do not apply
     if settings.method in MEDIA_METHODS:
-        MEDIA_METHODS[settings.method](box.column(), settings)
-        box.prop(settings, "seed")
+        col = box.column()
+        MEDIA_METHODS[settings.method](col, settings)
+        col.prop(settings, "seed")
         return
     col = box.column()
     col.prop(settings, "quality")
