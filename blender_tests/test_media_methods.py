@@ -146,7 +146,8 @@ def test_fluid_method_end_to_end_and_resume(media_scene, tmp_path):
 
 def _movie(tmp_path):
     movie = tmp_path / "ink.mov"
-    subprocess.run([shutil.which("ffmpeg"), "-y", "-v", "error", "-framerate", "12", "-i", str(tmp_path / "ink" / "ink_%04d.png"),
+    frames = str(tmp_path / "ink" / "ink_%04d.png")
+    subprocess.run([shutil.which("ffmpeg"), "-y", "-v", "error", "-framerate", "12", "-i", frames,
                     "-c:v", "png", "-pix_fmt", "rgba", str(movie)], check=True)
     return movie
 

@@ -120,6 +120,13 @@ def output_dir(settings):
     return resolve_path(settings.output_dir, "Output Folder")
 
 
+def require_consecutive(frames, method):
+    """ValueError unless `frames` follow each other (a method that carries
+    each frame on to the next)."""
+    if any(b != a + 1 for a, b in zip(frames, frames[1:])):
+        raise ValueError(f"{method} needs consecutive frames: set the scene's Frame Step to 1.")
+
+
 class StylizeRun:
     """The steps of one Stylize run: guides of every frame, then StyLit per frame."""
 
@@ -283,8 +290,7 @@ class CoherentRun(StylizeRun):
         from .keyframes import key_list
 
         super().__init__(scene, frames, mode)
-        if any(b != a + 1 for a, b in zip(self.frames, self.frames[1:])):
-            raise ValueError("The coherent method needs consecutive frames: set the scene's Frame Step to 1.")
+        require_consecutive(self.frames, "The coherent method")
         self.keys = [k for k in key_list(scene.tempera) if self.frames[0] <= k[0] <= self.frames[-1]]
         self.segments = tcia.segments(self.frames, [k[0] for k in self.keys])
         self.segment_results = []
@@ -470,11 +476,12 @@ class RgbaRun(StylizeRun):
         self.out = output_dir(settings)
         label = next(n for k, n, _ in MEDIA_EXEMPLAR_KINDS if k == settings.media_exemplar_kind)
         if settings.media_exemplar_kind not in self.kinds:
-            raise ValueError(f"{self.method_label} needs a video exemplar: set Exemplar to Image Sequence or Movie "
-                             f"(not {label}).")
+            raise ValueError(f"The {self.method_label} method needs a video exemplar: set Exemplar to Image Sequence "
+                             f"or Movie (not {label}).")
         cache = os.path.join(self.out, EXEMPLAR_FRAMES_DIR)
         self.exemplar = exemplar_source(settings.media_exemplar_kind,
                                         resolve_path(settings.media_exemplar, f"exemplar {label}"), cache)
+        require_consecutive(self.frames, f"The {self.method_label} method")
         self.guides = GuideJob.from_settings(scene, self.frames)
         self.method_out = self.result_dir = os.path.join(self.out, self.folder)
         self.config = {"out": os.path.join(self.method_out, FRAMES_DIR), "format": settings.output_format,
