@@ -44,7 +44,7 @@ OUTPUT_FORMATS = ("png", "exr")
 # tables (name -> default, min, max): LazyFluids (thesis §5.5: λ = 0.2, no
 # rotations, no motion blur) and Fluidymation (one forward pass, as in the paper).
 LAZYFLUIDS_PANEL = {
-    "lambda": {"default": 0.2, "min": 0.0, "max": 1.0},
+    "temporal_weight": {"default": 0.2, "min": 0.0, "max": 1.0},
     "rotations": {"default": False},
     "motion_blur": {"default": 0.0, "min": 0.0, "max": 16.0},
 }

@@ -358,8 +358,8 @@ class TemperaSettings(PropertyGroup):
         name="Masks", subtype="DIR_PATH", default="",
         description="Optional: a folder of the exemplar's mask frames (white = medium); empty: its alpha")
     lf_lambda: FloatProperty(
-        name="Temporal Coherence", default=limits.LAZYFLUIDS_PANEL["lambda"]["default"],
-        min=limits.LAZYFLUIDS_PANEL["lambda"]["min"], soft_max=limits.LAZYFLUIDS_PANEL["lambda"]["max"],
+        name="Temporal Coherence", default=limits.LAZYFLUIDS_PANEL["temporal_weight"]["default"],
+        min=limits.LAZYFLUIDS_PANEL["temporal_weight"]["min"], soft_max=limits.LAZYFLUIDS_PANEL["temporal_weight"]["max"],
         description="λ, the pull of the previous frame carried along the flow (thesis eq. 5.6): higher flickers less "
         "but lets the texture smear; 0 paints every frame afresh")
     lf_rotations: BoolProperty(

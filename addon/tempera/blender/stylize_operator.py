@@ -529,7 +529,7 @@ class FluidRun(RgbaRun):
     method_label = "Fluid"
 
     def job_options(self, settings):
-        return {"lambda": float(settings.lf_lambda), "rotations": bool(settings.lf_rotations),
+        return {"temporal_weight": float(settings.lf_lambda), "rotations": bool(settings.lf_rotations),
                 "motion_blur": float(settings.lf_motion_blur), "seed": int(settings.seed)}
 
     def make_method_job(self):
