@@ -43,6 +43,7 @@ GUIDES = {
     **{g["name"]: "RGB" for g in _native.light_path_guides()},
     "velocity_forward": "XY",  # V+: pixel p moves to p + V+ in the next frame
     "velocity_backward": "XY",  # V-: pixel p came from p - V- in the previous frame
+    "fluid_velocity": "XY",  # screen velocity of fluids: p moves to p + F in the next frame
     "occlusion_backward": "V",  # chi-: 1 visible in the previous frame, 0 disoccluded
     "occlusion_forward": "V",  # chi+: 1 still visible in the next frame, 0 about to be occluded
     "tensor": ("XX", "XY", "YY"),  # structure tensor of the grayscale render (interpolates)

@@ -74,6 +74,8 @@ const char* kStylizeHelpText =
     "                          Benard et al. 2013: the whole shot in forward and backward\n"
     "                          sweeps along the motion; needs consecutive frames with\n"
     "                          velocity_forward/backward and occlusion_forward/backward)\n"
+    "                          | lazyfluids (fluid elements from an RGBA exemplar along the\n"
+    "                          flow; own options: tempera stylize --method lazyfluids --help)\n"
     "  --key F=PATH[,MASK]     tcia: a painted keyframe (repeatable); comes out as painted\n"
     "                          (where MASK > 0.5 if given) and steers its neighbours\n"
     "  --segment A-B           tcia: solve only the segment from key A to key B (a farm\n"
@@ -174,7 +176,7 @@ bool set_engine_flag(Options& o, const std::string& flag, ArgReader& r) {
 
 void check_method(Options& o) {
   if (o.method != "stylit" && o.method != "tcia")
-    throw ValueError(concat("unknown --method '", o.method, "' (choose stylit or tcia)"));
+    throw ValueError(concat("unknown --method '", o.method, "' (choose stylit, tcia or lazyfluids)"));
   if (o.method == "stylit") {
     if (!o.keys.empty() || o.segment || !o.tcia_flags.empty())
       throw ValueError(concat(!o.keys.empty() ? "--key" : o.segment ? "--segment" : o.tcia_flags.front(),
@@ -422,6 +424,7 @@ int interrupted_segments() {
 }  // namespace
 
 int run_stylize(const Args& args) {
+  if (wants_lazyfluids(args)) return run_lazyfluids(args);
   if (ArgReader(args, "stylize").wants_help() || args.empty()) {
     std::cout << stylize_help();
     return args.empty() ? 2 : 0;

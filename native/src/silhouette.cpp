@@ -50,33 +50,6 @@ Image filled_silhouette(const ImageView& ink, float threshold) {
   return out;
 }
 
-Image gaussian_blur(const ImageView& image, float sigma) {
-  require_nonempty(image, "image to blur");
-  if (sigma <= 0) return Image::copy_of(image);
-  const int radius = int(std::ceil(3 * sigma));
-  std::vector<float> kernel(std::size_t(2 * radius + 1));
-  float sum = 0;
-  for (int i = -radius; i <= radius; ++i) sum += kernel[std::size_t(i + radius)] = std::exp(-0.5f * i * i / (sigma * sigma));
-  for (float& k : kernel) k /= sum;
-  const int w = image.width, h = image.height, c = image.channels;
-  Image tmp(w, h, c), out(w, h, c);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      for (int ch = 0; ch < c; ++ch) {
-        float acc = 0;
-        for (int i = -radius; i <= radius; ++i) acc += kernel[std::size_t(i + radius)] * image.at(std::clamp(x + i, 0, w - 1), y, ch);
-        tmp.at(x, y, ch) = acc;
-      }
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      for (int ch = 0; ch < c; ++ch) {
-        float acc = 0;
-        for (int i = -radius; i <= radius; ++i) acc += kernel[std::size_t(i + radius)] * tmp.at(x, std::clamp(y + i, 0, h - 1), ch);
-        out.at(x, y, ch) = acc;
-      }
-  return out;
-}
-
 std::vector<Vec2> iso_points(const ImageView& image, float level) {
   require_nonempty(image, "image");
   std::vector<Vec2> out;

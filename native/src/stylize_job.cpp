@@ -32,8 +32,6 @@ namespace {
 
 constexpr const char* kReportName = "tempera_stylize.json";
 constexpr const char* kReportFormat = "tempera-stylize 2";
-constexpr int kSheetMaxWidth = 2000;
-constexpr int kSheetGap = 4;
 
 void require_file(const std::string& path, const std::string& what) {
   std::error_code ec;
@@ -445,46 +443,10 @@ FrameResult StylizeJob::run_frame(std::size_t index, const ProgressCallback& pro
 void StylizeJob::write_contact_sheet(const std::string& path, int columns) const {
   if (same_path(path, config_.style)) throw ValueError(concat("the contact sheet '", path, "' would overwrite the painting"));
   std::vector<std::string> files;
-  std::vector<std::pair<int, int>> sizes = {{style_.width(), style_.height()}};
   std::error_code ec;
-  for (int frame : config_.frames) {
-    if (!fs::is_regular_file(output_path(frame), ec)) continue;
-    const ImageFileInfo info = inspect_image(output_path(frame));
-    files.push_back(output_path(frame));
-    sizes.push_back({info.width, info.height});
-  }
-  const int n = int(sizes.size());
-  const int cols = std::min(columns > 0 ? columns : int(std::ceil(std::sqrt(double(n)))), n);
-  const int rows = (n + cols - 1) / cols;
-  int widest = 0;
-  for (const auto& [w, h] : sizes) widest = std::max(widest, w);
-  const double scale = std::min(1.0, double(kSheetMaxWidth - (cols - 1) * kSheetGap) / (double(cols) * widest));
-  auto scaled = [&](int v) { return scale < 1.0 ? std::max(1, int(std::floor(v * scale))) : v; };
-  int cell_w = 0, cell_h = 0;
-  for (const auto& [w, h] : sizes) cell_w = std::max(cell_w, scaled(w)), cell_h = std::max(cell_h, scaled(h));
-  const int channels = style_.channels() == 1 ? 3 : style_.channels();
-  Image sheet(cols * cell_w + (cols - 1) * kSheetGap, rows * cell_h + (rows - 1) * kSheetGap, channels);
-  std::fill(sheet.data(), sheet.data() + sheet.pixel_count() * channels, 1.0f);  // white paper between the paintings
-  auto paste = [&](const ImageView& full, int i) {
-    Image small;
-    ImageView image = full;
-    if (scaled(full.width) != full.width || scaled(full.height) != full.height) {
-      small = resize_image(full, scaled(full.width), scaled(full.height));
-      image = small.view();
-    }
-    const int x0 = (i % cols) * (cell_w + kSheetGap) + (cell_w - image.width) / 2;
-    const int y0 = (i / cols) * (cell_h + kSheetGap) + (cell_h - image.height) / 2;
-    for (int y = 0; y < image.height; ++y)
-      for (int x = 0; x < image.width; ++x) {
-        float* out = sheet.pixel(x0 + x, y0 + y);
-        const float* in = image.pixel(x, y);
-        for (int c = 0; c < channels; ++c) out[c] = in[image.channels == 1 ? 0 : std::min(c, image.channels - 1)];
-        if (channels == 4 && image.channels < 4) out[3] = 1.0f;
-      }
-  };
-  paste(style_.view(), 0);
-  for (std::size_t i = 0; i < files.size(); ++i) paste(read_image(files[i]).view(), int(i) + 1);
-  write_image(path, sheet.view());
+  for (int frame : config_.frames)
+    if (fs::is_regular_file(output_path(frame), ec)) files.push_back(output_path(frame));
+  write_frames_contact_sheet(path, style_.view(), files, columns);
 }
 
 }  // namespace tempera

@@ -40,49 +40,21 @@ UsageStats retrieve_uniform(const PatchSpace& space, const SearchConstraints& co
     for (std::size_t p = 0; p < uses.size(); ++p) rr.eligible()[p] = cons.source_valid[p] && can_take(p);
   };
   UsageStats stats;
-  const int max_rounds = 64;  // then a greedy fill finishes the last few
-  while (rr.assigned_count() < rr.active() && stats.rounds < max_rounds) {
+  // Rounds until every target is assigned: each round gives every source
+  // with capacity one proposal, so a quota of K needs at least K rounds and
+  // no fixed cap fits every K (a cap followed by a random fill made large-K
+  // assignments random). Capacity sums to the targets of each segment, so
+  // while targets are open some source can take one and a round never stalls.
+  while (rr.assigned_count() < rr.active()) {
     refresh_eligible();
     auto winners = rr.round(stats.rounds++);
     std::sort(winners.begin(), winners.end());  // best first: counters fill with the best pairs
     std::size_t taken = 0;
     for (const auto& a : winners)
       if (can_take(a.source)) take(a), ++taken;
-    if (taken == 0) break;
+    if (taken == 0) throw ValueError("internal: uniform retrieval stalled with targets left");
   }
   stats.covered = double(rr.assigned_count()) / double(std::max<std::size_t>(1, rr.active()));
-  // Greedy fill: each remaining target takes the best of a deterministic sample
-  // of sources that still have capacity (its forward match first).
-  if (rr.assigned_count() < rr.active()) {
-    refresh_eligible();
-    std::vector<std::vector<std::int32_t>> open(segments);
-    for (std::size_t p = 0; p < uses.size(); ++p)
-      if (rr.eligible()[p]) open[cons.segment_of_source(p)].push_back(std::int32_t(p));
-    std::vector<std::uint8_t> pruned(segments, 0);
-    Rng rng(params.seed, mix64(stream) ^ 0xF111ull);
-    for (std::size_t q = 0; q < cons.target_active.size(); ++q) {
-      if (!cons.target_active[q] || rr.is_assigned(q)) continue;
-      auto& pool = open[cons.segment_of_target(q)];
-      const int tx = int(q % nnf.width), ty = int(q / nnf.width);
-      std::size_t best_slot = pool.size();
-      float best = kNoDistance;
-      for (int k = 0; k < 33 && !pool.empty(); ++k) {
-        const std::size_t slot = rng.below(int(pool.size()));
-        const std::int32_t p = pool[slot];
-        const float d = patch_distance(space, p % sw, p / sw, tx, ty, best);
-        if (d < best) best = d, best_slot = slot;
-      }
-      if (best_slot == pool.size()) throw ValueError("internal: uniform retrieval ran out of source capacity");
-      const std::int32_t p = pool[best_slot];
-      take({best, std::int32_t(q), p});
-      if (!can_take(p)) pool[best_slot] = pool.back(), pool.pop_back();
-      // When the last extra use of a segment is spent, sources at K are full.
-      const int s = cons.segment_of_source(p);
-      if (extra[s] == 0 && !pruned[s]++)
-        pool.erase(std::remove_if(pool.begin(), pool.end(), [&](std::int32_t o) { return !can_take(o); }),
-                   pool.end());
-    }
-  }
   return stats;
 }
 

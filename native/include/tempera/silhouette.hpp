@@ -5,6 +5,7 @@
 // by symmetric chamfer distance and IoU.
 #include <vector>
 
+#include "tempera/gaussian_blur.hpp"
 #include "tempera/image.hpp"
 #include "tempera/quadratic_map.hpp"
 
@@ -16,10 +17,6 @@ namespace tempera {
 // 0.5 level of the blurred silhouette runs along the strokes' middle, not
 // their outer edge.
 Image filled_silhouette(const ImageView& ink, float threshold = 0.5f);
-
-// Separable Gaussian blur of every channel (clamped border); sigma <= 0
-// returns a copy.
-Image gaussian_blur(const ImageView& image, float sigma);
 
 // Sub-pixel points where channel 0 crosses `level` between 4-neighbours.
 std::vector<Vec2> iso_points(const ImageView& image, float level = 0.5f);

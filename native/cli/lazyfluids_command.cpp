@@ -1,0 +1,148 @@
+// `tempera stylize --method lazyfluids`: LazyFluids over a guide cache
+// (lazyfluids_job.hpp), frame by frame with resume, then a contact sheet.
+#include <csignal>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+
+#include "cli_args.hpp"
+#include "tempera/error.hpp"
+#include "tempera/lazyfluids_job.hpp"
+
+namespace fs = std::filesystem;
+
+namespace tempera::cli {
+namespace {
+
+const char* kLazyFluidsHelpText =
+    "usage: tempera stylize --method lazyfluids --guides DIR --exemplar PATH --frames A-B --out DIR\n"
+    "                       [options]\n"
+    "\n"
+    "LazyFluids (Jamriska et al. 2015): an RGBA exemplar of a fluid element (smoke, fire,\n"
+    "ink) carried along the flow inside the target alpha, every exemplar patch used equally\n"
+    "often per boundary / interior segment so that it never washes out (docs/lazyfluids.md).\n"
+    "Target alpha: the guide cache's 'alpha'; flow: 'fluid_velocity' (p moves to p + F in\n"
+    "the next frame), else 'velocity_forward', else zero (with a warning).\n"
+    "\n"
+    "outputs:\n"
+    "  OUT/frames/frame_0001.png ...     RGBA frames, transparent outside (each written atomically)\n"
+    "  OUT/frames/tempera_lazyfluids/    per frame the float state and the resume record\n"
+    "  OUT/contact_sheet.png             the exemplar followed by the frames\n"
+    "\n"
+    "inputs:\n"
+    "  --exemplar PATH         RGBA image, or a folder of RGBA frames (a video exemplar,\n"
+    "                          sorted by name, looped when shorter than the shot)\n"
+    "  --guides DIR            guide cache of the animation (frame_####.exr)\n"
+    "  --frames RANGE          consecutive frames, e.g. 1-120\n"
+    "  --out DIR               output folder\n"
+    "\n"
+    "method:\n"
+    "@OPTIONS@"
+    "  (any engine option of 'tempera synth --help'; LazyFluids' defaults: --patch-size 5\n"
+    "  --usage uniform)\n"
+    "  --format F              png (default) | exr\n"
+    "  --no-resume             stylize every frame again, even if current\n"
+    "\n"
+    "Resume: a frame is skipped when its record matches the settings, the exemplar, its guide\n"
+    "files and the frame before; rerun the same command after an interruption (Ctrl-C stops\n"
+    "within the current frame; finished frames are kept).\n"
+    "Exit status: 0 done, 1 error (files), 2 bad usage or bad values, 130 interrupted.\n";
+
+std::string lazyfluids_help() {
+  std::string text = kLazyFluidsHelpText;
+  text.replace(text.find("@OPTIONS@"), 9, flags_help<LazyFluidsOptions>(lazyfluids_option_table()));
+  return text;
+}
+
+volatile std::sig_atomic_t g_interrupted = 0;
+void on_sigint(int) { g_interrupted = 1; }
+
+struct Options {
+  LazyFluidsJobConfig job;
+  std::string out;
+};
+
+Options parse(const Args& args) {
+  Options o;
+  ArgReader r(args, "stylize");
+  while (r.more()) {
+    const std::string flag = r.flag();
+    auto value = [&] { return r.value(flag); };
+    if (flag == "--method") r.value(flag);  // lazyfluids: how we got here
+    else if (flag == "--exemplar") o.job.exemplar = r.value(flag);
+    else if (flag == "--guides") o.job.guides = r.value(flag);
+    else if (flag == "--frames") o.job.frames = parse_frames(r.value(flag));
+    else if (flag == "--out") o.out = r.value(flag);
+    else if (flag == "--format") o.job.format = r.value(flag);
+    else if (flag == "--no-resume") o.job.resume = false;
+    else if (!set_from_flag(o.job.options, lazyfluids_option_table(), flag.substr(2), value) &&
+             !set_from_flag(o.job.options.synthesis, synthesis_option_table(), flag.substr(2), value))
+      throw ValueError(concat("unknown option '", flag, "' for --method lazyfluids (see tempera stylize --method "
+                              "lazyfluids --help)"));
+  }
+  if (o.job.exemplar.empty()) throw ValueError("--exemplar is required (the RGBA exemplar or a folder of frames)");
+  if (o.job.guides.empty()) throw ValueError("--guides is required (the guide cache with alpha and the flow)");
+  if (o.job.frames.empty()) throw ValueError("--frames is required (e.g. --frames 1-120)");
+  if (o.out.empty()) throw ValueError("--out is required (the output folder)");
+  o.job.out = (fs::path(o.out) / "frames").string();
+  return o;
+}
+
+// Runs every frame with a progress line each; false if interrupted.
+bool run_frames(LazyFluidsJob& job) {
+  const std::size_t n = job.frames().size();
+  int stylized = 0;
+  double spent = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    FrameResult r;
+    try {
+      r = job.run_frame(i, [](double) { return !g_interrupted; });
+    } catch (const CancelledError&) {
+      return false;
+    }
+    std::cout << "frame " << i + 1 << "/" << n << " (#" << r.frame << "): ";
+    if (r.status == "skipped") {
+      std::cout << "skipped, already current\n";
+      continue;
+    }
+    spent += r.seconds, ++stylized;
+    std::cout << std::fixed << std::setprecision(2) << r.seconds << " s, source coverage " << r.source_coverage
+              << std::defaultfloat << std::endl;
+  }
+  std::cout << "tempera stylize: " << stylized << " frame(s) stylized, " << n - std::size_t(stylized)
+            << " skipped (already current) in " << std::fixed << std::setprecision(1) << spent << " s"
+            << std::defaultfloat << "\n";
+  return true;
+}
+
+}  // namespace
+
+bool wants_lazyfluids(const Args& args) {
+  for (std::size_t i = 0; i + 1 < args.size(); ++i)
+    if (args[i] == "--method" && args[i + 1] == "lazyfluids") return true;
+  return false;
+}
+
+int run_lazyfluids(const Args& args) {
+  if (ArgReader(args, "stylize").wants_help()) {
+    std::cout << lazyfluids_help();
+    return 0;
+  }
+  Options o = parse(args);  // usage errors propagate: exit status 2
+  struct sigaction action {};
+  action.sa_handler = on_sigint;
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+  LazyFluidsJob job(o.job);  // bad files or values: exit status 1 or 2
+  for (const auto& w : job.warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
+  if (!run_frames(job)) {
+    std::cerr << "tempera stylize: interrupted; finished frames are kept, rerun the same command to resume\n";
+    return 130;
+  }
+  const fs::path sheet = fs::path(o.out) / "contact_sheet.png";
+  job.write_contact_sheet(sheet.string());
+  std::cout << "contact sheet: " << sheet.string() << "\nresults in " << o.out << "\n";
+  return 0;
+}
+
+}  // namespace tempera::cli

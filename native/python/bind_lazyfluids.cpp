@@ -1,0 +1,92 @@
+// Python binding of LazyFluids (lazyfluids.hpp, lazyfluids_job.hpp);
+// tempera.lazyfluids wraps it.
+#include <pybind11/functional.h>
+#include <pybind11/stl.h>
+
+#include "bind_options.hpp"
+#include "numpy_bridge.hpp"
+#include "tempera/lazyfluids.hpp"
+#include "tempera/lazyfluids_job.hpp"
+
+namespace py = pybind11;
+using namespace tempera;
+using py_bridge::FloatArray;
+
+namespace {
+
+std::vector<ImageView> views(const py::list& arrays, const char* what, std::vector<FloatArray>& keep) {
+  std::vector<ImageView> out;
+  for (std::size_t i = 0; i < arrays.size(); ++i) {
+    keep.push_back(arrays[i].cast<FloatArray>());
+    out.push_back(py_bridge::view_of(keep.back(), concat(what, " ", i)));
+  }
+  return out;
+}
+
+}  // namespace
+
+void bind_lazyfluids(py::module_& m) {
+  py_bridge::bind_options_class<LazyFluidsOptions>(m, "LazyFluidsOptions", lazyfluids_option_table(),
+                                                   "Options of LazyFluids (native/include/tempera/lazyfluids.hpp).")
+      .def_readwrite("synthesis", &LazyFluidsOptions::synthesis, "engine options (defaults: lazyfluids_defaults())");
+  m.def("lazyfluids_defaults", &lazyfluids_defaults, "The engine options of LazyFluids.");
+  m.def(
+      "stylize_fluid_sequence",
+      [](const py::list& exemplar, const py::list& alphas, const py::list& flows, const LazyFluidsOptions& options,
+         const std::function<bool(double)>& progress) {
+        std::vector<FloatArray> keep;
+        const auto z = views(exemplar, "exemplar frame", keep), a = views(alphas, "target alpha", keep),
+                   f = views(flows, "flow", keep);
+        ProgressCallback callback = py_bridge::with_gil([&](double x) { return progress ? progress(x) : true; });
+        std::vector<Image> out;
+        {
+          py::gil_scoped_release release;
+          out = stylize_fluid_sequence(z, a, f, options, callback);
+        }
+        py::list result;
+        for (auto& image : out) result.append(py_bridge::to_numpy(std::move(image)));
+        return result;
+      },
+      py::arg("exemplar"), py::arg("alphas"), py::arg("flows"), py::arg("options"), py::arg("progress") = nullptr,
+      "LazyFluids over arrays; use tempera.lazyfluids.stylize_sequence.");
+  m.def(
+      "lazyfluids_temporal_weights",
+      [](const FloatArray& target_alpha, const FloatArray& advected, float lambda) {
+        return py_bridge::to_numpy(temporal_weights(py_bridge::view_of(target_alpha, "target alpha"),
+                                                    py_bridge::view_of(advected, "advected"), lambda));
+      },
+      py::arg("target_alpha"), py::arg("advected"), py::arg("lam"), "λ_q of eq. 5.6.");
+  py::class_<LazyFluidsJob>(m, "LazyFluidsJob", "LazyFluids over a guide cache; use tempera.lazyfluids.FluidJob.")
+      .def(py::init([](const std::string& exemplar, const std::string& guides, const std::vector<int>& frames,
+                       const std::string& out, const std::string& format, bool resume,
+                       const LazyFluidsOptions& options) {
+             LazyFluidsJobConfig c{exemplar, guides, frames, out, format, resume, options};
+             py::gil_scoped_release release;  // reads the exemplar and cache headers
+             return std::make_unique<LazyFluidsJob>(std::move(c));
+           }),
+           py::arg("exemplar"), py::arg("guides"), py::arg("frames"), py::arg("out"), py::arg("format"),
+           py::arg("resume"), py::arg("options"))
+      .def_property_readonly("frames", &LazyFluidsJob::frames)
+      .def_property_readonly("warnings", &LazyFluidsJob::warnings)
+      .def("output_path", &LazyFluidsJob::output_path)
+      .def(
+          "run_frame",
+          [](LazyFluidsJob& job, std::size_t index, const std::function<bool(double)>& progress) {
+            ProgressCallback callback;
+            if (progress) callback = py_bridge::with_gil([&](double x) { return progress(x); });
+            FrameResult r;
+            {
+              py::gil_scoped_release release;
+              r = job.run_frame(index, callback);
+            }
+            return py::make_tuple(r.status, r.seconds);
+          },
+          py::arg("index"), py::arg("progress") = nullptr)
+      .def(
+          "write_contact_sheet",
+          [](const LazyFluidsJob& job, const std::string& path, int columns) {
+            py::gil_scoped_release release;
+            job.write_contact_sheet(path, columns);
+          },
+          py::arg("path"), py::arg("columns") = 0);
+}
