@@ -80,6 +80,8 @@ const char* kStylizeHelpText =
     "                          (where MASK > 0.5 if given) and steers its neighbours\n"
     "  --segment A-B           tcia: solve only the segment from key A to key B (a farm\n"
     "                          task); the shot splits at keys into independent segments\n"
+    "                          | fluidymation (natural media from a video exemplar; see\n"
+    "                          'tempera stylize --method fluidymation --help')\n"
     "@TCIA@"
     "@LINES@"
     "  tcia's engine defaults: 9x9 Gaussian window, centre output, histogram usage, automatic levels;\n"
@@ -425,6 +427,7 @@ int interrupted_segments() {
 
 int run_stylize(const Args& args) {
   if (wants_lazyfluids(args)) return run_lazyfluids(args);
+  if (wants_fluidymation(args)) return run_stylize_fluidymation(args);
   if (ArgReader(args, "stylize").wants_help() || args.empty()) {
     std::cout << stylize_help();
     return args.empty() ? 2 : 0;

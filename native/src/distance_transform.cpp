@@ -51,20 +51,17 @@ void squared_distance_1d(const double* f, double* d, int n, std::vector<int>& v,
 
 }  // namespace
 
-Image line_distance(const ImageView& mask, float d_max) {
-  require_nonempty(mask, "line mask");
-  if (mask.channels != 1)
-    throw ValueError(concat("line mask must have 1 channel, got ", mask.channels));
-  require_finite(mask, "line mask");
-  if (!(d_max > 0.0f) || !std::isfinite(d_max))
-    throw ValueError(concat("d_max must be a positive finite number, got ", d_max));
+Image euclidean_distance(const ImageView& mask, std::string_view what) {
+  require_nonempty(mask, what);
+  if (mask.channels != 1) throw ValueError(concat(what, " must have 1 channel, got ", mask.channels));
+  require_finite(mask, what);
   const int w = mask.width, h = mask.height;
   // Squared distances, column pass then row pass (exact: the Euclidean
   // distance squared separates into the two axes).
   std::vector<double> sq(mask.pixel_count());
   for (std::size_t i = 0; i < sq.size(); ++i) sq[i] = mask.data[i] > 0.5f ? 0.0 : kInf;
-  if (std::find(sq.begin(), sq.end(), 0.0) == sq.end()) return Image(w, h, 1, 1.0f);
-
+  Image out(w, h, 1, std::numeric_limits<float>::infinity());
+  if (std::find(sq.begin(), sq.end(), 0.0) == sq.end()) return out;
   parallel_for(w, 0, [&](int x) {
     std::vector<double> f(h), d(h), z;
     std::vector<int> v;
@@ -72,15 +69,21 @@ Image line_distance(const ImageView& mask, float d_max) {
     squared_distance_1d(f.data(), d.data(), h, v, z);
     for (int y = 0; y < h; ++y) sq[std::size_t(y) * w + x] = d[y];
   });
-  Image out(w, h, 1);
   parallel_for(h, 0, [&](int y) {
     std::vector<double> d(w), z;
     std::vector<int> v;
-    double* row = sq.data() + std::size_t(y) * w;
-    squared_distance_1d(row, d.data(), w, v, z);
-    for (int x = 0; x < w; ++x)
-      out.at(x, y, 0) = float(std::min(std::sqrt(d[x]), double(d_max)) / d_max);
+    squared_distance_1d(sq.data() + std::size_t(y) * w, d.data(), w, v, z);
+    for (int x = 0; x < w; ++x) out.at(x, y, 0) = float(std::sqrt(d[x]));
   });
+  return out;
+}
+
+Image line_distance(const ImageView& mask, float d_max) {
+  require_nonempty(mask, "line mask");
+  if (!(d_max > 0.0f) || !std::isfinite(d_max))
+    throw ValueError(concat("d_max must be a positive finite number, got ", d_max));
+  Image out = euclidean_distance(mask, "line mask");
+  for (std::size_t i = 0; i < out.pixel_count(); ++i) out.data()[i] = std::min(out.data()[i], d_max) / d_max;
   return out;
 }
 

@@ -1,7 +1,9 @@
 // Fluidymation's uniformity term (Platkevič et al. 2021, §3, Omega): usage
 // counted over patch footprints rather than centres. Each exemplar pixel
 // counts how many output patches cover it; a patch costs more the more its
-// own footprint is covered already, relative to fair use.
+// own footprint is covered already, relative to fair use. With a temporal
+// radius r the footprint is the paper's n x n x (2r + 1) cuboid: in a video
+// exemplar, coverage is averaged over the r frames either side.
 #include <algorithm>
 
 #include "tempera/patch_usage.hpp"
@@ -27,16 +29,36 @@ std::vector<float> box_sum(const std::vector<float>& in, int width, int height, 
   return out;
 }
 
+// Coverage of each atlas pixel averaged over the same pixel of the frames
+// up to r steps before and after it in its video (the atlas links frames).
+std::vector<float> temporal_mean(const std::vector<float>& in, const SourceLayout& lay, int width, int r) {
+  std::vector<float> out(in.size(), 0.0f);
+  for (std::size_t e = 0; e < lay.rects.size(); ++e) {
+    std::vector<int> frames = {int(e)};
+    for (int k = 0, f = int(e); k < r && (f = lay.next_frame[std::size_t(f)]) >= 0; ++k) frames.push_back(f);
+    for (int k = 0, f = int(e); k < r && (f = lay.previous_frame[std::size_t(f)]) >= 0; ++k) frames.push_back(f);
+    const SourceRect& rect = lay.rects[e];
+    for (int y = 0; y < rect.height; ++y)
+      for (int x = 0; x < rect.width; ++x) {
+        float sum = 0;
+        for (int f : frames) sum += in[std::size_t(lay.rects[std::size_t(f)].y0 + y) * width + x];
+        out[std::size_t(rect.y0 + y) * width + x] = sum / float(frames.size());
+      }
+  }
+  return out;
+}
+
 class FootprintUsage final : public EnergyTerm {
  public:
-  explicit FootprintUsage(float weight) : weight_(weight) {}
+  FootprintUsage(float weight, int temporal_radius) : weight_(weight), temporal_radius_(temporal_radius) {}
   const char* name() const override { return "footprint"; }
   void add_source_costs(const LevelContext& c, const OffsetField& field, std::vector<float>& cost,
                         TermState&) const override {
     const int sw = c.space->source->width, sh = c.space->source->height, r = c.space->radius;
     // Coverage of each exemplar pixel by used footprints, then the coverage
     // a candidate centre's own footprint would land on.
-    const std::vector<float> covered = box_sum(usage_counts(field, *c.constraints, sw), sw, sh, r);
+    std::vector<float> covered = box_sum(usage_counts(field, *c.constraints, sw), sw, sh, r);
+    if (temporal_radius_ > 0 && c.layout) covered = temporal_mean(covered, *c.layout, sw, temporal_radius_);
     const std::vector<float> crowd = box_sum(covered, sw, sh, r);
     const UsageScale scale = usage_scale(field, *c.constraints);
     if (!scale.valid) return;
@@ -48,12 +70,13 @@ class FootprintUsage final : public EnergyTerm {
 
  private:
   float weight_;
+  int temporal_radius_;
 };
 
 }  // namespace
 
-std::shared_ptr<const EnergyTerm> make_footprint_usage(float weight) {
-  return std::make_shared<FootprintUsage>(weight);
+std::shared_ptr<const EnergyTerm> make_footprint_usage(float weight, int temporal_radius) {
+  return std::make_shared<FootprintUsage>(weight, temporal_radius);
 }
 
 }  // namespace tempera

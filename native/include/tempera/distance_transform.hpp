@@ -2,6 +2,8 @@
 // Bounded distance to lines, the guide D(I) of Bénard et al. 2013's distance
 // transform term (§3.2): far from any line the guide saturates so that
 // synthesis there falls back to the other goals.
+#include <string_view>
+
 #include "tempera/image.hpp"
 
 namespace tempera {
@@ -12,5 +14,9 @@ namespace tempera {
 // min(distance, d_max) / d_max in [0, 1]: 0 on lines, 1 at d_max and beyond.
 // A mask without line pixels gives all 1.
 Image line_distance(const ImageView& mask, float d_max = 10.0f);
+
+// The unbounded distance from each pixel centre to the nearest pixel with
+// mask > 0.5 (0 on them); +inf everywhere if there is none. Same algorithm.
+Image euclidean_distance(const ImageView& mask, std::string_view what = "mask");
 
 }  // namespace tempera

@@ -82,8 +82,9 @@ std::shared_ptr<const EnergyTerm> make_occurrence_penalty(float weight);
 // unit-free).
 std::shared_ptr<const EnergyTerm> make_usage_histogram(float weight, float threshold, float sigma);
 // Fluidymation's Omega: weight * d~ * (coverage of the candidate's footprint
-// by the footprints in use) / fair coverage.
-std::shared_ptr<const EnergyTerm> make_footprint_usage(float weight);
+// by the footprints in use) / fair coverage; with temporal_radius r > 0 the
+// coverage of a video exemplar's pixel is averaged over r frames either side.
+std::shared_ptr<const EnergyTerm> make_footprint_usage(float weight, int temporal_radius = 0);
 std::shared_ptr<const EnergyTerm> make_uniform_usage();
 std::shared_ptr<const EnergyTerm> make_error_budget(double coverage, int max_rounds);
 // Bénard et al. 2013, eq. 5: weight * sum over the patch window of

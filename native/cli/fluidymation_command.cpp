@@ -1,0 +1,134 @@
+// `tempera stylize --method fluidymation`: Fluidymation (Platkevič et al.
+// 2021) over a guide cache, frame by frame with resume (fluidymation_job.hpp).
+#include <csignal>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+
+#include "cli_args.hpp"
+#include "tempera/error.hpp"
+#include "tempera/fluidymation_job.hpp"
+#include "tempera/image_io.hpp"
+
+namespace fs = std::filesystem;
+
+namespace tempera::cli {
+namespace {
+
+const char* kHelp =
+    "usage: tempera stylize --method fluidymation --guides DIR --exemplar DIR [--exemplar-masks DIR]\n"
+    "                       [--target-mask alpha|mask.NAME] [--flow guides|masks] [--bidirectional]\n"
+    "                       --frames A-B --out DIR [options]\n"
+    "\n"
+    "Fluidymation (Platkevic et al. 2021): the target's masks painted with the motion of a natural\n"
+    "medium filmed or simulated as a video exemplar (ink, watercolour). The exemplar's flow comes\n"
+    "from its masks; the target's from the guide cache's velocity_forward or from its masks.\n"
+    "\n"
+    "outputs:\n"
+    "  OUT/frame_0001.png ...       RGBA frames (alpha = the target mask), each written atomically\n"
+    "  OUT/tempera_fluidymation/    per frame the matches and a resume record\n"
+    "  OUT/contact_sheet.png        the first exemplar frame followed by the frames\n"
+    "\n"
+    "inputs:\n"
+    "  --guides DIR            guide cache of the animation\n"
+    "  --exemplar DIR          exemplar video as frames (PNG, EXR, ...; name order); RGBA: alpha\n"
+    "                          is the paint's mask, RGB: give --exemplar-masks\n"
+    "  --exemplar-masks DIR    mask frames of the exemplar (first channel > 0.5 = paint)\n"
+    "  --target-mask NAME      alpha (default) | mask.OB_<object> | mask.CO_<collection>\n"
+    "  --flow F                auto (default: guides when the cache has velocity_forward) |\n"
+    "                          guides (exact, from Blender) | masks (App. A, from the masks)\n"
+    "  --frames RANGE          consecutive frames, e.g. 1-48\n"
+    "  --out DIR               output folder\n"
+    "\n"
+    "method:\n"
+    "  --bidirectional         also solve the shot backward and keep, per pixel, the better pass\n"
+    "@OPTIONS@"
+    "  (any engine option of 'tempera synth --help'; defaults: 5x5 patches, directed orientations,\n"
+    "   3 EM iterations, exact guides)\n"
+    "  --format F              png (default) | exr\n"
+    "  --no-resume             stylize every frame again, even if current\n"
+    "\n"
+    "Resume: a frame is skipped when its output, matches and record are current (same settings,\n"
+    "files and every frame before it); rerun the same command after an interruption.\n"
+    "Exit status: 0 done, 1 error (files), 2 bad usage or bad values, 130 interrupted.\n";
+
+volatile std::sig_atomic_t g_stop = 0;
+void on_signal(int) { g_stop = 1; }
+
+FluidymationJobConfig parse(const Args& args) {
+  FluidymationJobConfig c;
+  ArgReader r(args, "stylize");
+  while (r.more()) {
+    const std::string flag = r.flag();
+    if (flag == "--method") {
+      if (r.value(flag) != "fluidymation") throw ValueError("--method given twice");
+    } else if (flag == "--guides") c.guides = r.value(flag);
+    else if (flag == "--exemplar") c.exemplar = r.value(flag);
+    else if (flag == "--exemplar-masks") c.exemplar_masks = r.value(flag);
+    else if (flag == "--target-mask") c.target_mask = r.value(flag);
+    else if (flag == "--flow") c.flow = parse_enum<FlowSource>(r.value(flag), "--flow");
+    else if (flag == "--bidirectional") c.options.bidirectional = true;
+    else if (flag == "--frames") c.frames = parse_frames(r.value(flag));
+    else if (flag == "--out") c.out = r.value(flag);
+    else if (flag == "--format") c.format = r.value(flag);
+    else if (flag == "--no-resume") c.resume = false;
+    else if (flag == "--max-image-pixels") set_max_image_pixels(r.number<std::int64_t>(flag));
+    else if (!set_from_flag(c.options, fluidymation_option_table(), flag.substr(2), [&] { return r.value(flag); }) &&
+             !set_from_flag(c.options.synthesis, synthesis_option_table(), flag.substr(2), [&] { return r.value(flag); }))
+      throw ValueError(concat("unknown option '", flag, "' (see tempera stylize --method fluidymation --help)"));
+  }
+  for (const auto& [value, what] : {std::pair{&c.guides, "--guides DIR (the guide cache)"},
+                                    {&c.exemplar, "--exemplar DIR (the exemplar's frames)"},
+                                    {&c.out, "--out DIR (the output folder)"}})
+    if (value->empty()) throw ValueError(concat(what, " is required"));
+  if (c.frames.empty()) throw ValueError("--frames is required (e.g. --frames 1-48)");
+  return c;
+}
+
+}  // namespace
+
+bool wants_fluidymation(const Args& args) {
+  for (std::size_t i = 0; i + 1 < args.size(); ++i)
+    if (args[i] == "--method" && args[i + 1] == "fluidymation") return true;
+  return false;
+}
+
+int run_stylize_fluidymation(const Args& args) {
+  if (ArgReader(args, "stylize").wants_help()) {
+    std::string text = kHelp;
+    text.replace(text.find("@OPTIONS@"), 9, flags_help<FluidymationOptions>(fluidymation_option_table()));
+    std::cout << text;
+    return 0;
+  }
+  FluidymationJobConfig config = parse(args);
+  FluidymationJob job(config);  // bad inputs: ValueError, exit status 2
+  for (const auto& w : job.warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
+  struct sigaction action {};
+  action.sa_handler = on_signal;
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+  const std::size_t n = job.frames().size();
+  int stylized = 0;
+  double seconds = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    FluidJobFrame r;
+    try {
+      r = job.run_frame(i, [](double) { return !g_stop; });
+    } catch (const CancelledError&) {
+      std::cerr << "tempera stylize: interrupted; finished frames are kept, rerun the same command to resume\n";
+      return 130;
+    }
+    std::cout << "frame " << i + 1 << "/" << n << " (#" << job.frames()[i] << "): ";
+    if (r.status == "skipped") std::cout << "skipped, already current\n";
+    else std::cout << std::fixed << std::setprecision(2) << r.seconds << " s\n" << std::defaultfloat, ++stylized;
+    seconds += r.seconds;
+  }
+  const fs::path sheet = fs::path(config.out) / "contact_sheet.png";
+  job.write_contact_sheet(sheet.string());
+  std::cout << "tempera stylize: " << stylized << " frame(s) stylized in " << std::fixed << std::setprecision(1)
+            << seconds << " s" << std::defaultfloat << "; flow from " << (job.flow_from_guides() ? "guides" : "masks")
+            << "; contact sheet " << sheet.string() << "\n";
+  return 0;
+}
+
+}  // namespace tempera::cli

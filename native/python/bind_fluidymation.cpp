@@ -1,0 +1,144 @@
+// Python binding of Fluidymation (fluidymation.hpp, fluidymation_job.hpp);
+// tempera.fluidymation wraps it.
+#include <pybind11/functional.h>
+#include <pybind11/stl.h>
+
+#include "bind_options.hpp"
+#include "numpy_bridge.hpp"
+#include "tempera/fluidymation.hpp"
+#include "tempera/fluidymation_job.hpp"
+#include "tempera/mask_flow.hpp"
+#include "tempera/motion_extent.hpp"
+
+namespace py = pybind11;
+using namespace tempera;
+using py_bridge::FloatArray;
+
+namespace {
+
+// Views of a list of arrays, kept alive in `keep`.
+std::vector<ImageView> views(const py::list& arrays, const std::string& what, std::vector<FloatArray>& keep) {
+  std::vector<ImageView> out;
+  keep.reserve(keep.size() + arrays.size());
+  for (std::size_t i = 0; i < arrays.size(); ++i) {
+    keep.push_back(arrays[i].cast<FloatArray>());
+    out.push_back(py_bridge::view_of(keep.back(), concat(what, " ", i)));
+  }
+  return out;
+}
+
+py::list to_list(std::vector<Image>&& images) {
+  py::list out;
+  for (Image& i : images) out.append(py_bridge::to_numpy(std::move(i)));
+  return out;
+}
+
+FluidymationJobConfig job_config(const py::dict& d, const FluidymationOptions& options) {
+  FluidymationJobConfig c;
+  c.exemplar = d["exemplar"].cast<std::string>();
+  if (!d["exemplar_masks"].is_none()) c.exemplar_masks = d["exemplar_masks"].cast<std::string>();
+  c.guides = d["guides"].cast<std::string>();
+  c.frames = d["frames"].cast<std::vector<int>>();
+  c.out = d["out"].cast<std::string>();
+  c.target_mask = d["target_mask"].cast<std::string>();
+  if (!d["flow"].is_none()) c.flow = parse_enum<FlowSource>(d["flow"].cast<std::string>(), "flow");
+  c.format = d["format"].cast<std::string>();
+  c.resume = d["resume"].cast<bool>();
+  c.options = options;
+  return c;
+}
+
+}  // namespace
+
+void bind_fluidymation(py::module_& m) {
+  py_bridge::bind_options_class<FluidymationOptions>(m, "FluidymationOptions", fluidymation_option_table(),
+                                                     "Options of Fluidymation (native/include/tempera/fluidymation.hpp).")
+      .def_readwrite("synthesis", &FluidymationOptions::synthesis, "engine options (defaults: fluidymation_defaults())");
+  m.def("fluidymation_defaults", &fluidymation_defaults, "The engine options of Fluidymation.");
+  m.def(
+      "flow_from_masks",
+      [](const py::list& masks, float temporal_radius) {
+        std::vector<FloatArray> keep;
+        const std::vector<ImageView> v = views(masks, "mask", keep);
+        std::vector<Image> out;
+        {
+          py::gil_scoped_release release;
+          out = flow_from_masks(v, temporal_radius);
+        }
+        return to_list(std::move(out));
+      },
+      py::arg("masks"), py::arg("temporal_radius") = 3.0f, "Flows of a mask sequence (App. A); see mask_flow.hpp.");
+  m.def(
+      "motion_extent",
+      [](const py::list& flows, const py::list& masks) {
+        std::vector<FloatArray> keep;
+        const std::vector<ImageView> f = views(flows, "flow", keep), k = views(masks, "mask", keep);
+        MotionExtent e;
+        {
+          py::gil_scoped_release release;
+          e = motion_extent(f, k);
+        }
+        return py::make_tuple(to_list(std::move(e.forward)), to_list(std::move(e.backward)));
+      },
+      py::arg("flows"), py::arg("masks"), "ext+ and ext- per frame; see motion_extent.hpp.");
+  m.def(
+      "stylize_fluid_sequence",
+      [](const py::list& exemplar, const py::list& exemplar_masks, const py::list& target_masks,
+         const py::object& target_flows, const FluidymationOptions& options, const std::function<bool(double)>& progress) {
+        std::vector<FloatArray> keep;
+        FluidSequence seq;
+        seq.exemplar = views(exemplar, "exemplar frame", keep);
+        seq.exemplar_masks = views(exemplar_masks, "exemplar mask", keep);
+        seq.target_masks = views(target_masks, "target mask", keep);
+        if (!target_flows.is_none()) seq.target_flows = views(target_flows.cast<py::list>(), "target flow", keep);
+        ProgressCallback callback = py_bridge::with_gil([&](double f) { return progress ? progress(f) : true; });
+        std::vector<FluidFrame> out;
+        {
+          py::gil_scoped_release release;
+          out = stylize_fluid_sequence(seq, options, callback);
+        }
+        py::list result;
+        for (FluidFrame& f : out) {
+          py::dict d;
+          d["image"] = py_bridge::to_numpy(std::move(f.image));
+          d["nnf"] = py_bridge::to_numpy(std::move(f.nnf));
+          d["time_shift"] = py_bridge::to_numpy(std::move(f.time_shift));
+          d["energy"] = f.energy;
+          result.append(d);
+        }
+        return result;
+      },
+      py::arg("exemplar"), py::arg("exemplar_masks"), py::arg("target_masks"), py::arg("target_flows"),
+      py::arg("options"), py::arg("progress") = nullptr, "Use tempera.fluidymation.stylize_sequence.");
+  py::class_<FluidymationJob>(m, "FluidymationJob", "Fluidymation over a guide cache; use tempera.fluidymation.MediaJob.")
+      .def(py::init([](const py::dict& config, const FluidymationOptions& options) {
+             FluidymationJobConfig c = job_config(config, options);
+             py::gil_scoped_release release;  // reads the exemplar and the target's masks
+             return std::make_unique<FluidymationJob>(std::move(c));
+           }),
+           py::arg("config"), py::arg("options"))
+      .def_property_readonly("frames", &FluidymationJob::frames)
+      .def_property_readonly("warnings", &FluidymationJob::warnings)
+      .def_property_readonly("flow_from_guides", &FluidymationJob::flow_from_guides)
+      .def("output_path", &FluidymationJob::output_path)
+      .def(
+          "run_frame",
+          [](FluidymationJob& job, std::size_t index, const std::function<bool(double)>& progress) {
+            ProgressCallback callback;
+            if (progress) callback = py_bridge::with_gil([&](double f) { return progress(f); });
+            FluidJobFrame r;
+            {
+              py::gil_scoped_release release;
+              r = job.run_frame(index, callback);
+            }
+            return py::make_tuple(r.status, r.seconds);
+          },
+          py::arg("index"), py::arg("progress") = nullptr)
+      .def(
+          "write_contact_sheet",
+          [](const FluidymationJob& job, const std::string& path, int columns) {
+            py::gil_scoped_release release;
+            job.write_contact_sheet(path, columns);
+          },
+          py::arg("path"), py::arg("columns") = 0);
+}

@@ -1,0 +1,143 @@
+#include "tempera/mask_flow.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "tempera/error.hpp"
+#include "tempera/parallel.hpp"
+#include "tempera/signed_distance.hpp"
+
+namespace tempera {
+namespace {
+
+constexpr int kJacobiSweeps = 60;
+
+bool inside(const ImageView& mask, std::size_t i) { return mask.data[i] > 0.5f; }
+
+// Inside pixels next to the outside (distance below one pixel): where the
+// boundary's motion is measured.
+bool on_boundary(const Image& dist, std::size_t i) { return dist.data()[i] > 0.0f && dist.data()[i] < 1.0f; }
+
+// Known values averaged 2x2 down (weights = known count), for the coarse guess.
+void pull(const Image& v, const Image& w, Image& cv, Image& cw) {
+  const int cwid = (v.width() + 1) / 2, chei = (v.height() + 1) / 2;
+  cv = Image(cwid, chei, 2);
+  cw = Image(cwid, chei, 1);
+  for (int y = 0; y < v.height(); ++y)
+    for (int x = 0; x < v.width(); ++x) {
+      const float k = w.at(x, y, 0);
+      cw.at(x / 2, y / 2, 0) += k;
+      for (int c = 0; c < 2; ++c) cv.at(x / 2, y / 2, c) += k * v.at(x, y, c);
+    }
+  for (std::size_t i = 0; i < cw.pixel_count(); ++i) {
+    if (cw.data()[i] <= 0) continue;
+    for (int c = 0; c < 2; ++c) cv.data()[2 * i + c] /= cw.data()[i];
+    cw.data()[i] = 1.0f;
+  }
+}
+
+// Push-pull: every pixel without a known value gets the nearest coarser
+// level's average of known values (a smooth first guess that Jacobi then
+// only has to refine locally, instead of diffusing across the whole mask).
+Image push_pull(const Image& v, const Image& w) {
+  if (v.width() <= 1 && v.height() <= 1) return v;
+  Image cv, cw;
+  pull(v, w, cv, cw);
+  const Image coarse = push_pull(cv, cw);
+  Image out = v;
+  for (int y = 0; y < v.height(); ++y)
+    for (int x = 0; x < v.width(); ++x)
+      if (w.at(x, y, 0) <= 0)
+        for (int c = 0; c < 2; ++c) out.at(x, y, c) = coarse.at(x / 2, y / 2, c);
+  return out;
+}
+
+}  // namespace
+
+Image diffuse_fill(const ImageView& values, const ImageView& known, const ImageView& mask) {
+  const int w = mask.width, h = mask.height;
+  Image v(w, h, 2), k(w, h, 1);
+  for (std::size_t i = 0; i < mask.pixel_count(); ++i)
+    if (known.data[i] > 0.5f) {
+      k.data()[i] = 1.0f;
+      for (int c = 0; c < 2; ++c) v.data()[2 * i + c] = values.data[2 * i + c];
+    }
+  Image cur = push_pull(v, k), next = cur;
+  // Jacobi over the free inside pixels, neighbours outside the mask left
+  // out (a zero-flux border): deterministic for any thread count.
+  for (int sweep = 0; sweep < kJacobiSweeps; ++sweep) {
+    parallel_for(h, 0, [&](int y) {
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i = std::size_t(y) * w + x;
+        if (!inside(mask, i) || k.data()[i] > 0) continue;
+        float sum[2] = {0, 0};
+        int n = 0;
+        const int nb[4][2] = {{x - 1, y}, {x + 1, y}, {x, y - 1}, {x, y + 1}};
+        for (const auto& q : nb) {
+          if (q[0] < 0 || q[1] < 0 || q[0] >= w || q[1] >= h) continue;
+          const std::size_t j = std::size_t(q[1]) * w + q[0];
+          if (!inside(mask, j)) continue;
+          sum[0] += cur.data()[2 * j], sum[1] += cur.data()[2 * j + 1], ++n;
+        }
+        if (n) next.data()[2 * i] = sum[0] / n, next.data()[2 * i + 1] = sum[1] / n;
+      }
+    });
+    std::swap(cur, next);
+  }
+  for (std::size_t i = 0; i < mask.pixel_count(); ++i)
+    if (!inside(mask, i)) cur.data()[2 * i] = cur.data()[2 * i + 1] = 0;
+  return cur;
+}
+
+std::vector<Image> flow_from_masks(const std::vector<ImageView>& masks, float temporal_radius) {
+  if (masks.size() < 2) throw ValueError(concat("flow from masks needs at least 2 masks, got ", masks.size()));
+  if (!(temporal_radius >= 0) || !std::isfinite(temporal_radius))
+    throw ValueError(concat("temporal radius must be >= 0, got ", temporal_radius));
+  for (std::size_t i = 0; i < masks.size(); ++i) {
+    require_nonempty(masks[i], concat("mask ", i));
+    if (masks[i].channels != 1) throw ValueError(concat("mask ", i, " must have 1 channel, got ", masks[i].channels));
+    require_same_size(masks[i], concat("mask ", i), masks[0], "mask 0");
+  }
+  const std::size_t n = masks.size();
+  std::vector<Image> dist;
+  for (const ImageView& m : masks) dist.push_back(signed_distance(m));
+  std::vector<Image> raw;
+  for (std::size_t i = 0; i < n; ++i) {
+    // The last frame measures its boundary against the frame before.
+    const std::size_t a = i + 1 < n ? i : i - 1, b = a + 1;
+    const Image g = gradient(dist[i].view());
+    Image boundary(masks[i].width, masks[i].height, 2), known(masks[i].width, masks[i].height, 1);
+    for (std::size_t p = 0; p < boundary.pixel_count(); ++p) {
+      if (!on_boundary(dist[i], p)) continue;
+      const float gx = g.data()[2 * p], gy = g.data()[2 * p + 1], len = std::hypot(gx, gy);
+      if (len < 1e-6f) continue;
+      const float speed = -(dist[b].data()[p] - dist[a].data()[p]);
+      boundary.data()[2 * p] = speed * gx / len, boundary.data()[2 * p + 1] = speed * gy / len;
+      known.data()[p] = 1.0f;
+    }
+    raw.push_back(diffuse_fill(boundary.view(), known.view(), masks[i]));
+  }
+  if (temporal_radius <= 0) return raw;
+  const int r = int(std::ceil(temporal_radius));
+  const float sigma = temporal_radius / 2.0f;
+  std::vector<Image> out;
+  for (std::size_t i = 0; i < n; ++i) {
+    Image f(raw[i].width(), raw[i].height(), 2);
+    for (std::size_t p = 0; p < f.pixel_count(); ++p) {
+      if (!inside(masks[i], p)) continue;
+      double sum[2] = {0, 0}, wsum = 0;
+      for (int d = -r; d <= r; ++d) {
+        const long k = long(i) + d;
+        if (k < 0 || k >= long(n) || !inside(masks[std::size_t(k)], p)) continue;
+        const double wt = std::exp(-0.5 * d * d / (sigma * sigma));
+        sum[0] += wt * raw[std::size_t(k)].data()[2 * p], sum[1] += wt * raw[std::size_t(k)].data()[2 * p + 1];
+        wsum += wt;
+      }
+      f.data()[2 * p] = float(sum[0] / wsum), f.data()[2 * p + 1] = float(sum[1] / wsum);
+    }
+    out.push_back(std::move(f));
+  }
+  return out;
+}
+
+}  // namespace tempera

@@ -1,0 +1,316 @@
+// Fluidymation (Platkevič et al. 2021): the flow from masks (App. A), the
+// motion extents, SHIFTNNF and the method's terms, on tiny synthetic discs.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <tuple>
+#include <vector>
+
+#include "tempera/fluidymation.hpp"
+#include "tempera/mask_flow.hpp"
+#include "tempera/motion_extent.hpp"
+#include "tempera/signed_distance.hpp"
+
+using namespace tempera;
+
+namespace {
+
+constexpr float kPi = 3.14159265f;
+
+Image disc(int w, int h, float cx, float cy, float radius) {
+  Image m(w, h, 1);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) m.at(x, y, 0) = std::hypot(x - cx, y - cy) <= radius ? 1.0f : 0.0f;
+  return m;
+}
+
+std::vector<Image> discs(int size, int frames, float r0, float speed) {
+  std::vector<Image> out;
+  for (int i = 0; i < frames; ++i) out.push_back(disc(size, size, size / 2.0f, size / 2.0f, r0 + speed * i));
+  return out;
+}
+
+std::vector<ImageView> views(const std::vector<Image>& images) {
+  std::vector<ImageView> out;
+  for (const Image& i : images) out.push_back(i.view());
+  return out;
+}
+
+// An ink-like exemplar frame: rings that travel outward with the disc's
+// front, over a little noise.
+Image ink(const Image& mask, float radius) {
+  Image out(mask.width(), mask.height(), 3);
+  for (int y = 0; y < mask.height(); ++y)
+    for (int x = 0; x < mask.width(); ++x) {
+      if (mask.at(x, y, 0) <= 0.5f) continue;
+      const float r = std::hypot(x - mask.width() / 2.0f, y - mask.height() / 2.0f);
+      const float ring = 0.5f + 0.5f * std::sin(2 * kPi * (radius - r) / 6.0f);
+      const float noise = float((x * 73856093u ^ y * 19349663u) % 97u) / 97.0f;
+      out.at(x, y, 0) = 0.2f + 0.6f * ring;
+      out.at(x, y, 1) = 0.3f + 0.2f * noise;
+      out.at(x, y, 2) = 0.9f - 0.5f * ring;
+    }
+  return out;
+}
+
+float axial_difference(float a, float b) {
+  float d = std::fmod(std::abs(a - b), kPi);
+  return std::min(d, kPi - d);
+}
+
+float median(std::vector<float> v) {
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+TEST(Fluidymation, SignedDistanceIsPositiveInsideAndGradientPointsInward) {
+  const Image m = disc(32, 32, 16, 16, 8);
+  const Image d = signed_distance(m.view());
+  EXPECT_NEAR(d.at(16, 16, 0), 8.0f, 1.0f);
+  EXPECT_LT(d.at(2, 2, 0), -10.0f);
+  const Image g = gradient(d.view());
+  EXPECT_LT(g.at(20, 16, 0), 0.0f);  // right of the centre the inside lies to the left
+}
+
+// F1: an expanding disc of speed c flows radially outward at c on its boundary, and 0 outside.
+TEST(Fluidymation, F1ExpandingDiscFlowsRadiallyOutwardAtItsSpeed) {
+  const float c = 2.0f;
+  const std::vector<Image> masks = discs(128, 10, 30, c);
+  const std::vector<Image> flow = flow_from_masks(views(masks));
+  const int i = 5;
+  const Image& f = flow[i];
+  const Image dist = signed_distance(masks[i].view());
+  double speed = 0;
+  int ring = 0;
+  std::vector<float> errors;
+  for (int y = 0; y < 128; ++y)
+    for (int x = 0; x < 128; ++x) {
+      const float fx = f.at(x, y, 0), fy = f.at(x, y, 1);
+      if (masks[i].at(x, y, 0) <= 0.5f) {
+        ASSERT_EQ(fx, 0.0f);
+        ASSERT_EQ(fy, 0.0f);
+        continue;
+      }
+      const float rx = x - 64.0f, ry = y - 64.0f, r = std::hypot(rx, ry);
+      if (r < 6) continue;
+      const float cosine = (fx * rx + fy * ry) / (std::hypot(fx, fy) * r + 1e-9f);
+      errors.push_back(std::acos(std::clamp(cosine, -1.0f, 1.0f)));
+      if (dist.at(x, y, 0) < 1.0f) speed += std::hypot(fx, fy), ++ring;
+    }
+  EXPECT_LT(median(errors), 5 * kPi / 180) << "directed: outward, not inward";
+  EXPECT_LT(*std::max_element(errors.begin(), errors.end()), 30 * kPi / 180);
+  ASSERT_GT(ring, 100);
+  EXPECT_NEAR(speed / ring, c, 0.1 * c);
+}
+
+// F2: under a constant flow ext+ grows linearly with the frame and is 0 outside the mask.
+TEST(Fluidymation, F2MotionExtentIsLinearUnderConstantFlowAndZeroOutside) {
+  const int n = 8;
+  std::vector<Image> masks, flows;
+  for (int i = 0; i < n; ++i) {
+    Image m(16, 8, 1, 1.0f);
+    for (int y = 0; y < 8; ++y) m.at(15, y, 0) = 0.0f;  // a column outside
+    masks.push_back(m);
+    Image f(16, 8, 2);
+    for (std::size_t p = 0; p < f.pixel_count(); ++p) f.data()[2 * p] = 1.5f, f.data()[2 * p + 1] = -2.0f;
+    flows.push_back(f);
+  }
+  const MotionExtent e = motion_extent(views(flows), views(masks));
+  for (int i = 0; i < n; ++i) {
+    EXPECT_NEAR(e.forward[i].at(3, 4, 0), 2.5f * i, 1e-4f);
+    EXPECT_NEAR(e.backward[i].at(3, 4, 0), 2.5f * (n - 1 - i), 1e-4f);
+    EXPECT_EQ(e.forward[i].at(15, 4, 0), 0.0f);
+    EXPECT_EQ(e.backward[i].at(15, 4, 0), 0.0f);
+  }
+}
+
+namespace {
+
+// The exemplar: a disc spreading at speed s (rings travelling with it).
+struct InkExemplar {
+  std::vector<Image> masks, frames;
+  InkExemplar(int size, int n, float r0, float s) : masks(discs(size, n, r0, s)) {
+    for (int i = 0; i < n; ++i) frames.push_back(ink(masks[std::size_t(i)], r0 + s * i));
+  }
+};
+
+// Iterates SHIFTNNF from "every pixel at exemplar frame 0, its own
+// position" and returns the exemplar-time speed (frames advanced x s per
+// target frame) over the pixels inside the first target mask.
+double shifted_speed(float s, float c, TimeShift mode, int steps, bool shrinking = false,
+                     double* share_backward = nullptr) {
+  const int size = 96, n = 24;
+  const InkExemplar ex(size, n, 10, s);
+  const std::vector<Image> target = shrinking ? discs(size, steps + 1, 10 + c * steps, -c) : discs(size, steps + 1, 10, c);
+  FluidSequence seq;
+  seq.exemplar = views(ex.frames);
+  seq.exemplar_masks = views(ex.masks);
+  seq.target_masks = views(target);
+  FluidymationOptions o = default_fluidymation_options();
+  o.time_shift = mode;
+  const Fluidymation fm(seq, o);
+  const int start = shrinking ? int(std::lround(c * steps / s)) : 0;
+  FluidNnf nnf(size, size, 4);
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      float* m = nnf.pixel(x, y);
+      m[0] = target[0].at(x, y, 0) > 0.5f ? float(start) : -1.0f;
+      m[1] = float(x), m[2] = float(y), m[3] = 0;
+    }
+  int backward = 0, counted = 0;
+  for (int j = 1; j <= steps; ++j) {
+    Image shift;
+    nnf = fm.shift_nnf(j, nnf, &shift);
+    for (std::size_t q = 0; q < shift.pixel_count(); ++q)
+      if (nnf.data()[4 * q] >= 0) backward += shift.data()[q] <= 0, ++counted;
+    for (std::size_t q = 0; q < nnf.pixel_count(); ++q)  // leaving the target: no match next frame
+      if (target[std::size_t(j)].data()[q] <= 0.5f) nnf.data()[4 * q] = -1;
+  }
+  if (share_backward) *share_backward = double(backward) / counted;
+  double sum = 0;
+  int count = 0;
+  for (std::size_t q = 0; q < nnf.pixel_count(); ++q)
+    if (nnf.data()[4 * q] >= 0) sum += std::abs(nnf.data()[4 * q] - start), ++count;
+  return s * sum / count / steps;
+}
+
+}  // namespace
+
+// F3: SHIFTNNF advances exemplar time at the target's speed: s/2, s and 2s
+// within 15%; a fixed delta i = 1 cannot keep up at 2s.
+TEST(Fluidymation, F3ShiftFollowsTheTargetSpeedAndFixedShiftFailsAtTwiceTheSpeed) {
+  const float s = 1.0f;
+  for (float c : {0.5f * s, s, 2 * s}) EXPECT_NEAR(shifted_speed(s, c, TimeShift::Extent, 8), c, 0.15 * c) << c;
+  EXPECT_GT(std::abs(shifted_speed(s, 2 * s, TimeShift::One, 8) - 2 * s), 0.15 * 2 * s);
+}
+
+// F5: a shrinking target matched to a spreading exemplar plays it backward.
+TEST(Fluidymation, F5ShrinkingDiscShiftsBackwardInExemplarTime) {
+  double share = 0;
+  shifted_speed(1.0f, 1.0f, TimeShift::Extent, 6, true, &share);
+  EXPECT_GE(share, 0.9);
+}
+
+namespace {
+
+struct SmallShot {
+  InkExemplar ex{48, 12, 6, 1.5f};
+  std::vector<Image> target = discs(48, 3, 8, 1.5f);
+  FluidSequence seq() const {
+    FluidSequence s;
+    s.exemplar = views(ex.frames);
+    s.exemplar_masks = views(ex.masks);
+    s.target_masks = views(target);
+    return s;
+  }
+};
+
+FluidymationOptions small_options() {
+  FluidymationOptions o = default_fluidymation_options();
+  o.shape_blur = 6;
+  o.synthesis.levels = 2;
+  o.synthesis.threads = 1;
+  return o;
+}
+
+// Median axial angle between the target flow and the exemplar flow at the match, rotated into the target.
+float direction_error(const Fluidymation& fm, const FluidFrame& f, int j, const SmallShot& shot) {
+  std::vector<float> errors;
+  const Image& tf = fm.target_flow(j);
+  for (int y = 0; y < 48; ++y)
+    for (int x = 0; x < 48; ++x) {
+      const float* m = f.nnf.pixel(x, y);
+      const float tx = tf.at(x, y, 0), ty = tf.at(x, y, 1);
+      if (m[0] < 0 || std::hypot(tx, ty) < 0.3f) continue;
+      const Image& sf = fm.exemplar_flow(int(std::lround(m[0])));
+      const int sx = std::clamp(int(std::lround(m[1])), 0, 47), sy = std::clamp(int(std::lround(m[2])), 0, 47);
+      const float a = std::atan2(sf.at(sx, sy, 1), sf.at(sx, sy, 0)) - m[3];
+      errors.push_back(axial_difference(a, std::atan2(ty, tx)));
+    }
+  (void)shot;
+  return median(errors);
+}
+
+}  // namespace
+
+// F4: with the rotation from the flow angles the exemplar flow follows the
+// target's; with rotation off (`rotate` = false) it does not.
+TEST(Fluidymation, F4RotatedExemplarFlowFollowsTheTargetFlow) {
+  const SmallShot shot;
+  FluidymationOptions o = small_options();
+  const Fluidymation on(shot.seq(), o);
+  const FluidFrame a = on.solve_frame(1, nullptr);
+  EXPECT_LT(direction_error(on, a, 1, shot), 10 * kPi / 180);
+  o.rotate = false;
+  const Fluidymation off(shot.seq(), o);
+  const FluidFrame b = off.solve_frame(1, nullptr);
+  EXPECT_GT(direction_error(off, b, 1, shot), 30 * kPi / 180);
+}
+
+// F6: the footprint term spreads matches over more of the exemplar (i, x, y).
+TEST(Fluidymation, F6UniformityCoversMoreOfTheExemplar) {
+  const SmallShot shot;
+  auto coverage = [&](float w) {
+    FluidymationOptions o = small_options();
+    o.uniformity_weight = w;
+    const FluidFrame f = Fluidymation(shot.seq(), o).solve_frame(2, nullptr);
+    std::set<std::tuple<int, int, int>> used;
+    for (std::size_t q = 0; q < f.nnf.pixel_count(); ++q) {
+      const float* m = f.nnf.data() + 4 * q;
+      if (m[0] >= 0) used.emplace(int(std::lround(m[0])), int(std::lround(m[1])), int(std::lround(m[2])));
+    }
+    return used.size();
+  };
+  EXPECT_GT(coverage(1.0f), 1.1 * coverage(0.0f));
+}
+
+TEST(Fluidymation, SameResultForAnyThreadCount) {
+  const SmallShot shot;
+  FluidymationOptions o = small_options();
+  const std::vector<FluidFrame> one = stylize_fluid_sequence(shot.seq(), o);
+  o.synthesis.threads = 2;
+  const std::vector<FluidFrame> two = stylize_fluid_sequence(shot.seq(), o);
+  ASSERT_EQ(one.size(), two.size());
+  for (std::size_t j = 0; j < one.size(); ++j) {
+    const std::size_t n = one[j].image.pixel_count() * one[j].image.channels();
+    EXPECT_TRUE(std::equal(one[j].image.data(), one[j].image.data() + n, two[j].image.data())) << j;
+  }
+}
+
+// Output only inside the target mask; the temporal term makes consecutive
+// frames closer than solving each frame alone.
+TEST(Fluidymation, TemporalTermKeepsFramesCloser) {
+  const SmallShot shot;
+  FluidymationOptions o = small_options();
+  const std::vector<FluidFrame> coherent = stylize_fluid_sequence(shot.seq(), o);
+  const Fluidymation fm(shot.seq(), o);
+  const FluidFrame alone = fm.solve_frame(2, nullptr);
+  auto difference = [&](const Image& a, const Image& b) {
+    double sum = 0;
+    int n = 0;
+    for (std::size_t q = 0; q < a.pixel_count(); ++q)
+      if (shot.target[1].data()[q] > 0.5f)
+        for (int c = 0; c < 3; ++c) sum += std::abs(a.data()[3 * q + c] - b.data()[3 * q + c]), ++n;
+    return sum / n;
+  };
+  for (std::size_t q = 0; q < coherent[2].image.pixel_count(); ++q)
+    if (shot.target[2].data()[q] <= 0.5f) ASSERT_EQ(coherent[2].image.data()[3 * q], 0.0f);
+  EXPECT_LT(difference(coherent[2].image, coherent[1].image), difference(alone.image, coherent[1].image));
+}
+
+TEST(Fluidymation, BadInputIsAValueError) {
+  const SmallShot shot;
+  FluidSequence s = shot.seq();
+  s.target_masks.resize(1);
+  EXPECT_THROW(Fluidymation(s, small_options()), ValueError);
+  FluidymationOptions o = small_options();
+  o.modulation_upper = 0.001f;
+  EXPECT_THROW(Fluidymation(shot.seq(), o), ValueError);
+  const Fluidymation fm(shot.seq(), small_options());
+  EXPECT_THROW(fm.solve_frame(5, nullptr), ValueError);
+  EXPECT_THROW(fm.shift_nnf(1, Image(3, 3, 4)), ValueError);
+}
