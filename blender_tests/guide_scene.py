@@ -14,6 +14,16 @@ CUBE_START, CUBE_STEP = Vector((-1.0, 0.0, -0.4)), Vector((0.5, 0.0, 0.2))  # at
 PARAMS = {"samples": 8, "ld12e_samples": 8}
 
 
+def cube_mesh(name, size):
+    """A new cube mesh of edge `size` centred on its origin."""
+    me = bpy.data.meshes.new(name)
+    s = size / 2
+    verts = [(x, y, z) for x in (-s, s) for y in (-s, s) for z in (-s, s)]
+    faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    me.from_pydata(verts, [], faces)
+    return me
+
+
 def build_scene(name="Guide render test"):
     scene = bpy.data.scenes.new(name)
     scene.render.engine = compat.eevee_engine()  # saved with EEVEE: guides still come from Cycles
@@ -22,11 +32,7 @@ def build_scene(name="Guide render test"):
     scene.frame_start, scene.frame_end = 1, 5
 
     def mesh(name, size, location, collection):
-        me = bpy.data.meshes.new(name)
-        s = size / 2
-        verts = [(x, y, z) for x in (-s, s) for y in (-s, s) for z in (-s, s)]
-        faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
-        me.from_pydata(verts, [], faces)
+        me = cube_mesh(name, size)
         mat = bpy.data.materials.new(name)
         mat.diffuse_color = (0.7, 0.3, 0.2, 1) if name == "MovingCube" else (0.5, 0.5, 0.55, 1)
         me.materials.append(mat)

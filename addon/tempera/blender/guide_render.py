@@ -6,6 +6,9 @@ Per frame: one main render with the light-path, motion, depth, normal and
 object-index passes, and a second render with one diffuse and no glossy or
 transmission bounce for LD{1,2}E. The derived guides (velocities, occlusion,
 structure tensor, lines, masks) are computed with numpy and tempera.guides.
+Scenes with fluids (gas and liquid domains, emitter particles) also get the
+fluid_velocity guide from the simulation (tempera.blender.fluid_velocity),
+since the Vector pass is zero on volumes.
 Guides of arbitrary light path expressions (params["lpe"]) come from
 Tempera's own path tracer on the exported scene (scene_export, tempera.lpe).
 
@@ -24,7 +27,7 @@ import bpy
 import numpy as np
 
 from .. import guide_cache, guides, image_info, read_image
-from . import compat, rigid_tracks
+from . import compat, fluid_velocity, rigid_tracks
 from ..frames import MAX_FRAME, check_frame
 from ..lpe import check_lpe, trace_lpe
 from ..stylize import tonemap
@@ -584,8 +587,12 @@ def _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress, 
     # An interrupted run keeps every frame finished so far, and `tmp` holds at
     # most three frames' renders.
     renders = {}
+    has_fluids = bool(fluid_velocity.fluid_objects(scene))
+    fluids = {}  # frame -> (fluid samples, camera matrix), read before the frame's render
 
     def render(frame):
+        if has_fluids:
+            fluids[frame] = _fluid_state(scene, layer, frame)
         _configure(scene, layer, params["samples"], main_passes, params["seed"])
         main = _render(scene, tmp / f"main_{frame}.exr", frame)
         _configure(scene, layer, params["ld12e_samples"], LD12E_PASSES, params["seed"])
@@ -618,6 +625,10 @@ def _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress, 
         v_minus_next, _ = guide_cache.velocities_from_vector_pass(vector_pass(frame + 1))
         frame_data = frame_guides(main, ld12e, v_plus_prev, v_minus_next, masks, params)
         height, width = main["Combined"].shape[:2]
+        samples, clip = fluids.pop(frame, (None, None))
+        if samples is not None:
+            frame_data["fluid_velocity"] = fluid_velocity.fluid_velocity_guide(samples, clip,
+                                                                               main["Combined"][:, :, 3])
         if params["lpe"]:
             step(i, f"tracing the light path expressions of frame {frame}")
             traced, frame_warnings = trace_lpe_guides(scene, layer, frame, (width, height), params, paths)
@@ -654,6 +665,16 @@ def _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress, 
             finish(done, frame)
             done += 1
     return warnings
+
+
+def _fluid_state(scene, layer, frame):
+    """(fluid samples or None, world to clip matrix) of `frame`, read from the
+    evaluated scene before it is rendered (a render can leave Blender 3.4's
+    evaluated objects stale: scene_export.evaluated_depsgraph)."""
+    scene.frame_set(frame)
+    depsgraph = layer.depsgraph
+    return (fluid_velocity.scene_fluid_samples(scene, depsgraph),
+            fluid_velocity.world_to_clip(scene, depsgraph, effective_resolution(scene)))
 
 
 @contextmanager
