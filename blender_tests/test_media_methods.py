@@ -12,9 +12,10 @@ import bpy
 import numpy as np
 import pytest
 from fake_ui import esc_within_next_step
-from guide_scene import FRAMES, SIZE, build_scene, remove_scene
+from guide_scene import FRAMES, RESOLUTION, build_scene, remove_scene
 
 SCENE = "Media methods test"
+SIZE = RESOLUTION  # at 100 %: the blurred-alpha boundary (r = 3 px) small beside the cube
 EXEMPLAR_SIZE = 32
 MEDIA_FRAMES = 8
 
@@ -39,6 +40,7 @@ def media_scene(tmp_path):
 
     scene = build_scene(SCENE)
     bpy.data.objects.remove(scene.objects["Backdrop"])
+    scene.render.resolution_percentage = 100
     shown = bpy.context.window.scene.name
     bpy.context.window.scene = scene
     still = tmp_path / "smoke.png"
@@ -193,3 +195,44 @@ def test_esc_within_a_frame_writes_nothing_then_resume(media_scene, tmp_path):
     written = sorted(p.name for p in (tmp_path / "out" / "lazyfluids").rglob("frame_*.png"))
     assert written == [f"frame_{FRAMES[0]:04d}.png"]  # the first frame only, nothing half-written
     assert _rerun(media_scene) == ["skipped", "stylized", "stylized"]
+
+
+def test_fluid_method_on_a_baked_smoke_domain(tmp_path):
+    """LazyFluids from the panel on Mantaflow smoke: its alpha follows the
+    smoke's, the flow is the fluid_velocity guide (the Vector pass is zero there)."""
+    import tempera
+    from tempera import guide_cache
+    from test_fluid_velocity import FRAMES as SMOKE_FRAMES, _bake, build_smoke_scene, mantaflow_problem
+
+    problem = mantaflow_problem()
+    if problem:
+        pytest.skip(f"Blender {bpy.app.version_string} cannot simulate fluids ({problem})")
+    scene, domain = build_smoke_scene(str(tmp_path / "fluid_cache"))
+    shown = bpy.context.window.scene
+    try:
+        _bake(scene, domain)
+        bpy.context.window.scene = scene
+        scene.render.resolution_x, scene.render.resolution_y = 192, 120  # three times the guide test's
+        tempera.write_image(str(tmp_path / "smoke.png"), _medium(MEDIA_FRAMES - 1, MEDIA_FRAMES), [])
+        s = scene.tempera
+        s.method, s.media_exemplar_kind, s.media_exemplar = "LAZYFLUIDS", "STILL", str(tmp_path / "smoke.png")
+        s.output_dir, s.guide_dir = str(tmp_path / "out"), str(tmp_path / "guides")
+        s.guide_frame_range = "CUSTOM"
+        s.guide_frame_start, s.guide_frame_end = SMOKE_FRAMES[0], SMOKE_FRAMES[-1]
+        s.guide_samples, s.guide_lpe, s.guide_masks, s.make_video = 4, "", "NONE", False
+        assert bpy.ops.tempera.stylize(mode="ANIMATION") == {"FINISHED"}
+        assert "fluid_velocity" in guide_cache.read_manifest(tmp_path / "guides")["guides"]
+        for frame in SMOKE_FRAMES:
+            out = tempera.read_image(str(tmp_path / "out" / "lazyfluids" / "frames" / f"frame_{frame:04d}.png"))
+            alpha = guide_cache.read_frame(tmp_path / "guides", frame, ["alpha"])["alpha"]
+            assert (alpha > 0.5).sum() > 50
+            assert _iou(out[..., 3] > 0.5, alpha > 0.5) >= 0.9, frame
+        assert scene.name + " Tempera Composite" in bpy.data.scenes
+    finally:
+        bpy.context.window.scene = shown
+        composite = bpy.data.scenes.get(scene.name + " Tempera Composite")
+        if composite is not None:
+            bpy.data.scenes.remove(composite)
+        for obj in list(scene.objects):
+            bpy.data.objects.remove(obj)
+        bpy.data.scenes.remove(scene)

@@ -40,14 +40,10 @@ DEFAULT_QUALITY = _native.stylit_defaults()["quality"]
 QUALITY_PRESETS = ("preview", "final")
 OUTPUT_FORMATS = ("png", "exr")
 
-# The fluid methods' options the panel shows, rows as in the native option
-# tables (name -> default, min, max): LazyFluids (thesis §5.5: λ = 0.2, no
-# rotations, no motion blur) and Fluidymation (one forward pass, as in the paper).
-LAZYFLUIDS_PANEL = {
-    "temporal_weight": {"default": 0.2, "min": 0.0, "max": 1.0},
-    "rotations": {"default": False},
-    "motion_blur": {"default": 0.0, "min": 0.0, "max": 16.0},
-}
-FLUIDYMATION_PANEL = {
-    "bidirectional": {"default": False},
-}
+# The fluid methods' option tables (name -> row, as ENGINE_OPTIONS):
+# LazyFluids (lazyfluids.hpp) and Fluidymation (fluidymation.hpp). The panel
+# shows λ, rotations and motion blur of the one, bidirectional of the other;
+# its sliders stop at these soft maxima (the tables take more, for scripts).
+LAZYFLUIDS_OPTIONS = {row["name"]: row for row in _native.LazyFluidsOptions.table()}
+FLUIDYMATION_OPTIONS = {row["name"]: row for row in _native.FluidymationOptions.table()}
+PANEL_SOFT_MAX = {"temporal_weight": 1.0, "motion_blur": 16.0}

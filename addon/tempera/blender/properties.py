@@ -127,6 +127,7 @@ RIGID_OUTPUTS = (
     ("PAPER", "On Paper", "Opaque frames: the drawn bodies on paper"),
 )
 DEFAULT_KEYFRAME_DIR = "//tempera/keys/"
+_LF = limits.LAZYFLUIDS_OPTIONS
 
 
 class TemperaKeyframe(PropertyGroup):
@@ -358,16 +359,16 @@ class TemperaSettings(PropertyGroup):
         name="Masks", subtype="DIR_PATH", default="",
         description="Optional: a folder of the exemplar's mask frames (white = medium); empty: its alpha")
     lf_lambda: FloatProperty(
-        name="Temporal Coherence", default=limits.LAZYFLUIDS_PANEL["temporal_weight"]["default"],
-        min=limits.LAZYFLUIDS_PANEL["temporal_weight"]["min"], soft_max=limits.LAZYFLUIDS_PANEL["temporal_weight"]["max"],
+        name="Temporal Coherence", default=_LF["temporal_weight"]["default"], min=_LF["temporal_weight"]["min"],
+        soft_max=limits.PANEL_SOFT_MAX["temporal_weight"],
         description="λ, the pull of the previous frame carried along the flow (thesis eq. 5.6): higher flickers less "
         "but lets the texture smear; 0 paints every frame afresh")
     lf_rotations: BoolProperty(
-        name="Rotations", default=limits.LAZYFLUIDS_PANEL["rotations"]["default"],
+        name="Rotations", default=_LF["rotations"]["default"],
         description="Also use the exemplar turned by 90, 180 and 270 degrees (more patches, for swirling flows)")
     lf_motion_blur: FloatProperty(
-        name="Motion Blur", default=limits.LAZYFLUIDS_PANEL["motion_blur"]["default"],
-        min=limits.LAZYFLUIDS_PANEL["motion_blur"]["min"], soft_max=limits.LAZYFLUIDS_PANEL["motion_blur"]["max"],
+        name="Motion Blur", default=_LF["motion_blur"]["default"], min=_LF["motion_blur"]["min"],
+        soft_max=limits.PANEL_SOFT_MAX["motion_blur"],
         subtype="PIXEL", description="Length in pixels of the blur along the flow; 0 = none")
     fm_target_object: PointerProperty(
         name="Target Object", type=bpy.types.Object,
@@ -379,6 +380,6 @@ class TemperaSettings(PropertyGroup):
     fm_flow: EnumProperty(name="Flow", items=MEDIA_FLOWS, default="GUIDES",
                           description="Where the target's motion comes from")
     fm_bidirectional: BoolProperty(
-        name="Bidirectional", default=limits.FLUIDYMATION_PANEL["bidirectional"]["default"],
+        name="Bidirectional", default=limits.FLUIDYMATION_OPTIONS["bidirectional"]["default"],
         description="A forward and a backward pass merged (the paper's future work): the medium also leads "
         "into where the target will be; twice the time")

@@ -509,7 +509,6 @@ class RgbaRun(StylizeRun):
         if result["status"] == "stylized":
             self.stylize_seconds += result["seconds"]
         path = str(self.job.output_path(self.frames[i]))
-        self.config["out"] = os.path.dirname(path)
         self.results.append({"frame": self.frames[i], "path": path, "status": result["status"]})
         if bpy.app.background:
             print(f"Tempera: {self.method_label} frame {self.frames[i]} {result['status']} "
@@ -535,7 +534,7 @@ class FluidRun(RgbaRun):
     def make_method_job(self):
         from ..lazyfluids import FluidJob
 
-        return FluidJob(self.exemplar, self.guides.folder, self.frames, self.method_out,
+        return FluidJob(self.exemplar, self.guides.folder, self.frames, self.config["out"],
                         format=self.config["format"], **self.options)
 
 
@@ -570,7 +569,7 @@ class MediaRun(RgbaRun):
     def make_method_job(self):
         from ..fluidymation import MediaJob
 
-        return MediaJob(self.exemplar, self.guides.folder, self.frames, self.method_out,
+        return MediaJob(self.exemplar, self.guides.folder, self.frames, self.config["out"],
                         exemplar_masks=self.exemplar_masks, target_mask=self.target_mask,
                         format=self.config["format"], **self.options)
 
