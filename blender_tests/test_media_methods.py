@@ -15,7 +15,7 @@ from fake_ui import esc_within_next_step
 from guide_scene import FRAMES, RESOLUTION, build_scene, remove_scene
 
 SCENE = "Media methods test"
-SIZE = RESOLUTION  # at 100 %: the blurred-alpha boundary (r = 3 px) small beside the cube
+SIZE = RESOLUTION  # at 100 % and a larger cube: the blurred-alpha boundary (r = 3 px) small beside it
 EXEMPLAR_SIZE = 32
 MEDIA_FRAMES = 8
 
@@ -41,6 +41,7 @@ def media_scene(tmp_path):
     scene = build_scene(SCENE)
     bpy.data.objects.remove(scene.objects["Backdrop"])
     scene.render.resolution_percentage = 100
+    scene.objects["MovingCube"].scale = (1.4, 1.4, 1.4)  # about 40 x 40 pixels
     shown = bpy.context.window.scene.name
     bpy.context.window.scene = scene
     still = tmp_path / "smoke.png"
