@@ -147,6 +147,16 @@ def test_fluid_method_end_to_end_and_resume(media_scene, tmp_path):
     assert _rerun(media_scene) == ["skipped"] * len(FRAMES)
 
 
+def test_stylize_frame_runs_the_fluid_method_on_that_frame(media_scene, tmp_path):
+    media_scene.tempera.method = "LAZYFLUIDS"
+    media_scene.frame_set(FRAMES[1])
+    assert bpy.ops.tempera.stylize(mode="FRAME") == {"FINISHED"}
+    written = sorted(p.name for p in (tmp_path / "out" / "lazyfluids" / "frames").glob("frame_*.png"))
+    assert written == [f"frame_{FRAMES[1]:04d}.png"]
+    image = bpy.data.images["Tempera frames " + str(FRAMES[1])]  # shown in the Image Editor, as StyLit's
+    assert bpy.path.abspath(image.filepath) == str(tmp_path / "out" / "lazyfluids" / "frames" / written[0])
+
+
 def _movie(tmp_path):
     movie = tmp_path / "ink.mov"
     frames = str(tmp_path / "ink" / "ink_%04d.png")

@@ -159,7 +159,7 @@ class StylizeRun:
             return CoherentRun(scene, frames, mode)
         if mode == "ANIMATION" and scene.tempera.method == "RIGID":
             return RigidRun(scene, frames, mode)
-        if mode == "ANIMATION" and scene.tempera.method in RGBA_RUNS:
+        if scene.tempera.method in RGBA_RUNS:  # Stylize Frame too: the method on that frame alone
             return RGBA_RUNS[scene.tempera.method](scene, frames, mode)
         return cls(scene, frames, mode)
 
