@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""Regenerates docs/images/lazyfluids.png: a smoke-like exemplar carried
-around a rotating disc for 40 frames, frames 1, 10, 20 and 40 with strict
-uniform usage (top) and with usage none (bottom), over dark grey.
+"""Regenerates docs/images/lazyfluids.png: a smoke-like exemplar whose
+contrast grows from left to right (bench_lazyfluids.graded_smoke) carried
+around a rotating disc for 40 frames with λ = 3, frames 1, 10, 20 and 40 with
+strict uniform usage (top) and with usage none (bottom), over dark grey.
 
     PYTHONPATH=addon /usr/bin/python3 docs/make_lazyfluids_figures.py
 """
@@ -15,7 +16,7 @@ from tempera import lazyfluids
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "bench"))
-from bench_lazyfluids import rotating_disc, smoke  # noqa: E402
+from bench_lazyfluids import graded_smoke, rotating_disc  # noqa: E402
 
 FRAMES, SHOWN, SIDE, SCALE = 40, (1, 10, 20, 40), 72, 3
 
@@ -36,12 +37,12 @@ def row(images, gap=6):
 
 
 def main():
-    exemplar = smoke(24)
+    exemplar = graded_smoke(32)
     alpha, flow = rotating_disc(SIDE, 0.08)
     rows = []
     for usage in ("uniform", "none"):
         frames = lazyfluids.stylize_sequence(exemplar, [alpha] * FRAMES, [flow] * FRAMES, usage=usage,
-                                             temporal_weight=1.0, em_iterations=3, threads=2)
+                                             temporal_weight=3.0, em_iterations=3, threads=2)
         rows.append(row([over_grey(exemplar)] + [over_grey(frames[t - 1]) for t in SHOWN]))
     sheet = np.concatenate([rows[0], np.ones((6, rows[0].shape[1], 3)), rows[1]], 0).astype(np.float32)
     path = ROOT / "docs" / "images" / "lazyfluids.png"

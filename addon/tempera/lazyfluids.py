@@ -16,6 +16,7 @@ import os
 import numpy as np
 
 from . import _native
+from .stylize import FrameJob
 from .synthesis import method_options
 
 LazyFluidsOptions = _native.LazyFluidsOptions
@@ -24,7 +25,7 @@ LazyFluidsOptions = _native.LazyFluidsOptions
 def options(**values) -> "LazyFluidsOptions":
     """LazyFluidsOptions from keywords: its own (temporal_weight λ,
     alpha_guide_weight η, alpha_weight, alpha_radius, alpha_lower,
-    alpha_upper, rotations, motion_blur) and engine options (SynthesisOptions
+    alpha_upper, rotations, motion_blur, warm_start) and engine options (SynthesisOptions
     names, from the method's defaults: 5 x 5 patches, uniform usage)."""
     return method_options(LazyFluidsOptions, _native.lazyfluids_defaults(), values, "lazyfluids")
 
@@ -65,7 +66,7 @@ def temporal_weights(target_alpha, advected, lam: float):
     return _native.lazyfluids_temporal_weights(_image(target_alpha, 1, "target alpha"), _image(advected), float(lam))
 
 
-class FluidJob:
+class FluidJob(FrameJob):
     """LazyFluids over a guide cache, frame by frame.
 
     exemplar  an RGBA image file, or a folder of RGBA frames (a video exemplar)
@@ -83,17 +84,6 @@ class FluidJob:
     def __init__(self, exemplar, guides, frames, out, *, format="png", resume=True, **values):
         self._job = _native.LazyFluidsJob(os.fspath(exemplar), os.fspath(guides), [int(f) for f in frames],
                                           os.fspath(out), str(format), bool(resume), options(**values))
-
-    @property
-    def frames(self) -> list:
-        return self._job.frames
-
-    @property
-    def warnings(self) -> list:
-        return self._job.warnings
-
-    def output_path(self, frame: int) -> str:
-        return self._job.output_path(int(frame))
 
     def run_frame(self, index: int, progress=None) -> dict:
         """Stylizes frames[index] (or skips it when current; the frame before

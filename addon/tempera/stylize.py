@@ -44,7 +44,23 @@ def _stylit_options(weights, temporal_weight, quality, engine):
     return options
 
 
-class StylizeJob:
+class FrameJob:
+    """What every per-frame job wrapper exposes of its native job (``_job``):
+    the frames, the warnings of its checks and the output path of a frame."""
+
+    @property
+    def frames(self) -> list:
+        return self._job.frames
+
+    @property
+    def warnings(self) -> list:
+        return self._job.warnings
+
+    def output_path(self, frame: int) -> str:
+        return self._job.output_path(int(frame))
+
+
+class StylizeJob(FrameJob):
     """Stylization of the frames of a guide cache with one painted exemplar.
 
     style            the painting (PNG/EXR/...), made on the exemplar render
@@ -78,20 +94,9 @@ class StylizeJob:
         self._job = _native.StylizeJob(config)
 
     @property
-    def frames(self) -> list:
-        return self._job.frames
-
-    @property
-    def warnings(self) -> list:
-        return self._job.warnings
-
-    @property
     def report_path(self) -> str:
         """The job's sidecar (out/tempera_stylize.json): settings, key and flicker per frame."""
         return self._job.report_path
-
-    def output_path(self, frame: int) -> str:
-        return self._job.output_path(int(frame))
 
     def run_frame(self, index: int, progress: ProgressFn = None) -> dict:
         """Stylizes frames[index], or skips it when its output is current.

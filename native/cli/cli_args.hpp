@@ -24,6 +24,10 @@ class ArgReader {
     if (f.rfind("--", 0) != 0) throw ValueError(concat("unexpected argument '", f, "'"));
     return f;
   }
+  // The next argument if it is not a flag (an optional value), else null.
+  const std::string* optional_value() const {
+    return pos_ < args_.size() && args_[pos_].rfind("--", 0) != 0 ? &args_[pos_] : nullptr;
+  }
   std::string value(const std::string& flag) {
     if (pos_ >= args_.size()) throw ValueError(concat(flag, " needs a value"));
     return args_[pos_++];

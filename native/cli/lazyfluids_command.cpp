@@ -51,6 +51,10 @@ const char* kLazyFluidsHelpText =
 std::string lazyfluids_help() {
   std::string text = kLazyFluidsHelpText;
   text.replace(text.find("@OPTIONS@"), 9, flags_help<LazyFluidsOptions>(lazyfluids_option_table()));
+  for (const std::string flag : {"--rotations", "--warm-start"}) {  // also bare switches
+    const std::size_t at = text.find(flag + " V  ");
+    text.replace(at, flag.size() + 4, flag + " [V]");
+  }
   return text;
 }
 
@@ -75,6 +79,8 @@ Options parse(const Args& args) {
     else if (flag == "--out") o.out = r.value(flag);
     else if (flag == "--format") o.job.format = r.value(flag);
     else if (flag == "--no-resume") o.job.resume = false;
+    else if (flag == "--rotations" && !r.optional_value()) o.job.options.rotations = true;  // bare switches
+    else if (flag == "--warm-start" && !r.optional_value()) o.job.options.warm_start = true;
     else if (!set_from_flag(o.job.options, lazyfluids_option_table(), flag.substr(2), value) &&
              !set_from_flag(o.job.options.synthesis, synthesis_option_table(), flag.substr(2), value))
       throw ValueError(concat("unknown option '", flag, "' for --method lazyfluids (see tempera stylize --method "

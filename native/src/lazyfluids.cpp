@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <chrono>
 #include <deque>
 
 #include "tempera/error.hpp"
 #include "tempera/patch_distance.hpp"  // sample_bilinear
 #include "tempera/pyramid.hpp"
+#include "tempera/solver.hpp"
 
 namespace tempera {
 
@@ -199,35 +201,28 @@ Image motion_blur_along_flow(const ImageView& image, const ImageView& flow, floa
   return out;
 }
 
-FluidFrameResult stylize_fluid_frame(const FluidFrameInput& in, const LazyFluidsOptions& o,
-                                     const ProgressCallback& progress) {
-  validate(o);
+namespace {
+
+void check_frame_input(const FluidFrameInput& in) {
   require_channels(in.style, 4, "exemplar (RGBA)");
   require_channels(in.previous_style, 4, "previous exemplar frame (RGBA)");
   require_same_size(in.style, "exemplar", in.previous_style, "previous exemplar frame");
   require_channels(in.target_alpha, 1, "target alpha");
-  const bool temporal = !in.advected.empty() && o.temporal_weight > 0;
   if (!in.advected.empty()) require_same_size(in.target_alpha, "target alpha", in.advected, "advected previous frame");
+}
 
-  FluidFrameResult result;
-  const AlphaSegments target = alpha_segments(in.target_alpha, segment_options(o));
-  result.target_labels = target.labels;
-  result.temporal_weights = temporal ? temporal_weights(in.target_alpha, in.advected, o.temporal_weight)
-                                     : Image(in.target_alpha.width, in.target_alpha.height, 1, 0.0f);
-  const bool any_target = std::any_of(target.inside.data(), target.inside.data() + target.inside.pixel_count(),
-                                      [](float v) { return v > 0.5f; });
-  if (!any_target) {  // nothing to synthesize: a transparent frame
-    result.image = Image(in.target_alpha.width, in.target_alpha.height, 4, 0.0f);
-    return result;
-  }
-
-  std::deque<Image> keep;
+// Eq. 5.9 on the engine: the RGBA style, the blurred-alpha guide (η), the
+// temporal guide weighted by λ_q, segments and masks; rotated copies of the
+// exemplar as further sources. Images it makes live in `keep`.
+SynthesisInput fluid_synthesis_input(const FluidFrameInput& in, const AlphaSegments& target,
+                                     const FluidFrameResult& result, bool temporal, const LazyFluidsOptions& o,
+                                     std::deque<Image>& keep) {
   const Exemplar main = source_exemplar(in.style, in.previous_style, temporal, o, 0, keep);
-  const Image advected = temporal ? scale_alpha(in.advected, std::sqrt(o.alpha_weight)) : Image();
   SynthesisInput si;
   si.style = main.style;
   si.guides.add("blurred_alpha", main.guides[0], target.blurred.view(), o.alpha_guide_weight);
   if (temporal) {
+    const Image& advected = keep.emplace_back(scale_alpha(in.advected, std::sqrt(o.alpha_weight)));
     si.guides.add("advected_previous", main.guides[1], advected.view(), 1.0f);
     si.target_weight_maps = {ImageView{}, result.temporal_weights.view()};
   }
@@ -238,12 +233,59 @@ FluidFrameResult stylize_fluid_frame(const FluidFrameInput& in, const LazyFluids
   if (o.rotations)
     for (int turns = 1; turns < 4; ++turns)
       si.exemplars.push_back(source_exemplar(in.style, in.previous_style, temporal, o, turns, keep));
+  return si;
+}
 
+// The engine's coarse-to-fine solve, or with a warm start only the finest
+// level from the previous frame's field advected along F^{t-1} (the
+// semi-Lagrangian stand-in for V-, as for the advected output).
+SynthesisResult solve(const SynthesisInput& si, const SynthesisOptions& engine, const FluidFrameInput& in,
+                      bool warm, const ProgressCallback& progress) {
+  if (!warm) return synthesize(si, engine, progress);
+  const auto t0 = std::chrono::steady_clock::now();
+  const Solver solver(si, engine);
+  if (in.previous_field->width != in.target_alpha.width || in.previous_field->height != in.target_alpha.height)
+    throw ValueError(concat("the previous frame's field is ", in.previous_field->width, "x", in.previous_field->height,
+                            " but the target alpha is ", in.target_alpha.width, "x", in.target_alpha.height));
+  const OffsetField start = solver.advect(*in.previous_field, 0, in.flow_previous);
+  LevelResult level = solver.solve_level(0, {&start}, progress);
+  SynthesisResult r;
+  r.image = std::move(level.image);
+  r.field = std::move(level.field);
+  r.layout = solver.layout(0);
+  r.source_coverage = level.stats.source_coverage;
+  r.levels = {level.stats};
+  r.guide_channels = solver.guide_channels();
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+}  // namespace
+
+FluidFrameResult stylize_fluid_frame(const FluidFrameInput& in, const LazyFluidsOptions& o,
+                                     const ProgressCallback& progress) {
+  validate(o);
+  check_frame_input(in);
+  const bool temporal = !in.advected.empty() && o.temporal_weight > 0;
+  FluidFrameResult result;
+  const AlphaSegments target = alpha_segments(in.target_alpha, segment_options(o));
+  result.target_labels = target.labels;
+  result.temporal_weights = temporal ? temporal_weights(in.target_alpha, in.advected, o.temporal_weight)
+                                     : Image(in.target_alpha.width, in.target_alpha.height, 1, 0.0f);
+  result.image = Image(in.target_alpha.width, in.target_alpha.height, 4, 0.0f);
+  const float* inside = target.inside.data();
+  if (std::none_of(inside, inside + target.inside.pixel_count(), [](float v) { return v > 0.5f; }))
+    return result;  // nothing to synthesize: a transparent frame
+
+  std::deque<Image> keep;
+  const SynthesisInput si = fluid_synthesis_input(in, target, result, temporal, o, keep);
   SynthesisOptions engine = o.synthesis;
   engine.style_channel_weights.resize(4, 1.0f);  // alpha_weight owns the alpha channel's
   engine.style_channel_weights[kAlpha] = o.alpha_weight;
   engine.levels = fluid_levels(alpha_segments(channel(in.style, kAlpha).view(), segment_options(o)), target, engine);
-  result.synthesis = synthesize(si, engine, progress);
+  const bool warm = o.warm_start && in.previous_field && !in.previous_field->x.empty();
+  if (warm) require_channels(in.flow_previous, 2, "previous flow");
+  result.synthesis = solve(si, engine, in, warm, progress);
   result.image = Image::copy_of(result.synthesis.image.view());
   clear_outside(result.image, target.labels);
   return result;
@@ -259,6 +301,7 @@ std::vector<Image> stylize_fluid_sequence(const std::vector<ImageView>& exemplar
     throw ValueError(concat(alphas.size(), " target alpha frames but ", flows.size(), " flow frames"));
   const std::size_t n = alphas.size(), m = exemplar.size();
   std::vector<Image> raw, out;
+  OffsetField previous_field;
   for (std::size_t t = 0; t < n; ++t) {
     require_same_size(alphas[t], concat("target alpha ", t).c_str(), flows[t], concat("flow ", t).c_str());
     FluidFrameInput in;
@@ -267,8 +310,11 @@ std::vector<Image> stylize_fluid_sequence(const std::vector<ImageView>& exemplar
     in.target_alpha = alphas[t];
     const Image advected = t == 0 ? Image() : advect_output(raw.back().view(), flows[t - 1]);
     in.advected = advected.empty() ? ImageView{} : advected.view();
+    if (t > 0) in.previous_field = &previous_field, in.flow_previous = flows[t - 1];
     auto report = [&](double f) { return !progress || progress((double(t) + f) / double(n)); };
-    raw.push_back(std::move(stylize_fluid_frame(in, o, report).image));
+    FluidFrameResult frame = stylize_fluid_frame(in, o, report);
+    previous_field = std::move(frame.synthesis.field);
+    raw.push_back(std::move(frame.image));
     out.push_back(motion_blur_along_flow(raw.back().view(), flows[t], o.motion_blur));
   }
   return out;

@@ -62,6 +62,22 @@ std::string frame_list(const std::vector<int>& frames) {
   return out;
 }
 
+// A field's source positions (x + rx, y + ry) as a 2-channel float image,
+// and back: what a warm start of the next frame needs, exactly.
+Image field_positions(const OffsetField& field) {
+  Image out(field.width, field.height, 2);
+  for (std::size_t i = 0; i < out.pixel_count(); ++i)
+    out.data()[2 * i] = field.position_x(i), out.data()[2 * i + 1] = field.position_y(i);
+  return out;
+}
+
+OffsetField field_from_positions(const Image& positions) {
+  OffsetField field(positions.width(), positions.height());
+  for (std::size_t i = 0; i < positions.pixel_count(); ++i)
+    field.set_position(i, positions.data()[2 * i], positions.data()[2 * i + 1]);
+  return field;
+}
+
 void check_config(const LazyFluidsJobConfig& c) {
   validate(c.options);
   if (c.format != "png" && c.format != "exr") throw ValueError(concat("format must be png or exr, got '", c.format, "'"));
@@ -133,6 +149,10 @@ std::string LazyFluidsJob::state_path(int frame) const {
   return (fs::path(config_.out) / kStateFolder / frame_file("frame_", frame, "exr")).string();
 }
 
+std::string LazyFluidsJob::field_path(int frame) const {
+  return (fs::path(config_.out) / kStateFolder / frame_file("field_", frame, "exr")).string();
+}
+
 std::string LazyFluidsJob::record_path(int frame) const {
   return (fs::path(config_.out) / kStateFolder / frame_file("frame_", frame, "txt")).string();
 }
@@ -146,6 +166,10 @@ std::string LazyFluidsJob::frame_key(std::size_t index) const {
   if (index > 0) {
     const FileDigest previous = file_digest(state_path(f - 1));
     text += concat("\n", file_stamp(guide_path(f - 1)), "\nprevious ", previous.size, " ", previous.checksum);
+    if (config_.options.warm_start) {
+      const FileDigest field = file_digest(field_path(f - 1));
+      text += concat("\nprevious field ", field.size, " ", field.checksum);
+    }
   }
   return hash_hex(text);
 }
@@ -188,25 +212,45 @@ FrameResult LazyFluidsJob::run_frame(std::size_t index, const ProgressCallback& 
     return result;
   }
   const auto t0 = std::chrono::steady_clock::now();
-  const std::size_t m = exemplar_.size();
   const Image alpha = Image::copy_of(GuideFrame::read(guide_path(f), {"alpha"}).get("alpha").view());
+  // The exact float state, never the 8-bit output: resumed == uninterrupted.
+  const Image flow_previous = index == 0 ? Image() : read_flow(f - 1);
+  const Image advected = index == 0 ? Image() : advect_output(read_image(state_path(f - 1)).view(), flow_previous.view());
+  const std::size_t m = exemplar_.size();
   FluidFrameInput in;
   in.style = exemplar_[index % m].view();
   in.previous_style = exemplar_[index == 0 ? 0 : (index - 1) % m].view();
   in.target_alpha = alpha.view();
-  Image advected;
-  if (index > 0) {
-    // The exact float state, never the 8-bit output: resumed == uninterrupted.
-    const Image previous = read_image(state_path(f - 1));
-    advected = advect_output(previous.view(), read_flow(f - 1).view());
-    in.advected = advected.view();
+  if (index > 0) in.advected = advected.view();
+  OffsetField previous_field;
+  std::error_code ec;
+  if (index > 0 && config_.options.warm_start && fs::is_regular_file(field_path(f - 1), ec)) {
+    previous_field = field_from_positions(read_image(field_path(f - 1)));
+    in.previous_field = &previous_field;
+    in.flow_previous = flow_previous.view();
   }
   const FluidFrameResult frame = stylize_fluid_frame(in, config_.options, progress);
-  const Image output = config_.options.motion_blur > 0
-                           ? motion_blur_along_flow(frame.image.view(), read_flow(f).view(), config_.options.motion_blur)
-                           : Image::copy_of(frame.image.view());
-  write_image(state_path(f), frame.image.view());  // atomic, float
-  write_image(output_path(f), output.view());
+  write_frame(index, frame);
+  result.status = "stylized";
+  result.source_coverage = frame.synthesis.source_coverage;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return result;
+}
+
+// The state, the output (motion-blurred when asked) and then the record,
+// each atomically: a crash leaves either no record or a matching one.
+void LazyFluidsJob::write_frame(std::size_t index, const FluidFrameResult& frame) const {
+  const int f = config_.frames[index];
+  const Image& state = frame.image;
+  std::error_code ec;
+  if (config_.options.warm_start && !frame.synthesis.field.x.empty())
+    write_image(field_path(f), field_positions(frame.synthesis.field).view());
+  else
+    fs::remove(field_path(f), ec);  // an empty frame: the next one starts cold
+  const float blur = config_.options.motion_blur;
+  const Image output = blur > 0 ? motion_blur_along_flow(state.view(), read_flow(f).view(), blur) : Image();
+  write_image(state_path(f), state.view());
+  write_image(output_path(f), blur > 0 ? output.view() : state.view());
   std::ostringstream record;
   record << kRecordFormat << "\n" << frame_key(index) << "\n";
   for (const std::string& path : {output_path(f), state_path(f)}) {
@@ -214,10 +258,6 @@ FrameResult LazyFluidsJob::run_frame(std::size_t index, const ProgressCallback& 
     record << d.size << " " << d.checksum << "\n";
   }
   write_text_atomically(record_path(f), record.str(), "the frame record");
-  result.status = "stylized";
-  result.source_coverage = frame.synthesis.source_coverage;
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return result;
 }
 
 void LazyFluidsJob::write_contact_sheet(const std::string& path, int columns) const {

@@ -90,7 +90,9 @@ def run_all(job):
     return [job.run_frame(i)["status"] for i in range(len(job.frames))]
 
 
-def test_job_resume_equals_uninterrupted_and_cancel_writes_nothing(cache):
+@pytest.mark.parametrize("warm_start", [False, True])
+def test_job_resume_equals_uninterrupted_and_cancel_writes_nothing(cache, warm_start):
+    FAST = dict(em_iterations=2, threads=2, warm_start=warm_start)
     whole = lazyfluids.FluidJob(cache / "smoke.png", cache / "cache", range(1, 5), cache / "whole", **FAST)
     assert any("velocity_forward" in w and "3" in w for w in whole.warnings)
     assert run_all(whole) == ["stylized"] * 4
@@ -136,7 +138,7 @@ def stylize(cli_path, *args):
 
 def test_cli_runs_resumes_and_rejects_bad_input(cli_path, cache):
     base = ("--guides", cache / "cache", "--exemplar", cache / "smoke.png", "--frames", "1-2", "--out", cache / "cli",
-            "--em-iters", "2", "--motion-blur", "3")
+            "--em-iters", "2", "--motion-blur", "3", "--rotations", "--warm-start")
     first = stylize(cli_path, *base)
     assert first.returncode == 0, first.stderr
     assert (cache / "cli" / "frames" / "frame_0002.png").is_file() and (cache / "cli" / "contact_sheet.png").is_file()

@@ -17,7 +17,8 @@
 //    patch of a segment is used K or K+1 times, so the exemplar's texture
 //    never washes out however long the sequence runs.
 // Options: the exemplar also pre-rotated by 90/180/270° (more sources for
-// turning flows), and a motion blur of the output along the flow.
+// turning flows), a motion blur of the output along the flow, and a warm
+// start (the finest level only, from the previous frame's field advected).
 #include <vector>
 
 #include "tempera/alpha_segments.hpp"
@@ -36,6 +37,7 @@ struct LazyFluidsOptions {
   float alpha_upper = 0.9f;      // u
   bool rotations = false;        // the exemplar also rotated by 90, 180 and 270 degrees
   float motion_blur = 0;         // streak length along the flow, pixels (0 = off)
+  bool warm_start = false;       // finest level only, from the previous frame's matches advected
   SynthesisOptions synthesis;    // lazyfluids_defaults()
 };
 
@@ -58,7 +60,9 @@ inline const auto& lazyfluids_option_table() {
       field(&L::rotations, "rotations", "rotations",
             "also copy from the exemplar rotated by 90, 180 and 270 degrees (turning flows)"),
       field(&L::motion_blur, "motion_blur", "motion-blur",
-            "motion blur of the output: streak length in pixels along the flow (0 = off)", 0, 1000));
+            "motion blur of the output: streak length in pixels along the flow (0 = off)", 0, 1000),
+      field(&L::warm_start, "warm_start", "warm-start",
+            "solve only the finest level, from the previous frame's matches advected along the flow (faster)"));
   return table;
 }
 
@@ -93,6 +97,10 @@ struct FluidFrameInput {
   ImageView previous_style;  // z^{t-1}, RGBA (a still exemplar: = style)
   ImageView target_alpha;    // X_a^t, 1 channel
   ImageView advected;        // X̂^{t-1}, RGBA; empty on the first frame (λ = 0)
+  // With warm_start: the previous frame's final field and F^{t-1}; the
+  // frame then starts from the field advected along the flow.
+  const OffsetField* previous_field = nullptr;
+  ImageView flow_previous;
 };
 
 struct FluidFrameResult {

@@ -39,6 +39,7 @@ class LazyFluidsJob {
   std::string output_path(int frame) const;
   std::string state_path(int frame) const;
   std::string record_path(int frame) const;
+  std::string field_path(int frame) const;  // warm start: the frame's final matches
 
   // Stylizes frames()[index] (or skips it when its record is current); the
   // frame before must be done. `progress` returning false cancels:
@@ -53,6 +54,7 @@ class LazyFluidsJob {
   std::string frame_key(std::size_t index) const;
   bool is_current(std::size_t index) const;
   Image read_flow(int frame) const;
+  void write_frame(std::size_t index, const FluidFrameResult& frame) const;
 
   LazyFluidsJobConfig config_;
   std::vector<std::string> warnings_, exemplar_files_;
