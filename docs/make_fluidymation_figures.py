@@ -33,7 +33,7 @@ def ink_exemplar(n=16):
         radius = 8 + 2.4 * i
         edge = np.clip((radius - r) / 6, 0, 1)
         ring = 0.5 + 0.5 * np.sin(2 * np.pi * (radius - r) / 7)
-        dark = 0.35 + 0.4 * ring * (1 - edge) + 0.25 * grain
+        dark = 0.2 + 0.3 * ring + 0.4 * (1 - edge) + 0.1 * grain  # rings, a dark front, grain
         rgb.append(np.stack([1 - 0.8 * dark, 1 - 0.6 * dark, 1 - 0.3 * dark], -1).astype(np.float32))
         masks.append((r <= radius).astype(np.float32))
     return rgb, masks

@@ -25,7 +25,9 @@ def options(**values) -> "FluidymationOptions":
     uniformity_weight, ..., see FluidymationOptions.table()) and engine
     options (SynthesisOptions names, from the method's defaults: 5 x 5
     patches, directed orientations, exact guides)."""
-    return method_options(FluidymationOptions, _native.fluidymation_defaults(), values, "fluidymation")
+    opts = method_options(FluidymationOptions, _native.fluidymation_defaults(), values, "fluidymation")
+    opts.validate()
+    return opts
 
 
 def _image(a, channels=None, what="image"):

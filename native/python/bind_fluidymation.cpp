@@ -53,7 +53,10 @@ FluidymationJobConfig job_config(const py::dict& d, const FluidymationOptions& o
 void bind_fluidymation(py::module_& m) {
   py_bridge::bind_options_class<FluidymationOptions>(m, "FluidymationOptions", fluidymation_option_table(),
                                                      "Options of Fluidymation (native/include/tempera/fluidymation.hpp).")
-      .def_readwrite("synthesis", &FluidymationOptions::synthesis, "engine options (defaults: fluidymation_defaults())");
+      .def_readwrite("synthesis", &FluidymationOptions::synthesis, "engine options (defaults: fluidymation_defaults())")
+      .def(
+          "validate", [](const FluidymationOptions& o) { validate(o); },
+          "ValueError naming the first bad value (ranges, and m_u > m_l).");
   m.def("fluidymation_defaults", &fluidymation_defaults, "The engine options of Fluidymation.");
   m.def(
       "flow_from_masks",

@@ -52,6 +52,9 @@ class FootprintUsage final : public EnergyTerm {
  public:
   FootprintUsage(float weight, int temporal_radius) : weight_(weight), temporal_radius_(temporal_radius) {}
   const char* name() const override { return "footprint"; }
+  // Held through a whole search, the costs would send every target of a
+  // covered region to the same next-best footprint at once.
+  bool refresh_each_iteration() const override { return true; }
   void add_source_costs(const LevelContext& c, const OffsetField& field, std::vector<float>& cost,
                         TermState&) const override {
     const int sw = c.space->source->width, sh = c.space->source->height, r = c.space->radius;

@@ -7,7 +7,6 @@ import pytest
 
 import tempera
 from tempera import fluidymation, guide_cache, read_image, write_image
-from conftest import cli_path
 
 SIZE = 40
 
@@ -124,9 +123,9 @@ def test_media_job_runs_earlier_frames_first_and_rejects_bad_input(tmp_path):
         fluidymation.MediaJob(tmp_path / "none", cache, [1, 2], tmp_path / "bad")
 
 
-def test_cli_runs_and_exits_2_on_bad_input(tmp_path):
+def test_cli_runs_and_exits_2_on_bad_input(tmp_path, cli_path):
     exemplar, cache = make_inputs(tmp_path, frames=2)
-    base = [str(cli_path()), "stylize", "--method", "fluidymation", "--guides", str(cache), "--exemplar",
+    base = [str(cli_path), "stylize", "--method", "fluidymation", "--guides", str(cache), "--exemplar",
             str(exemplar), "--out", str(tmp_path / "out")]
     ok = subprocess.run(base + ["--frames", "1-2", "--shape-blur", "6", "--levels", "2"], capture_output=True, text=True)
     assert ok.returncode == 0, ok.stderr

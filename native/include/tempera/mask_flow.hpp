@@ -9,10 +9,11 @@
 //    backward difference of the frame before, which flips the direction;
 //  - the interior is filled by diffusing the boundary values (Johnston 2002:
 //    a harmonic fill, Laplace's equation with the boundary held);
-//  - the sequence is smoothed by a temporal Gaussian of `temporal_radius`
-//    frames (sigma = radius / 2), averaging only frames where the pixel is
-//    inside, so that the boundary's speed is not diluted by the zeros
-//    outside the neighbours' masks.
+//  - the distance fields are first smoothed by a temporal Gaussian of
+//    `temporal_radius` frames (sigma = radius / 2): the paper's Fig. 14
+//    smooths the distance fields, which gives sub-pixel speeds and, unlike
+//    smoothing the flows, does not mix a boundary pixel's speed with the
+//    slower interior it becomes in later frames.
 // Convention: pixels per frame, x right, y down, forward (p moves to p + F in
 // the next frame), like the guide cache's velocity_forward. 0 outside the
 // mask. The last frame, which has no next one, takes its predecessor's
@@ -29,7 +30,8 @@ std::vector<Image> flow_from_masks(const std::vector<ImageView>& masks, float te
 
 // The harmonic fill of `values` (2 channels) inside `mask`: pixels where
 // `known` > 0.5 keep their values, the other inside pixels solve Laplace's
-// equation (coarse-to-fine initial guess, then Jacobi sweeps); 0 outside.
+// equation (a push-pull first guess, then red-black over-relaxation); 0
+// outside.
 Image diffuse_fill(const ImageView& values, const ImageView& known, const ImageView& mask);
 
 }  // namespace tempera
