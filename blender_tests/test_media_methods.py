@@ -141,7 +141,8 @@ def test_fluid_method_end_to_end_and_resume(media_scene, tmp_path):
     from tempera.blender.stylize_operator import FluidRun, StylizeRun
 
     media_scene.tempera.method = "LAZYFLUIDS"
-    assert type(StylizeRun.from_settings(media_scene, "ANIMATION")) is FluidRun
+    run = StylizeRun.from_settings(media_scene, "ANIMATION")
+    assert type(run) is FluidRun and run.estimate_seconds(media_scene) > 0  # the long-run confirmation's figure
     assert bpy.ops.tempera.stylize(mode="ANIMATION") == {"FINISHED"}
     _check_result(media_scene, tmp_path, "lazyfluids", "alpha")
     assert _rerun(media_scene) == ["skipped"] * len(FRAMES)

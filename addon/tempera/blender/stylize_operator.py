@@ -120,6 +120,12 @@ def output_dir(settings):
     return resolve_path(settings.output_dir, "Output Folder")
 
 
+def megapixels(scene):
+    """The render's size in megapixels (at its resolution percentage)."""
+    r = scene.render
+    return r.resolution_x * r.resolution_y * (r.resolution_percentage / 100.0) ** 2 / 1e6
+
+
 def require_consecutive(frames, method):
     """ValueError unless `frames` follow each other (a method that carries
     each frame on to the next)."""
@@ -256,9 +262,8 @@ class StylizeRun:
 
     def estimate_seconds(self, scene):
         """A rough duration of the whole run from scratch (guides and stylizing)."""
-        r = scene.render
-        mpix = r.resolution_x * r.resolution_y * (r.resolution_percentage / 100.0) ** 2 / 1e6
-        per_frame = mpix * STYLIZE_SECONDS_PER_MPIX.get(self.config["quality"], STYLIZE_SECONDS_PER_MPIX["final"])
+        per_frame = megapixels(scene) * STYLIZE_SECONDS_PER_MPIX.get(self.config["quality"],
+                                                                     STYLIZE_SECONDS_PER_MPIX["final"])
         return estimate_guide_seconds(scene, self.guides.params, len(self.frames)) + per_frame * len(self.frames)
 
     def mean_flicker(self):
@@ -465,6 +470,7 @@ class RgbaRun(StylizeRun):
 
     folder = None  # the method's folder in the Output Folder
     method_label = None  # the method's name in messages
+    seconds_per_mpix = None  # a frame's rough cost, for the confirmation of long runs
     kinds = ("STILL", "SEQUENCE", "MOVIE")  # the exemplars the method takes
 
     def __init__(self, scene, frames, mode="ANIMATION"):
@@ -514,6 +520,10 @@ class RgbaRun(StylizeRun):
             print(f"Tempera: {self.method_label} frame {self.frames[i]} {result['status']} "
                   f"in {result['seconds']:.1f} s", flush=True)
 
+    def estimate_seconds(self, scene):
+        return (estimate_guide_seconds(scene, self.guides.params, len(self.frames))
+                + megapixels(scene) * self.seconds_per_mpix * len(self.frames))
+
     def render_paths(self):
         """The render frames under the result (made from the guide cache when stale)."""
         from ..beauty import write_render_frames
@@ -526,6 +536,7 @@ class FluidRun(RgbaRun):
 
     folder = "lazyfluids"
     method_label = "Fluid"
+    seconds_per_mpix = 20.0  # wall, loaded 2-core machine (docs/benchmarks.md: 4.6-8.6 s per 0.26 Mpix)
 
     def job_options(self, settings):
         return {"temporal_weight": float(settings.lf_lambda), "rotations": bool(settings.lf_rotations),
@@ -544,6 +555,7 @@ class MediaRun(RgbaRun):
 
     folder = "fluidymation"
     method_label = "Natural Media"
+    seconds_per_mpix = 25.0  # wall, 2 cores (docs/benchmarks.md: 2.5 s idle, 14 s loaded per 0.3 Mpix)
     kinds = ("SEQUENCE", "MOVIE")
 
     def __init__(self, scene, frames, mode="ANIMATION"):
