@@ -148,3 +148,15 @@ def test_cli_runs_resumes_and_rejects_bad_input(cli_path, cache):
                 ("--format", "gif")):
         r = stylize(cli_path, *base, *bad)  # a later --frames replaces the first
         assert r.returncode == 2, (bad, r.stderr)
+
+
+def test_video_exemplar_arrays_loop_and_progress_cancels():
+    video = [smoke(seed=20), smoke(seed=21)]
+    alphas = [disc(16)] * 3
+    looped = lazyfluids.stylize_sequence(video, alphas, [flow(0)] * 3, temporal_weight=0, **FAST)
+    still = lazyfluids.stylize_sequence(video[0], alphas, [flow(0)] * 3, temporal_weight=0, **FAST)
+    # λ = 0 and a still target: frame t depends only on exemplar frame t mod 2.
+    assert np.array_equal(looped[0], looped[2]) and not np.array_equal(looped[0], looped[1])
+    assert np.array_equal(looped[0], still[0])
+    with pytest.raises(tempera.Cancelled):
+        lazyfluids.stylize_sequence(video, alphas, [flow()] * 3, progress=lambda f: f < 0.5, **FAST)
