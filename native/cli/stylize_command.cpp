@@ -76,12 +76,12 @@ const char* kStylizeHelpText =
     "                          velocity_forward/backward and occlusion_forward/backward)\n"
     "                          | lazyfluids (fluid elements from an RGBA exemplar along the\n"
     "                          flow; own options: tempera stylize --method lazyfluids --help)\n"
+    "                          | fluidymation (natural media from a video exemplar; see\n"
+    "                          'tempera stylize --method fluidymation --help')\n"
     "  --key F=PATH[,MASK]     tcia: a painted keyframe (repeatable); comes out as painted\n"
     "                          (where MASK > 0.5 if given) and steers its neighbours\n"
     "  --segment A-B           tcia: solve only the segment from key A to key B (a farm\n"
     "                          task); the shot splits at keys into independent segments\n"
-    "                          | fluidymation (natural media from a video exemplar; see\n"
-    "                          'tempera stylize --method fluidymation --help')\n"
     "@TCIA@"
     "@LINES@"
     "  tcia's engine defaults: 9x9 Gaussian window, centre output, histogram usage, automatic levels;\n"
@@ -178,7 +178,7 @@ bool set_engine_flag(Options& o, const std::string& flag, ArgReader& r) {
 
 void check_method(Options& o) {
   if (o.method != "stylit" && o.method != "tcia")
-    throw ValueError(concat("unknown --method '", o.method, "' (choose stylit, tcia or lazyfluids)"));
+    throw ValueError(concat("unknown --method '", o.method, "' (choose stylit, tcia, lazyfluids or fluidymation)"));
   if (o.method == "stylit") {
     if (!o.keys.empty() || o.segment || !o.tcia_flags.empty())
       throw ValueError(concat(!o.keys.empty() ? "--key" : o.segment ? "--segment" : o.tcia_flags.front(),
@@ -426,8 +426,8 @@ int interrupted_segments() {
 }  // namespace
 
 int run_stylize(const Args& args) {
-  if (wants_lazyfluids(args)) return run_lazyfluids(args);
   if (wants_fluidymation(args)) return run_stylize_fluidymation(args);
+  if (wants_lazyfluids(args)) return run_lazyfluids(args);
   if (ArgReader(args, "stylize").wants_help() || args.empty()) {
     std::cout << stylize_help();
     return args.empty() ? 2 : 0;

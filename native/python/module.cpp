@@ -84,8 +84,8 @@ void bind_tracer(py::module_& m);     // bind_tracer.cpp
 void bind_noisy(py::module_& m);      // bind_noisy.cpp
 void bind_tcia(py::module_& m);       // bind_tcia.cpp
 void bind_rigid(py::module_& m);      // bind_rigid.cpp
-void bind_lazyfluids(py::module_& m); // bind_lazyfluids.cpp
 void bind_fluidymation(py::module_& m);  // bind_fluidymation.cpp
+void bind_lazyfluids(py::module_& m); // bind_lazyfluids.cpp
 
 PYBIND11_MODULE(_native, m) {
   m.doc() = "Tempera native engine";
@@ -99,6 +99,6 @@ PYBIND11_MODULE(_native, m) {
   bind_noisy(m);
   bind_tcia(m);
   bind_rigid(m);
-  bind_lazyfluids(m);
   bind_fluidymation(m);
+  bind_lazyfluids(m);
 }

@@ -36,8 +36,6 @@ void validate(const FluidymationOptions& o) {
 
 namespace {
 
-constexpr float kPi = 3.14159265358979f;
-
 float smoothstep(float v, float lo, float hi) {
   const float t = std::clamp((v - lo) / (hi - lo), 0.0f, 1.0f);
   return t * t * (3.0f - 2.0f * t);
@@ -163,7 +161,11 @@ struct Fluidymation::Data {
   FluidymationOptions o;
   Side S, T;
   int tw = 0, th = 0;
-  Image zero_angle_source, zero_angle_target;
+
+  Image temporal_weight(int j, const FluidNnf& shifted, const Image& voted) const;
+  SynthesisInput input(int j, const Image* temporal, const Image* weight) const;
+  void read_matches(int j, const Solver& solver, const LevelResult& r, const std::optional<FluidNnf>& shifted,
+                    FluidFrame& out) const;
 };
 
 Fluidymation::Fluidymation(const FluidSequence& seq, const FluidymationOptions& o) : d_(new Data) {
@@ -299,68 +301,65 @@ OffsetField level_field(const Solver& solver, int l, const FluidNnf& nnf, Candid
 
 }  // namespace
 
-FluidFrame Fluidymation::solve_frame(int j, const FluidNnf* previous, const ProgressCallback& progress) const {
-  const Data& d = *d_;
-  const FluidymationOptions& o = d.o;
-  if (j < 0 || j >= frames()) throw ValueError(concat("frame ", j, " is outside the target's 0 to ", frames() - 1));
-  if (previous && j == 0) throw ValueError("the first frame has no previous frame");
-  FluidFrame out;
-  std::optional<FluidNnf> shifted;
-  if (previous) shifted = shift_nnf(j, *previous, &out.time_shift);
-  else out.time_shift = Image(d.tw, d.th, 1);
-  const int ns = int(d.seq.exemplar.size()), radius = o.synthesis.patch_size / 2;
-  // The temporal guide and its weight w_t m(q).
-  Image temporal, weight;
-  const bool use_temporal = shifted && o.temporal_weight > 0;
-  if (use_temporal) {
-    Image voted;
-    temporal = vote_matches(d.seq, *shifted, radius, voted);
-    weight = Image(d.tw, d.th, 1);
-    const float lo = o.modulation_lower * float(std::max(d.tw, d.th)), hi = o.modulation_upper * float(std::max(d.tw, d.th));
-    const ImageView& before = d.seq.target_masks[std::size_t(j - 1)];
-    const int sw = d.seq.exemplar[0].width, sh = d.seq.exemplar[0].height;
-    for (std::size_t q = 0; q < weight.pixel_count(); ++q) {
-      const float* m = shifted->data() + 4 * q;
-      if (before.data[q] <= 0.5f || voted.data()[q] <= 0 || m[0] < 0) continue;
-      const std::size_t p = std::size_t(clamp_index(m[2], sh)) * sw + std::size_t(clamp_index(m[1], sw));
-      const float s = smoothstep(std::abs(d.T.dist[std::size_t(j)].data()[q] -
-                                          d.S.dist[std::size_t(clamp_index(m[0], ns))].data()[p]),
-                                 lo, hi);
-      weight.data()[q] = o.modulation == TemporalModulation::Release ? 1.0f - s : s;
-    }
+// w_t m(q) per target pixel: 0 where the previous mask was empty or nothing
+// voted, else the smoothstep of the distance-field mismatch (or 1 - it).
+Image Fluidymation::Data::temporal_weight(int j, const FluidNnf& shifted, const Image& voted) const {
+  Image weight(tw, th, 1);
+  const float d_max = float(std::max(tw, th)), lo = o.modulation_lower * d_max, hi = o.modulation_upper * d_max;
+  const ImageView& before = seq.target_masks[std::size_t(j - 1)];
+  const int ns = int(seq.exemplar.size()), sw = seq.exemplar[0].width, sh = seq.exemplar[0].height;
+  for (std::size_t q = 0; q < weight.pixel_count(); ++q) {
+    const float* m = shifted.data() + 4 * q;
+    if (before.data[q] <= 0.5f || voted.data()[q] <= 0 || m[0] < 0) continue;
+    const std::size_t p = std::size_t(clamp_index(m[2], sh)) * sw + std::size_t(clamp_index(m[1], sw));
+    const float mismatch = std::abs(T.dist[std::size_t(j)].data()[q] - S.dist[std::size_t(clamp_index(m[0], ns))].data()[p]);
+    const float s = smoothstep(mismatch, lo, hi);
+    weight.data()[q] = o.modulation == TemporalModulation::Release ? 1.0f - s : s;
   }
+  return weight;
+}
+
+// The engine's input of frame j: the exemplar video as the source set with
+// its guides (shape, extent and, with a temporal guide, its RGB), the
+// target's guides, masks, orientations and the method's terms.
+SynthesisInput Fluidymation::Data::input(int j, const Image* temporal, const Image* weight) const {
   SynthesisInput in;
-  in.style = d.seq.exemplar[0];
-  in.guides.add("shape", d.S.shape[0].view(), d.T.shape[std::size_t(j)].view(), o.boundary_weight);
-  in.guides.add("extent", d.S.extent[0].view(), d.T.extent[std::size_t(j)].view(), o.extent_weight);
-  if (use_temporal) {
-    in.guides.add("temporal", d.seq.exemplar[0], temporal.view(), o.temporal_weight);
-    in.target_weight_maps = {ImageView{}, ImageView{}, weight.view()};
+  in.style = seq.exemplar[0];
+  in.guides.add("shape", S.shape[0].view(), T.shape[std::size_t(j)].view(), o.boundary_weight);
+  in.guides.add("extent", S.extent[0].view(), T.extent[std::size_t(j)].view(), o.extent_weight);
+  if (temporal) {
+    in.guides.add("temporal", seq.exemplar[0], temporal->view(), o.temporal_weight);
+    in.target_weight_maps = {ImageView{}, ImageView{}, weight->view()};
   }
-  in.source_mask = d.seq.exemplar_masks[0];
-  in.target_mask = d.seq.target_masks[std::size_t(j)];
+  in.source_mask = seq.exemplar_masks[0];
+  in.target_mask = seq.target_masks[std::size_t(j)];
   if (o.rotate) {
-    in.source_orientation = d.S.angle[0].view();
-    in.target_orientation = d.T.angle[std::size_t(j)].view();
+    in.source_orientation = S.angle[0].view();
+    in.target_orientation = T.angle[std::size_t(j)].view();
   }
   in.sequence = 0;
   in.time = 0;
-  for (int i = 1; i < ns; ++i) {
+  for (std::size_t i = 1; i < seq.exemplar.size(); ++i) {
     Exemplar e;
-    e.style = d.seq.exemplar[std::size_t(i)];
-    e.guides = {d.S.shape[std::size_t(i)].view(), d.S.extent[std::size_t(i)].view()};
-    if (use_temporal) e.guides.push_back(e.style);
-    e.mask = d.seq.exemplar_masks[std::size_t(i)];
-    if (o.rotate) e.orientation = d.S.angle[std::size_t(i)].view();
+    e.style = seq.exemplar[i];
+    e.guides = {S.shape[i].view(), S.extent[i].view()};
+    if (temporal) e.guides.push_back(e.style);
+    e.mask = seq.exemplar_masks[i];
+    if (o.rotate) e.orientation = S.angle[i].view();
     e.sequence = 0;
-    e.time = i;
+    e.time = int(i);
     in.exemplars.push_back(e);
   }
   if (o.uniformity_weight > 0) in.terms.push_back(make_footprint_usage(o.uniformity_weight, o.uniformity_frames));
   if (o.direction_weight > 0 && o.rotate) in.terms.push_back(make_direction_term(o.direction_weight));
-  SynthesisOptions so = o.synthesis;
-  so.seed = o.synthesis.seed + std::uint64_t(j) * 0x9E3779B97F4A7C15ull;
-  const Solver solver(in, so);
+  return in;
+}
+
+namespace {
+
+// Coarse to fine: the coarsest level cold (frame 1) or from NNF_prev; each
+// finer level from the coarser field upscaled, with NNF_prev as candidates.
+LevelResult solve_levels(const Solver& solver, const std::optional<FluidNnf>& shifted, const ProgressCallback& progress) {
   LevelResult r;
   const int levels = solver.levels();
   for (int l = solver.coarsest(); l >= 0; --l) {
@@ -381,13 +380,24 @@ FluidFrame Fluidymation::solve_frame(int j, const FluidNnf* previous, const Prog
     if (progress) level_progress = [&](double f) { return progress((done + f) / levels); };
     r = solver.solve_level(l, start, level_progress);
   }
+  return r;
+}
+
+}  // namespace
+
+// The finest level's matches as (i, x, y, phi), 0 (and i = -1) outside the mask.
+void Fluidymation::Data::read_matches(int j, const Solver& solver, const LevelResult& r,
+                                      const std::optional<FluidNnf>& shifted, FluidFrame& out) const {
+  const int ns = int(seq.exemplar.size());
   out.energy = r.stats.energy.empty() ? 0.0 : r.stats.energy.back();
-  out.image = std::move(r.image);
-  out.nnf = Image(d.tw, d.th, 4, 0.0f);
-  const ImageView& mask = d.seq.target_masks[std::size_t(j)];
+  out.image = r.image;
+  out.nnf = Image(tw, th, 4, 0.0f);
+  out.distance = Image(tw, th, 1);
+  const ImageView& mask = seq.target_masks[std::size_t(j)];
   const int ch = out.image.channels();
   for (std::size_t q = 0; q < out.nnf.pixel_count(); ++q) {
     float* m = out.nnf.data() + 4 * q;
+    out.distance.data()[q] = r.field.dist[q];
     if (mask.data[q] <= 0.5f) {
       m[0] = -1;
       std::fill_n(out.image.data() + q * std::size_t(ch), ch, 0.0f);
@@ -402,12 +412,31 @@ FluidFrame Fluidymation::solve_frame(int j, const FluidNnf* previous, const Prog
         m[0] = sm[0];
     }
     if (o.rotate) {
-      const Image& a = d.S.angle[std::size_t(e.exemplar)];
-      m[3] = a.at(clamp_index(e.x, a.width()), clamp_index(e.y, a.height()), 0) - d.T.angle[std::size_t(j)].data()[q];
+      const Image& a = S.angle[std::size_t(e.exemplar)];
+      m[3] = a.at(clamp_index(e.x, a.width()), clamp_index(e.y, a.height()), 0) - T.angle[std::size_t(j)].data()[q];
     }
   }
-  out.distance = Image(d.tw, d.th, 1);
-  for (std::size_t q = 0; q < out.distance.pixel_count(); ++q) out.distance.data()[q] = r.field.dist[q];
+}
+
+FluidFrame Fluidymation::solve_frame(int j, const FluidNnf* previous, const ProgressCallback& progress) const {
+  const Data& d = *d_;
+  if (j < 0 || j >= frames()) throw ValueError(concat("frame ", j, " is outside the target's 0 to ", frames() - 1));
+  if (previous && j == 0) throw ValueError("the first frame has no previous frame");
+  FluidFrame out;
+  std::optional<FluidNnf> shifted;
+  if (previous) shifted = shift_nnf(j, *previous, &out.time_shift);
+  else out.time_shift = Image(d.tw, d.th, 1);
+  Image temporal, weight;
+  const bool use_temporal = shifted && d.o.temporal_weight > 0;
+  if (use_temporal) {
+    Image voted;
+    temporal = vote_matches(d.seq, *shifted, d.o.synthesis.patch_size / 2, voted);
+    weight = d.temporal_weight(j, *shifted, voted);
+  }
+  SynthesisOptions so = d.o.synthesis;
+  so.seed = d.o.synthesis.seed + std::uint64_t(j) * 0x9E3779B97F4A7C15ull;
+  const Solver solver(d.input(j, use_temporal ? &temporal : nullptr, &weight), so);
+  d.read_matches(j, solver, solve_levels(solver, shifted, progress), shifted, out);
   return out;
 }
 

@@ -190,7 +190,7 @@ FluidJobFrame FluidymationJob::run_frame(std::size_t index, const ProgressCallba
         loaded = read_image(state_path(config_.frames[index - 1]), {"i", "x", "y", "phi"});
         previous = &loaded;
       } else {
-        run_frame(index - 1, {});  // the frames before, in order (not reported: they are this frame's cost)
+        run_frame(index - 1, progress);  // the frames before, in order; cancelling there cancels this one too
         previous = &last_nnf_;
       }
     }

@@ -7,6 +7,7 @@ import pytest
 
 import tempera
 from tempera import fluidymation, guide_cache, read_image, write_image
+from conftest import assert_releases_gil
 
 SIZE = 40
 
@@ -62,6 +63,13 @@ def test_stylize_sequence_paints_inside_the_masks_only():
     assert np.all(frames[0]["time_shift"] == 0)
 
 
+def test_the_solve_releases_the_gil():
+    ex = ink_frames()
+    targets = [disc(7 + 1.5 * j) for j in range(3)]
+    assert_releases_gil(lambda: fluidymation.stylize_sequence([e[..., :3] for e in ex], [e[..., 3] for e in ex],
+                                                              targets, em_iterations=12, **FAST))
+
+
 def test_bad_values_are_value_errors():
     ex = ink_frames(3)
     with pytest.raises(ValueError, match="target"):
@@ -115,12 +123,30 @@ def test_media_job_runs_earlier_frames_first_and_rejects_bad_input(tmp_path):
     assert not job.flow_from_guides
     assert job.run_frame(2)["status"] == "stylized"
     assert job.run_frame(0)["status"] == "skipped"
+    both = fluidymation.MediaJob(exemplar, cache, [1, 2, 3], tmp_path / "both", bidirectional=True, **FAST)
+    assert [both.run_frame(i)["status"] for i in range(3)] == ["stylized"] * 3
+    assert np.allclose(read_image(both.output_path(3))[..., 3], disc(7 + 3.0), atol=1 / 255)
     with pytest.raises(ValueError, match="consecutive"):
         fluidymation.MediaJob(exemplar, cache, [1, 3], tmp_path / "bad")
     with pytest.raises(ValueError, match="mask.OB_Nope"):
         fluidymation.MediaJob(exemplar, cache, [1, 2], tmp_path / "bad", target_mask="mask.OB_Nope")
     with pytest.raises(FileNotFoundError):
         fluidymation.MediaJob(tmp_path / "none", cache, [1, 2], tmp_path / "bad")
+
+
+def test_media_job_takes_rgb_frames_with_a_mask_folder(tmp_path):
+    _, cache = make_inputs(tmp_path, frames=2)
+    rgb, masks = tmp_path / "rgb", tmp_path / "masks"
+    rgb.mkdir(), masks.mkdir()
+    for i, f in enumerate(ink_frames()):
+        write_image(str(rgb / f"f{i:02d}.png"), np.ascontiguousarray(f[..., :3]))
+        write_image(str(masks / f"m{i:02d}.png"), np.ascontiguousarray(f[..., 3:]))
+    job = fluidymation.MediaJob(rgb, cache, [1, 2], tmp_path / "out", exemplar_masks=masks, format="exr", **FAST)
+    assert [job.run_frame(i)["status"] for i in range(2)] == ["stylized"] * 2
+    out = read_image(job.output_path(2))
+    assert out.shape == (SIZE, SIZE, 4) and np.all(out[disc(8.5) <= 0.5, :3] == 0)
+    with pytest.raises(ValueError, match="no alpha"):
+        fluidymation.MediaJob(rgb, cache, [1, 2], tmp_path / "bad")
 
 
 def test_cli_runs_and_exits_2_on_bad_input(tmp_path, cli_path):

@@ -11,7 +11,8 @@
 //  - theta is not searched: source and target orientations are the flow
 //    angles, and the engine rotates each patch by a_src - a_tgt, so the
 //    rotated exemplar flow points along the target flow at the patch centre;
-//    D_dir (a pair term) adds |tan| of what is left across the patch;
+//    D_dir (a pair term) adds |tan| of what is left on the patch's corners
+//    and edge midpoints;
 //  - D_temp: the previous frame's field advanced in exemplar time by
 //    SHIFTNNF (shift_nnf below) and voted, weighted by w_t m(q);
 //  - Omega: footprint usage over the n x n x (2r + 1) cuboid
@@ -30,13 +31,18 @@
 //    exemplar keeps the exemplar's fronts facing outward, D_ext compares
 //    like with like with no per-pair swap, and SHIFTNNF plays such matches
 //    backward (delta i <= 0 on ext-): the paper's "opposite flows";
-//  - D_dir is clamped at |tan| = 1 and averaged over the patch, so w_d = 1
-//    weighs a fully misaligned patch like a unit colour difference;
+//  - D_dir is clamped at |tan| = 1 and averaged over the patch's corners and
+//    edge midpoints, so w_d = 1 weighs a fully misaligned patch like a unit
+//    colour difference;
 //  - ext is divided by `extent_scale` pixels before it is matched;
 //  - the shape blur b is the Gaussian's radius, sigma = b / 3;
 //  - m(q): smoothstep(|T_dist - S_dist|; m_l, m_u) as printed, or 1 - that
 //    ("release", the default: a pixel whose exemplar lags far behind the
-//    target's boundary is released from the temporal term; tested by F3).
+//    target's boundary is released from the temporal term; as printed the
+//    term is off wherever the match keeps pace, and flickers more: tested);
+//  - SHIFTNNF's exemplar time is fractional (quarter-frame search, kept while
+//    a pixel keeps its match), so slower targets advance by fractions;
+//  - DOWNSCALE picks the match under each level pixel's centre.
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -178,8 +184,8 @@ class Fluidymation {
 std::vector<FluidFrame> stylize_fluid_sequence(const FluidSequence& sequence, const FluidymationOptions& options,
                                                const ProgressCallback& progress = {});
 
-// The engine's energy term of D_dir (exposed for tests): weight times the
-// patch mean of min(|tan(a_src(p') - phi - a_tgt(q'))|, 1).
+// The engine's energy term of D_dir: weight times the mean over the patch's
+// corners and edge midpoints of min(|tan(a_src(p') - phi - a_tgt(q'))|, 1).
 std::shared_ptr<const EnergyTerm> make_direction_term(float weight);
 
 }  // namespace tempera
