@@ -34,7 +34,7 @@ MANTAFLOW_TIME_UNITS_PER_SECOND = 2.5
 PARTICLE_SECONDS_PER_FRAME = 0.04
 
 DEFAULT_ALPHA_THRESHOLD = 1e-3  # alpha above which a pixel shows fluid and gets a velocity
-FILL_ITERATIONS = 40  # Jacobi sweeps of the diffusion fill on each level of the pyramid
+FILL_ITERATIONS = 24  # Jacobi sweeps of the diffusion fill on each level of the pyramid
 
 
 def _array(name, value, shape_tail, dtype=np.float64):
@@ -127,20 +127,28 @@ def splat(positions, values, weights, size):
         inside = (x >= 0) & (x < width) & (y >= 0) & (y < height)
         index = (y * width + x)[inside]
         sw = (w * share)[inside]
-        np.add.at(weight_sum, index, sw)
+        weight_sum += np.bincount(index, sw, minlength=height * width)
         for c in range(vals.shape[1]):
-            np.add.at(value_sum[:, c], index, sw * vals[inside, c])
+            value_sum[:, c] += np.bincount(index, sw * vals[inside, c], minlength=height * width)
     return value_sum.reshape(height, width, -1), weight_sum.reshape(height, width)
 
 
-def _neighbour_mean(values, region):
-    """Mean of the 4-neighbours of each pixel that lie in `region` (H, W), and
-    where any does; values outside the region do not count."""
-    v = np.pad(values * region[:, :, None], ((1, 1), (1, 1), (0, 0)))
-    r = np.pad(region.astype(np.float64), 1)
-    total = v[:-2, 1:-1] + v[2:, 1:-1] + v[1:-1, :-2] + v[1:-1, 2:]
-    count = r[:-2, 1:-1] + r[2:, 1:-1] + r[1:-1, :-2] + r[1:-1, 2:]
-    return total / np.maximum(count, 1.0)[:, :, None], count > 0
+def _relax(out, holes, inside, iterations):
+    """Jacobi sweeps in place: each hole becomes the mean of its 4-neighbours
+    in `inside` (`out` is 0 outside it, so those add nothing)."""
+    h, w = inside.shape
+    region = np.pad(inside.astype(out.dtype), 1)
+    count = region[:-2, 1:-1] + region[2:, 1:-1] + region[1:-1, :-2] + region[1:-1, 2:]
+    update = (holes & (count > 0))[:, :, None]
+    inverse = (1.0 / np.maximum(count, 1.0))[:, :, None]
+    padded = np.zeros((h + 2, w + 2, out.shape[2]), out.dtype)
+    for _ in range(iterations):
+        padded[1:-1, 1:-1] = out
+        total = padded[:-2, 1:-1] + padded[2:, 1:-1]
+        total += padded[1:-1, :-2]
+        total += padded[1:-1, 2:]
+        total *= inverse
+        np.copyto(out, total, where=update)
 
 
 def _coarser(values, known, inside):
@@ -165,24 +173,30 @@ def diffuse_fill(values, known, inside, iterations=FILL_ITERATIONS):
     level starts from the level below and relaxes with Jacobi sweeps. Pixels
     outside `inside` are 0; a region of `inside` with no known pixel gets what
     diffuses in through the coarse levels, or 0."""
-    values = np.asarray(values, np.float64)
+    values = np.asarray(values, np.float32)  # float32 halves the sweeps' memory traffic
     values = values[:, :, None] if values.ndim == 2 else values
     known, inside = np.asarray(known, bool) & np.asarray(inside, bool), np.asarray(inside, bool)
     if values.shape[:2] != known.shape or known.shape != inside.shape:
         raise ValueError(f"values {values.shape[:2]}, known {known.shape} and inside {inside.shape} differ in size")
-    out = np.where(known[:, :, None], values, 0.0)
+    out = np.where(known[:, :, None], values, np.float32(0))
     holes = inside & ~known
     if not holes.any() or not known.any():
         return out
+    rows, cols = np.flatnonzero(inside.any(axis=1)), np.flatnonzero(inside.any(axis=0))
+    box = np.s_[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1]  # the work is inside's bounding box only
+    out[box] = _fill(out[box], known[box], inside[box], iterations)
+    return out
+
+
+def _fill(out, known, inside, iterations):
+    holes = inside & ~known
     h, w = known.shape
     if min(h, w) > 2:
         coarse, coarse_known, coarse_inside = _coarser(out, known, inside)
         start = diffuse_fill(coarse, coarse_known, coarse_inside, iterations)
         up = np.repeat(np.repeat(start, 2, axis=0), 2, axis=1)[:h, :w]
         out = np.where(holes[:, :, None], up, out)
-    for _ in range(iterations):
-        mean, any_neighbour = _neighbour_mean(out, inside)
-        out = np.where((holes & any_neighbour)[:, :, None], mean, out)
+    _relax(out, holes, inside, iterations)
     return out
 
 
@@ -211,6 +225,7 @@ def fluid_velocity(points, velocities, weights, world_to_clip, size, alpha,
     if not np.all(np.isfinite(w)) or np.any(w < 0):
         raise ValueError("weights (densities) must be finite and >= 0")
     start, displacement, valid = screen_displacement(p, velocities, world_to_clip, (width, height))
+    valid &= w > 0  # most voxels of a gas domain are empty
     total, weight = splat(start[valid], displacement[valid], w[valid], (width, height))
     known = weight > 1e-12 * max(weight.max(initial=0.0), 1e-300)
     mean = total / np.where(known, weight, 1.0)[:, :, None]
@@ -227,39 +242,81 @@ def _matrix(name, matrix):
     return m
 
 
-def gas_domain_samples(velocity_grid, density_grid, resolution, bounds_min, bounds_max, matrix_world,
-                       fps, time_scale=1.0):
-    """(points, velocities per frame, weights) of a Mantaflow gas domain's
-    voxels, all in world space.
+class DomainGrid:
+    """A Mantaflow domain's grid: resolution (X, Y, Z), its corners in the
+    domain object's space, the object's matrix_world, and the length of a
+    frame in Mantaflow time units (2.5 * time_scale / fps,
+    MANTAFLOW_TIME_UNITS_PER_SECOND)."""
 
-    velocity_grid: 3 * X * Y * Z floats (x fastest, as Blender's
-    FluidDomainSettings.velocity_grid), in cells per Mantaflow time unit;
-    density_grid: X * Y * Z floats; resolution: (X, Y, Z); bounds_min/max:
-    the corners of the grid in the domain object's space; matrix_world: the
-    domain object's. A frame is 2.5 * time_scale / fps time units
-    (MANTAFLOW_TIME_UNITS_PER_SECOND), a cell is (bounds_max - bounds_min) /
-    resolution in object space."""
-    res = np.asarray(resolution, np.int64)
-    if res.shape != (3,) or np.any(res < 1):
-        raise ValueError(f"resolution must be 3 positive whole numbers, got {resolution!r}")
-    count = int(np.prod(res))
-    vel = np.asarray(velocity_grid, np.float64).reshape(-1)
+    def __init__(self, resolution, bounds_min, bounds_max, matrix_world, fps, time_scale=1.0):
+        self.res = np.asarray(resolution, np.int64)
+        if self.res.shape != (3,) or np.any(self.res < 1):
+            raise ValueError(f"resolution must be 3 positive whole numbers, got {resolution!r}")
+        self.matrix = _matrix("matrix_world", matrix_world)
+        self.low, high = np.asarray(bounds_min, np.float64), np.asarray(bounds_max, np.float64)
+        if self.low.shape != (3,) or high.shape != (3,) or np.any(high <= self.low):
+            raise ValueError(f"bounds must be two 3D corners with min < max, got {bounds_min!r}, {bounds_max!r}")
+        self.cell = (high - self.low) / self.res
+        self.frame_length = (MANTAFLOW_TIME_UNITS_PER_SECOND * _positive("time_scale", time_scale)
+                             / _positive("fps (frames per second)", fps))
+
+    def count(self):
+        return int(np.prod(self.res))
+
+    def velocities(self, velocity_grid):
+        """The grid's velocities (X * Y * Z, 3), x fastest, as object-space displacements per frame."""
+        vel = np.asarray(velocity_grid, np.float64).reshape(-1)
+        if vel.size != 3 * self.count():
+            raise ValueError(f"a {' x '.join(map(str, self.res))} grid needs {3 * self.count()} velocity values, "
+                             f"got {vel.size}")
+        return vel.reshape(-1, 3) * self.cell * self.frame_length
+
+    def voxel_centres(self):
+        """Object-space voxel centres (X * Y * Z, 3), x fastest."""
+        z, y, x = np.meshgrid(*(np.arange(n) for n in self.res[::-1]), indexing="ij")
+        return self.low + (np.stack([x, y, z], axis=-1).reshape(-1, 3) + 0.5) * self.cell
+
+    def sample(self, field, local_points):
+        """Trilinear interpolation of a per-voxel field (X * Y * Z, C) at
+        object-space points (N, 3), clamped to the voxel centres."""
+        grid = np.asarray(field).reshape(self.res[2], self.res[1], self.res[0], -1)
+        index = np.clip((local_points - self.low) / self.cell - 0.5, 0, self.res - 1)
+        i0 = np.minimum(np.floor(index).astype(np.int64), self.res - 1)
+        i1, t = np.minimum(i0 + 1, self.res - 1), index - i0
+        out = np.zeros((len(local_points), grid.shape[3]))
+        for corner in range(8):
+            pick = [(corner >> axis) & 1 for axis in range(3)]
+            ix, iy, iz = (np.where(pick[a], i1[:, a], i0[:, a]) for a in range(3))
+            share = np.prod([np.where(pick[a], t[:, a], 1 - t[:, a]) for a in range(3)], axis=0)
+            out += share[:, None] * grid[iz, iy, ix]
+        return out
+
+    def to_world(self, local_points, local_velocities):
+        m = self.matrix
+        return local_points @ m[:3, :3].T + m[:3, 3], local_velocities @ m[:3, :3].T
+
+
+def gas_domain_samples(velocity_grid, density_grid, grid):
+    """(points, velocities per frame, weights) of a Mantaflow gas domain's
+    voxels (DomainGrid `grid`), all in world space. velocity_grid: 3 * X * Y
+    * Z floats (x fastest, as Blender's FluidDomainSettings.velocity_grid), in
+    cells per Mantaflow time unit; density_grid: X * Y * Z floats."""
     dens = np.asarray(density_grid, np.float64).reshape(-1)
-    if vel.size != 3 * count or dens.size != count:
-        raise ValueError(f"a {res[0]} x {res[1]} x {res[2]} grid needs {3 * count} velocity and {count} density "
-                         f"values, got {vel.size} and {dens.size}")
-    m = _matrix("matrix_world", matrix_world)
-    low, high = np.asarray(bounds_min, np.float64), np.asarray(bounds_max, np.float64)
-    if low.shape != (3,) or high.shape != (3,) or np.any(high <= low):
-        raise ValueError(f"bounds must be two 3D corners with min < max, got {bounds_min!r}, {bounds_max!r}")
-    cell = (high - low) / res
-    z, y, x = np.meshgrid(*(np.arange(n) for n in res[::-1]), indexing="ij")
-    local = low + (np.stack([x, y, z], axis=-1).reshape(-1, 3) + 0.5) * cell
-    frame_length = (MANTAFLOW_TIME_UNITS_PER_SECOND * _positive("time_scale", time_scale)
-                    / _positive("fps (frames per second)", fps))
-    local_velocity = vel.reshape(-1, 3) * cell * frame_length  # object space, per frame
-    points = local @ m[:3, :3].T + m[:3, 3]
-    return points, local_velocity @ m[:3, :3].T, np.maximum(np.nan_to_num(dens), 0.0)
+    if dens.size != grid.count():
+        raise ValueError(f"a {' x '.join(map(str, grid.res))} grid needs {grid.count()} density values, "
+                         f"got {dens.size}")
+    points, velocities = grid.to_world(grid.voxel_centres(), grid.velocities(velocity_grid))
+    return points, velocities, np.maximum(np.nan_to_num(dens), 0.0)
+
+
+def liquid_grid_samples(vertices, velocity_grid, grid):
+    """(points, velocities per frame, weights of 1) of a liquid mesh's
+    vertices (N, 3, object space) moving with the domain's velocity grid
+    (interpolated at each vertex): what a baked cache gives, whose liquid
+    mesh reads back with a velocity attribute of zeros (Blender 3.4 writes no
+    mesh velocity files)."""
+    v = _array("vertices", vertices, (3,))
+    return (*grid.to_world(v, grid.sample(grid.velocities(velocity_grid), v)), np.ones(len(v)))
 
 
 def mesh_samples(vertices, velocity, matrix_world, domain_size, fps, time_scale=1.0):

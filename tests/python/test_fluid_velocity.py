@@ -127,8 +127,8 @@ def test_gas_domain_voxels_and_mantaflow_units():
     density = np.arange(np.prod(res), dtype=float)
     matrix = np.diag([2.0, 1.0, 1.0, 1.0])
     matrix[:3, 3] = [10, 0, 0]
-    points, per_frame, weights = fv.gas_domain_samples(velocity, density, res, [-1, -1, -1], [1, 1, 1], matrix,
-                                                       fps=24, time_scale=0.5)
+    grid = fv.DomainGrid(res, [-1, -1, -1], [1, 1, 1], matrix, fps=24, time_scale=0.5)
+    points, per_frame, weights = fv.gas_domain_samples(velocity, density, grid)
     cell = np.array([2 / 4, 2 / 3, 2 / 2])
     np.testing.assert_allclose(points[0], [10 + 2 * (-1 + cell[0] / 2), -1 + cell[1] / 2, -1 + cell[2] / 2])
     np.testing.assert_allclose(points[1] - points[0], [2 * cell[0], 0, 0])  # x fastest
@@ -137,8 +137,28 @@ def test_gas_domain_voxels_and_mantaflow_units():
     np.testing.assert_allclose(per_frame, np.broadcast_to(expected, per_frame.shape))
     np.testing.assert_allclose(weights, density)
     # the +2 m/s flow measured on Blender 3.4 (6.4 cells per unit in a 4 m, 32 cell domain) is 2/24 m per frame
-    _, v, _ = fv.gas_domain_samples([6.4, 0, 0], [1], (1, 1, 1), [0, 0, 0], [4 / 32] * 3, np.eye(4), fps=24)
+    one_cell = fv.DomainGrid((1, 1, 1), [0, 0, 0], [4 / 32] * 3, np.eye(4), fps=24)
+    _, v, _ = fv.gas_domain_samples([6.4, 0, 0], [1], one_cell)
     assert v[0, 0] == pytest.approx(2 / 24)
+
+
+def test_liquid_vertices_take_the_interpolated_grid_velocity():
+    """A grid velocity linear in x is interpolated exactly between voxel
+    centres and clamped beyond them; a +3 m/s liquid (9.5 cells per unit
+    in a 4 m, 32 cell domain, Blender 3.4) moves 0.124 m per frame."""
+    res = (4, 2, 2)
+    grid = fv.DomainGrid(res, [0, 0, 0], [4, 2, 2], np.eye(4), fps=24)
+    centres = grid.voxel_centres()
+    field = np.zeros((len(centres), 3))
+    field[:, 0] = centres[:, 0]  # vx = x cells per unit
+    points, v, w = fv.liquid_grid_samples([[1.25, 0.7, 1.1], [0.1, 1, 1], [3.9, 1, 1]], field.reshape(-1), grid)
+    frame = 2.5 / 24
+    np.testing.assert_allclose(v[:, 0], np.array([1.25, 0.5, 3.5]) * frame)
+    np.testing.assert_allclose(v[:, 1:], 0)
+    assert list(w) == [1, 1, 1]
+    liquid = fv.DomainGrid((32, 16, 16), [-2, -1, -1], [2, 1, 1], np.eye(4), fps=24)
+    _, v, _ = fv.liquid_grid_samples([[0, 0, 0]], np.tile([9.5, 0, 0], 32 * 16 * 16), liquid)
+    assert v[0, 0] == pytest.approx(0.124, rel=0.01)
 
 
 def test_liquid_mesh_and_particle_units():
@@ -173,10 +193,11 @@ def test_liquid_mesh_and_particle_units():
                                np.ones((W, H))), "alpha must be"),
     (lambda: fv.fluid_velocity(np.full((3, 3), np.nan), np.zeros((3, 3)), np.ones(3), np.eye(4), (W, H),
                                np.ones((H, W))), "NaN"),
-    (lambda: fv.gas_domain_samples(np.zeros(5), np.zeros(2), (2, 1, 1), [0] * 3, [1] * 3, np.eye(4), 24),
-     "grid needs"),
-    (lambda: fv.gas_domain_samples(np.zeros(6), np.zeros(2), (2, 1, 1), [0] * 3, [1] * 3, np.eye(4), 0),
-     "fps"),
+    (lambda: fv.gas_domain_samples(np.zeros(5), np.zeros(2), fv.DomainGrid((2, 1, 1), [0] * 3, [1] * 3,
+                                                                           np.eye(4), 24)), "grid needs"),
+    (lambda: fv.DomainGrid((2, 1, 1), [0] * 3, [1] * 3, np.eye(4), 0), "fps"),
+    (lambda: fv.DomainGrid((2, 0, 1), [0] * 3, [1] * 3, np.eye(4), 24), "resolution"),
+    (lambda: fv.DomainGrid((2, 1, 1), [0] * 3, [1, 0, 1], np.eye(4), 24), "bounds"),
     (lambda: fv.particle_samples(np.zeros((2, 3)), np.zeros((2, 3)), timestep=0), "timestep"),
     (lambda: fv.mesh_samples(np.zeros((2, 3)), np.zeros((2, 3)), np.eye(4), 0.0, 24), "domain_size"),
 ])

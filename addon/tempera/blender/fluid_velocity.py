@@ -10,7 +10,9 @@ grids crash Blender 3.4):
   bounds, which are the evaluated domain mesh's (the adaptive domain's
   current box included);
 * liquid domains: the vertices of the evaluated liquid mesh and their
-  `velocity` attribute (the domain's Speed Vectors option);
+  `velocity` attribute (the domain's Speed Vectors option) or, where that
+  reads back as zeros (a baked cache in Blender 3.4), the domain's velocity
+  grid at each vertex;
 * emitter particle systems: the live particles' location and velocity.
 Cycles' Vector pass is zero on volumes and about zero on liquid meshes, which
 is why this guide exists (docs/guide_cache.md).
@@ -46,40 +48,51 @@ def _matrix(matrix):
     return np.array([list(row) for row in matrix], np.float64)
 
 
-def _longest_side(mesh):
+def _bounds(mesh):
     co = np.zeros(len(mesh.vertices) * 3, np.float32)
     mesh.vertices.foreach_get("co", co)
     co = co.reshape(-1, 3)
-    return float((co.max(axis=0) - co.min(axis=0)).max())
+    return co.min(axis=0), co.max(axis=0)
+
+
+def _grid(obj, settings, bounds, fps):
+    return fv.DomainGrid(tuple(settings.domain_resolution), *bounds, _matrix(obj.matrix_world), fps,
+                         settings.time_scale)
 
 
 def _gas_samples(obj, settings, fps):
-    res = tuple(settings.domain_resolution)
     velocity = np.array(settings.velocity_grid, np.float32)
-    density = np.array(settings.density_grid, np.float32)
-    if min(res) < 1 or velocity.size == 0:
+    if min(settings.domain_resolution) < 1 or velocity.size == 0:
         return None  # not simulated at this frame (e.g. before the cache starts)
-    corners = np.array([list(c) for c in obj.bound_box])
-    return fv.gas_domain_samples(velocity, density, res, corners.min(axis=0), corners.max(axis=0),
-                                 _matrix(obj.matrix_world), fps, settings.time_scale)
+    corners = np.array([list(c) for c in obj.bound_box])  # the evaluated box: an adaptive domain's too
+    grid = _grid(obj, settings, (corners.min(axis=0), corners.max(axis=0)), fps)
+    return fv.gas_domain_samples(velocity, np.array(settings.density_grid, np.float32), grid)
 
 
 def _liquid_samples(obj, settings, fps):
     mesh = obj.to_mesh()
     try:
         count = len(mesh.vertices)
-        attribute = mesh.attributes.get("velocity")
-        if count == 0 or attribute is None:
-            return None  # no surface yet, or Speed Vectors off: nothing says how it moves
+        if count == 0:
+            return None  # no liquid yet
         vertices = np.zeros(count * 3, np.float32)
         mesh.vertices.foreach_get("co", vertices)
         velocity = np.zeros(count * 3, np.float32)
-        attribute.data.foreach_get("vector", velocity)
+        attribute = mesh.attributes.get("velocity")
+        if attribute is not None:
+            attribute.data.foreach_get("vector", velocity)
     finally:
         obj.to_mesh_clear()
-    size = _longest_side(obj.original.data)  # of the domain's own mesh, not the liquid's
-    return fv.mesh_samples(vertices.reshape(-1, 3), velocity.reshape(-1, 3), _matrix(obj.matrix_world), size, fps,
-                           settings.time_scale)
+    vertices = vertices.reshape(-1, 3)
+    bounds = _bounds(obj.original.data)  # the domain's own mesh, not the liquid's
+    if velocity.any():  # Speed Vectors, while simulating
+        size = float((bounds[1] - bounds[0]).max())
+        return fv.mesh_samples(vertices, velocity.reshape(-1, 3), _matrix(obj.matrix_world), size, fps,
+                               settings.time_scale)
+    grid_velocity = np.array(settings.velocity_grid, np.float32)
+    if grid_velocity.size == 0:
+        return None
+    return fv.liquid_grid_samples(vertices, grid_velocity, _grid(obj, settings, bounds, fps))
 
 
 def _particle_samples(system):

@@ -669,10 +669,9 @@ def _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress, 
 
 def _fluid_state(scene, layer, frame):
     """(fluid samples or None, world to clip matrix) of `frame`, read from the
-    evaluated scene before it is rendered (a render can leave Blender 3.4's
-    evaluated objects stale: scene_export.evaluated_depsgraph)."""
-    scene.frame_set(frame)
-    depsgraph = layer.depsgraph
+    scene evaluated afresh (a render can leave Blender 3.4's evaluated objects
+    stale: scene_export.evaluated_depsgraph)."""
+    depsgraph = evaluated_depsgraph(scene, layer, frame)
     return (fluid_velocity.scene_fluid_samples(scene, depsgraph),
             fluid_velocity.world_to_clip(scene, depsgraph, effective_resolution(scene)))
 
