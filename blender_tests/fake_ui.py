@@ -64,3 +64,29 @@ def modal_run(operator_class, scene, job, events, after_start=None, tick=0.0):
             break
         time.sleep(tick)
     return results, log, reports, wm.timers, op
+
+
+def esc_within_next_step(operator_class, scene, job, hold):
+    """Runs `job` modally until Esc stops it in the middle of its next step:
+    `hold(wrap)` puts, in the job's step, wrap(progress): a progress callback
+    that waits for the Esc (at most 60 s) before passing the fraction on, so
+    the Esc surely comes within the step however fast the machine. One TIMER
+    starts the step in the worker, then Esc. Returns modal_run's tuple."""
+    holder = []
+
+    def wrap(progress):
+        def wait_for_esc(fraction):
+            deadline = time.monotonic() + 60
+            while not holder[0]._stop and time.monotonic() < deadline:
+                time.sleep(0.01)
+            return progress(fraction)
+        return wait_for_esc
+
+    hold(wrap)
+
+    def events(op):
+        holder.append(op)
+        yield ("TIMER", "NOTHING")
+        yield ("ESC", "PRESS")
+
+    return modal_run(operator_class, scene, job, events, tick=0.02)

@@ -4,12 +4,11 @@ exemplar. Stylize Animation renders the guides (which write tracks.json),
 runs the method a step per object and chunk, composites and loads the
 result; Esc within a step writes nothing of it, and a rerun resumes."""
 import math
-import time
 
 import bpy
 import numpy as np
 import pytest
-from fake_ui import modal_run
+from fake_ui import esc_within_next_step
 
 SCENE = "Rigid method test"
 SIZE = (96, 72)
@@ -135,23 +134,10 @@ def test_esc_within_a_step_writes_nothing_then_resume(rigid_scene, tmp_path):
     held = run._rigid_job()
     stylize = held._stylize
 
-    def held_stylize(name, frames, paths, progress):
-        def wait_for_esc(fraction):  # Esc surely comes within the step, however fast the machine
-            deadline = time.monotonic() + 60
-            while not op_holder[0]._stop and time.monotonic() < deadline:
-                time.sleep(0.01)
-            return progress(fraction)
-        return stylize(name, frames, paths, wait_for_esc)
+    def hold(wrap):
+        held._stylize = lambda name, frames, paths, progress: stylize(name, frames, paths, wrap(progress))
 
-    held._stylize = held_stylize
-    op_holder = []
-
-    def events(op):
-        op_holder.append(op)
-        yield ("TIMER", "NOTHING")  # starts the second chunk in the worker
-        yield ("ESC", "PRESS")
-
-    results, _log, reports, timers, _op = modal_run(TEMPERA_OT_stylize, rigid_scene, run, events, tick=0.02)
+    results, _log, reports, timers, _op = esc_within_next_step(TEMPERA_OT_stylize, rigid_scene, run, hold)
     assert results[-1] == {"CANCELLED"} and not timers and "Stopped" in reports[-1][1]
     layers = tmp_path / "out" / "rigid" / "layers" / "Ball"
     assert _frames(layers) == [f"frame_{f:04d}.png" for f in range(FRAMES[0], FRAMES[0] + 8)]  # the first chunk only

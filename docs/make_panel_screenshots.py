@@ -21,7 +21,8 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 IMAGES = HERE / "images"
 # (file, width of the Properties area, what is set up first)
-SHOTS = (("panel_top.png", "top"), ("panel_custom_exemplar.png", "custom"), ("panel_guides.png", "guides"))
+SHOTS = (("panel_top.png", "top"), ("panel_custom_exemplar.png", "custom"), ("panel_guides.png", "guides"),
+         ("panel_fluid.png", "fluid"), ("panel_natural_media.png", "media"))
 # Blender's default layout on a tall screen: its Properties editor keeps the
 # default width (333 px, as at 1920x1080) and is tall enough for the panel.
 WINDOW = (1920, 2300)
@@ -137,6 +138,12 @@ def in_blender(argv):
         elif kind == "guides":
             settings.exemplar_source = "KIT"
             settings.guide_lpe = "L.*SDE; LD{2}E"
+        elif kind == "fluid":
+            settings.guide_lpe = ""
+            settings.method, settings.media_exemplar_kind, settings.media_exemplar = "LAZYFLUIDS", "STILL", "//smoke.png"
+        elif kind == "media":
+            settings.method, settings.media_exemplar_kind, settings.media_exemplar = "FLUIDYMATION", "MOVIE", "//ink.mov"
+            settings.fm_target_object = scene.objects.get("Cube")
 
     def shoot():
         if not steps:

@@ -98,6 +98,15 @@ def mask_guide(kind, name):
     return f"mask.{kind}_{name.replace('.', '_')}"
 
 
+def masks_including(mode, kind):
+    """The "masks" parameter that renders the masks `mode` renders and those
+    of `kind` ('OB' objects, 'CO' collections) too: a method whose target is
+    an object's or a collection's mask widens the guides' masks to include it."""
+    wanted = {"OB": "objects", "CO": "collections"}[kind]
+    kinds = ({"objects", "collections"} if mode == "objects+collections" else {mode}) - {"none"} | {wanted}
+    return "objects+collections" if len(kinds) == 2 else wanted
+
+
 def lpe_guide(expression):
     """Guide name of a light path expression: "lpe_" and the expression if it
     is only letters and digits ("LDE" -> "lpe_LDE"); otherwise every run of

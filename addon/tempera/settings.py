@@ -39,3 +39,11 @@ PANEL_TEMPORAL_WEIGHT = 0.5
 DEFAULT_QUALITY = _native.stylit_defaults()["quality"]
 QUALITY_PRESETS = ("preview", "final")
 OUTPUT_FORMATS = ("png", "exr")
+
+# The fluid methods' option tables (name -> row, as ENGINE_OPTIONS):
+# LazyFluids (lazyfluids.hpp) and Fluidymation (fluidymation.hpp). The panel
+# shows λ, rotations and motion blur of the one, bidirectional of the other;
+# its sliders stop at these soft maxima (the tables take more, for scripts).
+LAZYFLUIDS_OPTIONS = {row["name"]: row for row in _native.LazyFluidsOptions.table()}
+FLUIDYMATION_OPTIONS = {row["name"]: row for row in _native.FluidymationOptions.table()}
+PANEL_SOFT_MAX = {"temporal_weight": 1.0, "motion_blur": 16.0}

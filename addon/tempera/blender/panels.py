@@ -70,8 +70,11 @@ class TEMPERA_PT_output(Panel):
         col.operator(TEMPERA_OT_render_guides.bl_idname, text="Render Guides Only", icon="RENDERLAYERS")
         draw_frames(layout.column(), settings)
 
-        draw_exemplar(layout.box(), settings)
-        draw_light_paths(layout.box(), settings)
+        if settings.method in MEDIA_METHODS:  # an exemplar of the medium, no light-path guides
+            draw_media_exemplar(layout.box(), settings)
+        else:
+            draw_exemplar(layout.box(), settings)
+            draw_light_paths(layout.box(), settings)
         draw_synthesis(layout.box(), settings)
         draw_output(layout.box(), settings)
         draw_guides(layout.box(), context.scene, settings)
@@ -138,6 +141,11 @@ def draw_synthesis(box, settings):
     if settings.method == "RIGID":
         draw_rigid(box, settings)
         return  # the StyLit settings below do not apply
+    if settings.method in MEDIA_METHODS:
+        col = box.column()
+        MEDIA_METHODS[settings.method](col, settings)
+        col.prop(settings, "seed")
+        return
     col = box.column()
     col.prop(settings, "quality")
     col.prop(settings, "usage")
@@ -170,6 +178,34 @@ def draw_rigid(box, settings):
     col.prop(settings, "rigid_collection")
     col.prop(settings, "rigid_shape")
     col.prop(settings, "rigid_output")
+
+
+def draw_media_exemplar(box, settings):
+    """The exemplar of the fluid methods: a still, a sequence or a movie (and masks)."""
+    box.label(text="Exemplar", icon="BRUSH_DATA")
+    box.prop(settings, "media_exemplar_kind")
+    box.prop(settings, "media_exemplar")
+    if settings.method == "FLUIDYMATION":
+        box.prop(settings, "media_masks")
+
+
+def draw_lazyfluids(col, settings):
+    """LazyFluids: the temporal pull, the rotated exemplars, the motion blur."""
+    wide_prop(col, settings, "lf_lambda")
+    col.prop(settings, "lf_rotations")
+    col.prop(settings, "lf_motion_blur")
+
+
+def draw_fluidymation(col, settings):
+    """Fluidymation: the target (its mask guide), the flow, the two passes."""
+    col.prop(settings, "fm_target_object")
+    if settings.fm_target_object is None:
+        col.prop(settings, "fm_target_collection")
+    col.prop(settings, "fm_flow")
+    col.prop(settings, "fm_bidirectional")
+
+
+MEDIA_METHODS = {"LAZYFLUIDS": draw_lazyfluids, "FLUIDYMATION": draw_fluidymation}
 
 
 def draw_keyframes(box, settings):

@@ -102,6 +102,21 @@ METHOD_ITEMS = (
      "steer the frames around them (Stylize Frame stays per-frame StyLit)"),
     ("RIGID", "Rigid Bodies (hand-drawn)", "The squash, stretch and line of drawn examples carried onto the "
      "scene's rigid-body simulation (Dvorožňák 2017; needs a baked rigid-body world)"),
+    ("LAZYFLUIDS", "Fluid (LazyFluids)", "Smoke, fire and liquids painted from an RGBA exemplar carried along the "
+     "fluid's flow, its texture kept fresh by uniform patch usage (Jamriška 2015); RGBA frames over the render"),
+    ("FLUIDYMATION", "Natural Media (Fluidymation)", "A moving object or collection rendered as a filmed medium "
+     "(ink, watercolour) spreading along its motion, from a video exemplar with masks (Platkevič 2021); RGBA "
+     "frames over the render"),
+)
+MEDIA_EXEMPLAR_KINDS = (
+    ("STILL", "Still Image", "One RGBA image (LazyFluids only: Fluidymation needs the medium's motion)"),
+    ("SEQUENCE", "Image Sequence", "A folder of frames, or the first file of a numbered sequence (ink_0001.png)"),
+    ("MOVIE", "Movie", "A movie file, decoded to PNG frames once by ffmpeg (into Output Folder/exemplar_frames)"),
+)
+MEDIA_FLOWS = (
+    ("GUIDES", "Blender Motion", "The target's exact motion from the render (the guide cache's velocity)"),
+    ("MASKS", "From Masks", "Motion estimated from the target's masks alone (signed distance, diffusion fill, "
+     "temporal smoothing; Fluidymation App. A)"),
 )
 RIGID_SHAPES = (
     ("circle", "Circle", "The bodies and the drawn examples are balls"),
@@ -112,6 +127,7 @@ RIGID_OUTPUTS = (
     ("PAPER", "On Paper", "Opaque frames: the drawn bodies on paper"),
 )
 DEFAULT_KEYFRAME_DIR = "//tempera/keys/"
+_LF = limits.LAZYFLUIDS_OPTIONS
 
 
 class TemperaKeyframe(PropertyGroup):
@@ -331,3 +347,39 @@ class TemperaSettings(PropertyGroup):
                               description="The proxy shape of the bodies and of the drawn examples")
     rigid_output: EnumProperty(name="Result", items=RIGID_OUTPUTS, default="RGBA",
                                description="What the drawn bodies are drawn on")
+
+    # The fluid methods (docs/lazyfluids.md, docs/fluidymation.md): the exemplar they share.
+    media_exemplar_kind: EnumProperty(name="Exemplar", items=MEDIA_EXEMPLAR_KINDS, default="SEQUENCE",
+                                      description="What the exemplar of the medium is")
+    media_exemplar: StringProperty(
+        name="File", subtype="FILE_PATH", default="",
+        description="The still, the sequence's folder or first file, or the movie; '//' is relative to the "
+        ".blend file")
+    media_masks: StringProperty(
+        name="Masks", subtype="DIR_PATH", default="",
+        description="Optional: a folder of the exemplar's mask frames (white = medium); empty: its alpha")
+    lf_lambda: FloatProperty(
+        name="Temporal Coherence", default=_LF["temporal_weight"]["default"], min=_LF["temporal_weight"]["min"],
+        soft_max=limits.PANEL_SOFT_MAX["temporal_weight"],
+        description="λ, the pull of the previous frame carried along the flow (thesis eq. 5.6): higher flickers less "
+        "but lets the texture smear; 0 paints every frame afresh")
+    lf_rotations: BoolProperty(
+        name="Rotations", default=_LF["rotations"]["default"],
+        description="Also use the exemplar turned by 90, 180 and 270 degrees (more patches, for swirling flows)")
+    lf_motion_blur: FloatProperty(
+        name="Motion Blur", default=_LF["motion_blur"]["default"], min=_LF["motion_blur"]["min"],
+        soft_max=limits.PANEL_SOFT_MAX["motion_blur"],
+        subtype="PIXEL", description="Length in pixels of the blur along the flow; 0 = none")
+    fm_target_object: PointerProperty(
+        name="Target Object", type=bpy.types.Object,
+        description="The object the medium fills (its mask guide); empty: the collection below, else everything "
+        "rendered (the render's alpha)")
+    fm_target_collection: PointerProperty(
+        name="Target Collection", type=bpy.types.Collection,
+        description="The collection the medium fills (its mask guide), when no Target Object is set")
+    fm_flow: EnumProperty(name="Flow", items=MEDIA_FLOWS, default="GUIDES",
+                          description="Where the target's motion comes from")
+    fm_bidirectional: BoolProperty(
+        name="Bidirectional", default=limits.FLUIDYMATION_OPTIONS["bidirectional"]["default"],
+        description="A forward and a backward pass merged (the paper's future work): the medium also leads "
+        "into where the target will be; twice the time")

@@ -6,6 +6,7 @@ import bpy
 from . import compat
 
 RESULT_SCENE_SUFFIX = " Tempera"
+COMPOSITE_SCENE_SUFFIX = " Tempera Composite"  # RGBA results over the render
 RESULT_MARK = "tempera_result"  # custom property of a result scene (the panel hides there)
 
 
@@ -48,7 +49,25 @@ def load_sequencer_scene(scene, paths, frames):
     strip at their frame numbers, with the scene's frame rate and the frames'
     resolution (made anew on each run). Its view transform is Standard: the
     frames are display-referred paint, which Filmic would dim."""
-    name = scene.name + RESULT_SCENE_SUFFIX
+    result = _new_result_scene(scene, scene.name + RESULT_SCENE_SUFFIX, paths[0], frames)
+    _image_strip(result, "Tempera", paths, frames, channel=1)
+    return result
+
+
+def load_composite_scene(scene, render_paths, rgba_paths, frames):
+    """A scene '<scene> Tempera Composite' whose sequencer lays the RGBA
+    frames (channel 2, Alpha Over) over the render frames (channel 1): what
+    the fluid and natural-media methods look like over the shot."""
+    result = _new_result_scene(scene, scene.name + COMPOSITE_SCENE_SUFFIX, rgba_paths[0], frames)
+    _image_strip(result, "Render", render_paths, frames, channel=1)
+    _image_strip(result, "Tempera", rgba_paths, frames, channel=2).blend_type = "ALPHA_OVER"
+    return result
+
+
+def _new_result_scene(scene, name, first_path, frames):
+    """A new result scene `name` (replacing an old one) with the scene's frame
+    rate, the frames' range and the resolution of the image at `first_path`,
+    in the Standard view transform."""
     old = bpy.data.scenes.get(name)
     if old is not None:
         for window in bpy.context.window_manager.windows:  # no window may show a removed scene
@@ -61,7 +80,7 @@ def load_sequencer_scene(scene, paths, frames):
     result.render.fps, result.render.fps_base = scene.render.fps, scene.render.fps_base
     result.frame_start, result.frame_end = frames[0], frames[-1]
     result.frame_current = frames[0]
-    first = bpy.data.images.load(paths[0], check_existing=False)
+    first = bpy.data.images.load(first_path, check_existing=False)
     result.render.resolution_x, result.render.resolution_y = first.size
     result.render.resolution_percentage = 100
     bpy.data.images.remove(first)
@@ -71,11 +90,16 @@ def load_sequencer_scene(scene, paths, frames):
     result.view_settings.gamma = 1.0
     result.display_settings.display_device = "sRGB"
     result.sequencer_colorspace_settings.name = "sRGB"
-    editor = result.sequence_editor_create()
-    strip = compat.sequencer_strips(editor).new_image("Tempera", paths[0], channel=1, frame_start=frames[0])
+    return result
+
+
+def _image_strip(result, name, paths, frames, channel):
+    """An image strip of `paths` (one folder) from frames[0] in `result`'s sequencer."""
+    editor = result.sequence_editor or result.sequence_editor_create()
+    strip = compat.sequencer_strips(editor).new_image(name, paths[0], channel=channel, frame_start=frames[0])
     for path in paths[1:]:
         strip.elements.append(os.path.basename(path))
-    return result
+    return strip
 
 
 def reload_images_under(folder):

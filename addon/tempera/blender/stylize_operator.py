@@ -41,7 +41,7 @@ from .guide_operator import (ETA_AFTER_FRAMES, GuideJob, estimate_guide_seconds,
                              long_run_question, resolve_guide_dir)
 from .guide_render import GuideRenderError
 from .job_operator import JobOperator
-from .properties import WEIGHT_PROPERTIES
+from .properties import MEDIA_EXEMPLAR_KINDS, WEIGHT_PROPERTIES
 from . import results
 
 # Rough stylizing cost per megapixel on a 2-core machine (docs/benchmarks.md).
@@ -120,6 +120,19 @@ def output_dir(settings):
     return resolve_path(settings.output_dir, "Output Folder")
 
 
+def megapixels(scene):
+    """The render's size in megapixels (at its resolution percentage)."""
+    r = scene.render
+    return r.resolution_x * r.resolution_y * (r.resolution_percentage / 100.0) ** 2 / 1e6
+
+
+def require_consecutive(frames, method):
+    """ValueError unless `frames` follow each other (a method that carries
+    each frame on to the next)."""
+    if any(b != a + 1 for a, b in zip(frames, frames[1:])):
+        raise ValueError(f"{method} needs consecutive frames: set the scene's Frame Step to 1.")
+
+
 class StylizeRun:
     """The steps of one Stylize run: guides of every frame, then StyLit per frame."""
 
@@ -128,6 +141,7 @@ class StylizeRun:
         self.mode = mode
         self.frames = list(frames)
         self.out = output_dir(settings)
+        self.result_dir = self.out  # where the contact sheet and the mp4 go
         style, exemplar_guides, exemplar_frame = exemplar_paths(settings)
         self.guides = GuideJob.from_settings(scene, self.frames)
         self.config = dict(stylize_options(settings), style=style, exemplar_guides=exemplar_guides,
@@ -151,6 +165,8 @@ class StylizeRun:
             return CoherentRun(scene, frames, mode)
         if mode == "ANIMATION" and scene.tempera.method == "RIGID":
             return RigidRun(scene, frames, mode)
+        if scene.tempera.method in RGBA_RUNS:  # Stylize Frame too: the method on that frame alone
+            return RGBA_RUNS[scene.tempera.method](scene, frames, mode)
         return cls(scene, frames, mode)
 
     @property
@@ -246,9 +262,8 @@ class StylizeRun:
 
     def estimate_seconds(self, scene):
         """A rough duration of the whole run from scratch (guides and stylizing)."""
-        r = scene.render
-        mpix = r.resolution_x * r.resolution_y * (r.resolution_percentage / 100.0) ** 2 / 1e6
-        per_frame = mpix * STYLIZE_SECONDS_PER_MPIX.get(self.config["quality"], STYLIZE_SECONDS_PER_MPIX["final"])
+        per_frame = megapixels(scene) * STYLIZE_SECONDS_PER_MPIX.get(self.config["quality"],
+                                                                     STYLIZE_SECONDS_PER_MPIX["final"])
         return estimate_guide_seconds(scene, self.guides.params, len(self.frames)) + per_frame * len(self.frames)
 
     def mean_flicker(self):
@@ -280,8 +295,7 @@ class CoherentRun(StylizeRun):
         from .keyframes import key_list
 
         super().__init__(scene, frames, mode)
-        if any(b != a + 1 for a, b in zip(self.frames, self.frames[1:])):
-            raise ValueError("The coherent method needs consecutive frames: set the scene's Frame Step to 1.")
+        require_consecutive(self.frames, "The coherent method")
         self.keys = [k for k in key_list(scene.tempera) if self.frames[0] <= k[0] <= self.frames[-1]]
         self.segments = tcia.segments(self.frames, [k[0] for k in self.keys])
         self.segment_results = []
@@ -446,6 +460,135 @@ class RigidRun(StylizeRun):
         return f"Tempera: {', '.join(parts)} in {self.config['out']}"
 
 
+EXEMPLAR_FRAMES_DIR = "exemplar_frames"  # decoded movies and linked sequences, in the Output Folder
+RENDER_DIR = "render"  # the render under an RGBA result (tempera.beauty), in the method's folder
+
+
+class RgbaRun(StylizeRun):
+    """Guides of every frame, then an RGBA method's job a frame per step:
+    the frames go over the render (tempera.beauty) in a composite scene."""
+
+    folder = None  # the method's folder in the Output Folder
+    method_label = None  # the method's name in messages
+    seconds_per_mpix = None  # a frame's rough cost, for the confirmation of long runs
+    kinds = ("STILL", "SEQUENCE", "MOVIE")  # the exemplars the method takes
+
+    def __init__(self, scene, frames, mode="ANIMATION"):
+        from ..media_source import exemplar_source
+
+        settings = scene.tempera
+        self.mode = mode
+        self.frames = list(frames)
+        self.out = output_dir(settings)
+        label = next(n for k, n, _ in MEDIA_EXEMPLAR_KINDS if k == settings.media_exemplar_kind)
+        if settings.media_exemplar_kind not in self.kinds:
+            raise ValueError(f"The {self.method_label} method needs a video exemplar: set Exemplar to Image Sequence "
+                             f"or Movie (not {label}).")
+        cache = os.path.join(self.out, EXEMPLAR_FRAMES_DIR)
+        self.exemplar = exemplar_source(settings.media_exemplar_kind,
+                                        resolve_path(settings.media_exemplar, f"exemplar {label}"), cache)
+        require_consecutive(self.frames, f"The {self.method_label} method")
+        self.guides = GuideJob.from_settings(scene, self.frames)
+        self.method_out = self.result_dir = os.path.join(self.out, self.folder)
+        self.config = {"out": os.path.join(self.method_out, FRAMES_DIR), "format": settings.output_format,
+                       "quality": "final"}
+        self.options = self.job_options(settings)
+        self.noise = None
+        self.job = None  # the method's job, made once the guides exist
+        self.index = 0
+        self.results = []
+        self.stylize_seconds = 0.0
+        self.warnings = []
+
+    @property
+    def in_noise_phase(self):
+        return False  # no Temporal Noise after an RGBA method
+
+    def _stylize(self, progress):
+        if self.job is None:
+            self.job = self.make_method_job()
+            self.warnings = list(self.job.warnings)
+            for warning in self.warnings:
+                print(f"Tempera: {warning}", flush=True)
+        i = self.index - len(self.frames)
+        result = self.job.run_frame(i, progress)
+        if result["status"] == "stylized":
+            self.stylize_seconds += result["seconds"]
+        path = str(self.job.output_path(self.frames[i]))
+        self.results.append({"frame": self.frames[i], "path": path, "status": result["status"]})
+        if bpy.app.background:
+            print(f"Tempera: {self.method_label} frame {self.frames[i]} {result['status']} "
+                  f"in {result['seconds']:.1f} s", flush=True)
+
+    def estimate_seconds(self, scene):
+        return (estimate_guide_seconds(scene, self.guides.params, len(self.frames))
+                + megapixels(scene) * self.seconds_per_mpix * len(self.frames))
+
+    def render_paths(self):
+        """The render frames under the result (made from the guide cache when stale)."""
+        from ..beauty import write_render_frames
+
+        return write_render_frames(self.guides.folder, self.frames, os.path.join(self.method_out, RENDER_DIR))
+
+
+class FluidRun(RgbaRun):
+    """Guides, then LazyFluids (tempera.lazyfluids.FluidJob): smoke, fire and liquids."""
+
+    folder = "lazyfluids"
+    method_label = "Fluid"
+    seconds_per_mpix = 20.0  # wall, loaded 2-core machine (docs/benchmarks.md: 4.6-8.6 s per 0.26 Mpix)
+
+    def job_options(self, settings):
+        return {"temporal_weight": float(settings.lf_lambda), "rotations": bool(settings.lf_rotations),
+                "motion_blur": float(settings.lf_motion_blur), "seed": int(settings.seed)}
+
+    def make_method_job(self):
+        from ..lazyfluids import FluidJob
+
+        return FluidJob(self.exemplar, self.guides.folder, self.frames, self.config["out"],
+                        format=self.config["format"], **self.options)
+
+
+class MediaRun(RgbaRun):
+    """Guides (with the target's mask), then Fluidymation
+    (tempera.fluidymation.MediaJob): a moving object or collection as a medium."""
+
+    folder = "fluidymation"
+    method_label = "Natural Media"
+    seconds_per_mpix = 25.0  # wall, 2 cores (docs/benchmarks.md: 2.5 s idle, 14 s loaded per 0.3 Mpix)
+    kinds = ("SEQUENCE", "MOVIE")
+
+    def __init__(self, scene, frames, mode="ANIMATION"):
+        from .. import guide_cache
+
+        super().__init__(scene, frames, mode)
+        settings = scene.tempera
+        masks = settings.media_masks.strip()
+        self.exemplar_masks = resolve_path(masks, "exemplar Masks folder") if masks else None
+        if self.exemplar_masks is not None and not os.path.isdir(self.exemplar_masks):
+            raise FileNotFoundError(f"The exemplar Masks folder '{self.exemplar_masks}' does not exist.")
+        self.target_mask = "alpha"  # everything rendered
+        target = settings.fm_target_object or settings.fm_target_collection
+        if target is not None:
+            kind = "OB" if settings.fm_target_object is not None else "CO"
+            self.target_mask = guide_cache.mask_guide(kind, target.name)
+            self.guides.params["masks"] = guide_cache.masks_including(self.guides.params["masks"], kind)
+
+    def job_options(self, settings):
+        return {"flow": settings.fm_flow.lower(), "bidirectional": bool(settings.fm_bidirectional),
+                "seed": int(settings.seed)}
+
+    def make_method_job(self):
+        from ..fluidymation import MediaJob
+
+        return MediaJob(self.exemplar, self.guides.folder, self.frames, self.config["out"],
+                        exemplar_masks=self.exemplar_masks, target_mask=self.target_mask,
+                        format=self.config["format"], **self.options)
+
+
+RGBA_RUNS = {"LAZYFLUIDS": FluidRun, "FLUIDYMATION": MediaRun}
+
+
 def flicker_text(flicker):
     """The flicker figure, said so that an artist can read it."""
     verdict = "steady" if flicker < 0.02 else "some flicker" if flicker < 0.05 else "strong flicker"
@@ -497,7 +640,7 @@ class TEMPERA_OT_stylize(JobOperator, Operator):
         results.reload_images_under(job.out)  # images already open show this run's pixels
         shown = []
         if job.mode == "ANIMATION" and hasattr(job.job, "write_contact_sheet"):  # StyLit's frames
-            sheet = os.path.join(job.out, CONTACT_SHEET)
+            sheet = os.path.join(job.result_dir, CONTACT_SHEET)
             job.job.write_contact_sheet(sheet)
             shown.append(f"contact sheet {sheet}")
             if settings.make_video:
@@ -505,7 +648,11 @@ class TEMPERA_OT_stylize(JobOperator, Operator):
                 if video:
                     shown.append(f"video {video}")
         how = settings.load_result if job.mode == "ANIMATION" else "IMAGE"
-        loaded = results.load(scene, paths, job.frames, how)
+        if isinstance(job, RgbaRun) and paths and how != "NONE":  # over the render, whatever is shown
+            composite = results.load_composite_scene(scene, job.render_paths(), paths, job.frames)
+            loaded = composite if how == "SEQUENCER" else results.load(scene, paths, job.frames, how)
+        else:
+            loaded = results.load(scene, paths, job.frames, how)
         where = results.show(context, loaded, how)
         if where:
             shown.insert(0, where)
@@ -524,7 +671,7 @@ class TEMPERA_OT_stylize(JobOperator, Operator):
         # A '%' in the folder would be read by ffmpeg as a number of its own.
         pattern = os.path.join(job.config["out"].replace("%", "%%"), "frame_%04d.png")
         fps = scene.render.fps / scene.render.fps_base
-        video = os.path.join(job.out, VIDEO)
+        video = os.path.join(job.result_dir, VIDEO)
         if not encode_video(pattern, job.frames[0], video, fps):
             self.report({"WARNING"}, "ffmpeg not found: no mp4 written (the frames are there)")
             return None
