@@ -72,6 +72,7 @@ test: build addon-zip extension
 demo: build addon-zip
 	$(PYTHON) tools/run_demo.py --addon-zip $(ADDON_ZIP) --blender $(BLENDER) --out $(DEMO_OUT)
 	$(MAKE) demo-rigid
+	$(MAKE) demo-fluids
 
 # The rigid-body demo (scenes/rigid_demo.py): three balls and a box on ramps, hand-drawn.
 DEMO_RIGID_OUT ?= out/demo-rigid
