@@ -296,17 +296,25 @@ class DomainGrid:
         return local_points @ m[:3, :3].T + m[:3, 3], local_velocities @ m[:3, :3].T
 
 
-def gas_domain_samples(velocity_grid, density_grid, grid):
+def gas_domain_samples(velocity_grid, density_grid, grid, density_scale=1):
     """(points, velocities per frame, weights) of a Mantaflow gas domain's
     voxels (DomainGrid `grid`), all in world space. velocity_grid: 3 * X * Y
     * Z floats (x fastest, as Blender's FluidDomainSettings.velocity_grid), in
-    cells per Mantaflow time unit; density_grid: X * Y * Z floats."""
-    dens = np.asarray(density_grid, np.float64).reshape(-1)
-    if dens.size != grid.count():
-        raise ValueError(f"a {' x '.join(map(str, grid.res))} grid needs {grid.count()} density values, "
-                         f"got {dens.size}")
+    cells per Mantaflow time unit; density_grid: X * Y * Z floats, or with
+    noise on (Quick Smoke's fire) (s X) * (s Y) * (s Z) at density_scale s =
+    the noise upres, averaged over each voxel's s^3 noise cells."""
+    dens = _base_density(np.asarray(density_grid, np.float64).reshape(-1), grid, int(density_scale))
     points, velocities = grid.to_world(grid.voxel_centres(), grid.velocities(velocity_grid))
     return points, velocities, np.maximum(np.nan_to_num(dens), 0.0)
+
+
+def _base_density(dens, grid, scale):
+    """The density on the velocity grid from one `scale` times finer per axis."""
+    if scale < 1 or dens.size != grid.count() * scale ** 3:
+        raise ValueError(f"a {' x '.join(map(str, grid.res))} grid at density scale {scale} needs "
+                         f"{grid.count() * max(scale, 1) ** 3} density values, got {dens.size}")
+    x, y, z = (int(n) for n in grid.res)
+    return dens.reshape(z, scale, y, scale, x, scale).mean(axis=(1, 3, 5)).reshape(-1)
 
 
 def liquid_grid_samples(vertices, velocity_grid, grid):

@@ -16,7 +16,7 @@ from . import _native
 from .synthesis import method_options
 
 FluidymationOptions = _native.FluidymationOptions
-FLOW_SOURCES = ("guides", "masks")
+FLOW_SOURCES = ("auto", "fluid", "guides", "masks")
 
 
 def options(**values) -> "FluidymationOptions":
@@ -87,7 +87,8 @@ class MediaJob:
     out             output folder: frame_0001.png ... (RGBA, alpha = the target mask)
     exemplar_masks  folder of the exemplar's mask frames (first channel > 0.5)
     target_mask     "alpha" or a mask guide "mask.OB_<object>" / "mask.CO_<collection>"
-    flow            None (the cache's velocity_forward when present, else masks), "guides" or "masks"
+    flow            None or "auto" (the cache's fluid_velocity, else its velocity_forward, else the
+                    masks), "fluid" (fluid_velocity), "guides" (velocity_forward) or "masks"
     format          "png" or "exr"
     resume          skip frames whose output and record are current
     **values        tempera.fluidymation.options (bidirectional=True solves the shot both ways)
@@ -98,7 +99,7 @@ class MediaJob:
     def __init__(self, exemplar, guides, frames, out, *, exemplar_masks=None, target_mask="alpha", flow=None,
                  format="png", resume=True, **values):
         if flow is not None and flow not in FLOW_SOURCES:
-            raise ValueError(f"flow must be None, 'guides' or 'masks', got {flow!r}")
+            raise ValueError(f"flow must be None or one of {', '.join(FLOW_SOURCES)}, got {flow!r}")
         config = dict(exemplar=os.fspath(exemplar), guides=os.fspath(guides), frames=[int(f) for f in frames],
                       out=os.fspath(out), exemplar_masks=None if exemplar_masks is None else os.fspath(exemplar_masks),
                       target_mask=str(target_mask), flow=flow, format=str(format), resume=bool(resume))
@@ -113,9 +114,10 @@ class MediaJob:
         return self._job.warnings
 
     @property
-    def flow_from_guides(self) -> bool:
-        """Whether the target's flow is the cache's velocity_forward (else made from the masks)."""
-        return self._job.flow_from_guides
+    def flow_guide(self):
+        """The guide the target's flow is read from ("fluid_velocity" or
+        "velocity_forward"), or None when it is made from the masks."""
+        return self._job.flow_guide or None
 
     def output_path(self, frame: int) -> str:
         return self._job.output_path(int(frame))

@@ -17,12 +17,13 @@ namespace {
 
 const char* kHelp =
     "usage: tempera stylize --method fluidymation --guides DIR --exemplar DIR [--exemplar-masks DIR]\n"
-    "                       [--target-mask alpha|mask.NAME] [--flow guides|masks] [--bidirectional]\n"
+    "                       [--target-mask alpha|mask.NAME] [--flow auto|fluid|guides|masks] [--bidirectional]\n"
     "                       --frames A-B --out DIR [options]\n"
     "\n"
     "Fluidymation (Platkevic et al. 2021): the target's masks painted with the motion of a natural\n"
     "medium filmed or simulated as a video exemplar (ink, watercolour). The exemplar's flow comes\n"
-    "from its masks; the target's from the guide cache's velocity_forward or from its masks.\n"
+    "from its masks; the target's from the guide cache's fluid_velocity or velocity_forward, or\n"
+    "from its masks.\n"
     "\n"
     "outputs:\n"
     "  OUT/frame_0001.png ...       RGBA frames (alpha = the target mask), each written atomically\n"
@@ -35,8 +36,9 @@ const char* kHelp =
     "                          is the paint's mask, RGB: give --exemplar-masks\n"
     "  --exemplar-masks DIR    mask frames of the exemplar (first channel > 0.5 = paint)\n"
     "  --target-mask NAME      alpha (default) | mask.OB_<object> | mask.CO_<collection>\n"
-    "  --flow F                auto (default: guides when the cache has velocity_forward) |\n"
-    "                          guides (exact, from Blender) | masks (App. A, from the masks)\n"
+    "  --flow F                auto (default: fluid, else guides, else masks, by what the cache\n"
+    "                          has) | fluid (fluid_velocity: smoke, liquids) | guides\n"
+    "                          (velocity_forward, exact from Blender) | masks (App. A)\n"
     "  --frames RANGE          consecutive frames, e.g. 1-48\n"
     "  --out DIR               output folder\n"
     "\n"
@@ -126,7 +128,7 @@ int run_stylize_fluidymation(const Args& args) {
   const fs::path sheet = fs::path(config.out) / "contact_sheet.png";
   job.write_contact_sheet(sheet.string());
   std::cout << "tempera stylize: " << stylized << " frame(s) stylized in " << std::fixed << std::setprecision(1)
-            << seconds << " s" << std::defaultfloat << "; flow from " << (job.flow_from_guides() ? "guides" : "masks")
+            << seconds << " s" << std::defaultfloat << "; flow from " << (job.flow_guide().empty() ? "masks" : job.flow_guide())
             << "; contact sheet " << sheet.string() << "\n";
   return 0;
 }

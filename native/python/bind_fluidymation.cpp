@@ -122,7 +122,7 @@ void bind_fluidymation(py::module_& m) {
            py::arg("config"), py::arg("options"))
       .def_property_readonly("frames", &FluidymationJob::frames)
       .def_property_readonly("warnings", &FluidymationJob::warnings)
-      .def_property_readonly("flow_from_guides", &FluidymationJob::flow_from_guides)
+      .def_property_readonly("flow_guide", &FluidymationJob::flow_guide)
       .def("output_path", &FluidymationJob::output_path)
       .def(
           "run_frame",

@@ -60,6 +60,29 @@ std::string read_record(const std::string& path) {
 
 FluidymationJob::~FluidymationJob() = default;
 
+namespace {
+
+// The guide of `flow` in the frame `path` described by `info`; "" = from the
+// masks. Auto prefers fluid_velocity: on smoke velocity_forward is zero.
+std::string pick_flow_guide(FlowSource flow, const ImageFileInfo& info, const std::string& path) {
+  const auto required = [&](const char* guide, const char* choice) {
+    if (!has_layer(info, guide))
+      throw ValueError(concat("--flow ", choice, " needs ", guide, " in the guide cache ('", path, "' has none)"));
+    return std::string(guide);
+  };
+  switch (flow) {
+    case FlowSource::Fluid: return required("fluid_velocity", "fluid");
+    case FlowSource::Guides: return required("velocity_forward", "guides");
+    case FlowSource::Masks: return "";
+    case FlowSource::Auto: break;
+  }
+  for (const char* guide : {"fluid_velocity", "velocity_forward"})
+    if (has_layer(info, guide)) return guide;
+  return "";
+}
+
+}  // namespace
+
 FluidymationJob::FluidymationJob(FluidymationJobConfig c) : config_(std::move(c)) {
   validate(config_.options);
   if (config_.format != "png" && config_.format != "exr")
@@ -101,14 +124,9 @@ FluidymationJob::FluidymationJob(FluidymationJobConfig c) : config_(std::move(c)
     const ImageFileInfo info = inspect_image(path);
     if (!has_layer(info, config_.target_mask))
       throw ValueError(concat("guide cache frame '", path, "' has no '", config_.target_mask, "' guide"));
-    if (f == config_.frames.front()) {
-      const bool velocity = has_layer(info, "velocity_forward");
-      if (config_.flow == FlowSource::Guides && !velocity)
-        throw ValueError(concat("--flow guides needs velocity_forward in the guide cache ('", path, "' has none)"));
-      flow_from_guides_ = config_.flow == FlowSource::Guides || (config_.flow == FlowSource::Auto && velocity);
-    }
+    if (f == config_.frames.front()) flow_guide_ = pick_flow_guide(config_.flow, info, path);
     target_masks_.push_back(channel(read_image_layer(path, config_.target_mask), 0));
-    if (flow_from_guides_) target_flows_.push_back(read_image_layer(path, "velocity_forward"));
+    if (!flow_guide_.empty()) target_flows_.push_back(read_image_layer(path, flow_guide_));
     inputs.push_back(path);
   }
   fs::create_directories(fs::path(config_.out) / "tempera_fluidymation");
@@ -116,7 +134,7 @@ FluidymationJob::FluidymationJob(FluidymationJobConfig c) : config_(std::move(c)
   std::ostringstream base;
   base << settings_text(config_.options, fluidymation_option_table())
        << settings_text(config_.options.synthesis, synthesis_option_table()) << "format=" << config_.format
-       << ";mask=" << config_.target_mask << ";flow=" << (flow_from_guides_ ? "guides" : "masks") << ";frames="
+       << ";mask=" << config_.target_mask << ";flow=" << (flow_guide_.empty() ? "masks" : flow_guide_) << ";frames="
        << config_.frames.front() << "-" << config_.frames.back();
   for (const std::string& in : inputs) base << "\n" << file_stamp(in);
   std::string previous = hash_hex(base.str());

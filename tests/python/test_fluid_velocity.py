@@ -142,6 +142,20 @@ def test_gas_domain_voxels_and_mantaflow_units():
     assert v[0, 0] == pytest.approx(2 / 24)
 
 
+def test_a_noise_density_grid_is_averaged_onto_the_velocity_grid():
+    """With Mantaflow's noise on, density_grid is noise_scale times finer per
+    axis (Quick Smoke's fire); each voxel weighs the mean of its s^3 cells."""
+    res, s = (3, 2, 2), 2
+    grid = fv.DomainGrid(res, [0, 0, 0], [1, 1, 1], np.eye(4), fps=24)
+    coarse = np.arange(12, dtype=float).reshape(2, 2, 3)  # z, y, x
+    fine = coarse.repeat(s, 0).repeat(s, 1).repeat(s, 2)
+    fine[0, 0, 0] += 8.0  # one noise cell of voxel 0: its mean rises by 1
+    _, _, weights = fv.gas_domain_samples(np.zeros(3 * 12), fine.reshape(-1), grid, density_scale=s)
+    np.testing.assert_allclose(weights, coarse.reshape(-1) + np.eye(12)[0])
+    with pytest.raises(ValueError, match="density scale 2 needs 96 density values, got 12"):
+        fv.gas_domain_samples(np.zeros(3 * 12), coarse.reshape(-1), grid, density_scale=s)
+
+
 def test_liquid_vertices_take_the_interpolated_grid_velocity():
     """A grid velocity linear in x is interpolated exactly between voxel
     centres and clamped beyond them; a +3 m/s liquid (9.5 cells per unit

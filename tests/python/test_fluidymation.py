@@ -98,7 +98,7 @@ def make_inputs(tmp_path, frames=4):
 def test_media_job_resumes_to_the_uninterrupted_result(tmp_path):
     exemplar, cache = make_inputs(tmp_path)
     whole = fluidymation.MediaJob(exemplar, cache, [1, 2, 3, 4], tmp_path / "whole", **FAST)
-    assert whole.flow_from_guides
+    assert whole.flow_guide == "velocity_forward"
     assert [whole.run_frame(i)["status"] for i in range(4)] == ["stylized"] * 4
     # Interrupted after frame 2 (a new job, as after a restart), then resumed.
     part = fluidymation.MediaJob(exemplar, cache, [1, 2, 3, 4], tmp_path / "part", **FAST)
@@ -120,7 +120,7 @@ def test_media_job_resumes_to_the_uninterrupted_result(tmp_path):
 def test_media_job_runs_earlier_frames_first_and_rejects_bad_input(tmp_path):
     exemplar, cache = make_inputs(tmp_path, frames=3)
     job = fluidymation.MediaJob(exemplar, cache, [1, 2, 3], tmp_path / "out", flow="masks", **FAST)
-    assert not job.flow_from_guides
+    assert job.flow_guide is None
     assert job.run_frame(2)["status"] == "stylized"
     assert job.run_frame(0)["status"] == "skipped"
     both = fluidymation.MediaJob(exemplar, cache, [1, 2, 3], tmp_path / "both", bidirectional=True, **FAST)
@@ -132,6 +132,27 @@ def test_media_job_runs_earlier_frames_first_and_rejects_bad_input(tmp_path):
         fluidymation.MediaJob(exemplar, cache, [1, 2], tmp_path / "bad", target_mask="mask.OB_Nope")
     with pytest.raises(FileNotFoundError):
         fluidymation.MediaJob(tmp_path / "none", cache, [1, 2], tmp_path / "bad")
+
+
+def test_auto_flow_prefers_fluid_velocity(tmp_path):
+    """As on Mantaflow smoke: velocity_forward zero, the motion in fluid_velocity.
+    Auto must solve with fluid_velocity (the result of --flow fluid), not the zeros."""
+    exemplar, cache = make_inputs(tmp_path, frames=3)
+    for f in (1, 2, 3):
+        guides = guide_cache.read_frame(cache, f, ["alpha", "velocity_forward"])
+        guide_cache.write_frame(cache, f, {"alpha": guides["alpha"], "fluid_velocity": guides["velocity_forward"],
+                                           "velocity_forward": np.zeros_like(guides["velocity_forward"])})
+    results = {}
+    for flow in ("auto", "fluid", "guides"):
+        job = fluidymation.MediaJob(exemplar, cache, [1, 2, 3], tmp_path / flow, flow=flow, **FAST)
+        assert job.flow_guide == {"guides": "velocity_forward"}.get(flow, "fluid_velocity")
+        assert [job.run_frame(i)["status"] for i in range(3)] == ["stylized"] * 3
+        results[flow] = read_image(job.output_path(3))
+    assert np.array_equal(results["auto"], results["fluid"])
+    assert np.abs(results["auto"] - results["guides"]).max() > 0.1  # the flow matters
+    guide_cache.write_frame(cache, 1, {"alpha": disc(7)})
+    with pytest.raises(ValueError, match="--flow fluid needs fluid_velocity"):
+        fluidymation.MediaJob(exemplar, cache, [1, 2, 3], tmp_path / "none", flow="fluid", **FAST)
 
 
 def test_media_job_takes_rgb_frames_with_a_mask_folder(tmp_path):

@@ -66,7 +66,8 @@ def _gas_samples(obj, settings, fps):
         return None  # not simulated at this frame (e.g. before the cache starts)
     corners = np.array([list(c) for c in obj.bound_box])  # the evaluated box: an adaptive domain's too
     grid = _grid(obj, settings, (corners.min(axis=0), corners.max(axis=0)), fps)
-    return fv.gas_domain_samples(velocity, np.array(settings.density_grid, np.float32), grid)
+    upres = settings.noise_scale if settings.use_noise else 1  # the density is at the noise's resolution
+    return fv.gas_domain_samples(velocity, np.array(settings.density_grid, np.float32), grid, upres)
 
 
 def _liquid_samples(obj, settings, fps):

@@ -114,6 +114,9 @@ MEDIA_EXEMPLAR_KINDS = (
     ("MOVIE", "Movie", "A movie file, decoded to PNG frames once by ffmpeg (into Output Folder/exemplar_frames)"),
 )
 MEDIA_FLOWS = (
+    ("AUTO", "Automatic", "Fluid Velocity when the scene has smoke or liquids, else Blender Motion"),
+    ("FLUID", "Fluid Velocity", "A smoke or liquid's velocity from its simulation (the guide cache's "
+     "fluid_velocity; the render's motion is zero on volumes)"),
     ("GUIDES", "Blender Motion", "The target's exact motion from the render (the guide cache's velocity)"),
     ("MASKS", "From Masks", "Motion estimated from the target's masks alone (signed distance, diffusion fill, "
      "temporal smoothing; Fluidymation App. A)"),
@@ -377,7 +380,7 @@ class TemperaSettings(PropertyGroup):
     fm_target_collection: PointerProperty(
         name="Target Collection", type=bpy.types.Collection,
         description="The collection the medium fills (its mask guide), when no Target Object is set")
-    fm_flow: EnumProperty(name="Flow", items=MEDIA_FLOWS, default="GUIDES",
+    fm_flow: EnumProperty(name="Flow", items=MEDIA_FLOWS, default="AUTO",
                           description="Where the target's motion comes from")
     fm_bidirectional: BoolProperty(
         name="Bidirectional", default=limits.FLUIDYMATION_OPTIONS["bidirectional"]["default"],

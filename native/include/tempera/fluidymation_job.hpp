@@ -25,11 +25,14 @@
 
 namespace tempera {
 
-enum class FlowSource { Auto, Guides, Masks };
+// Where the target's flow comes from: fluid = the cache's fluid_velocity
+// (Mantaflow smoke and liquids, whose Vector pass is zero), guides = its
+// velocity_forward, masks = made from the target masks (App. A).
+enum class FlowSource { Auto, Fluid, Guides, Masks };
 template <>
 struct EnumNames<FlowSource> {
   static constexpr const char* what = "flow source";
-  static constexpr std::array<const char*, 3> names = {"auto", "guides", "masks"};
+  static constexpr std::array<const char*, 4> names = {"auto", "fluid", "guides", "masks"};
 };
 
 struct FluidymationJobConfig {
@@ -39,7 +42,7 @@ struct FluidymationJobConfig {
   std::vector<int> frames;     // consecutive
   std::string out;
   std::string target_mask = "alpha";  // alpha | mask.OB_<name> | mask.CO_<name>
-  FlowSource flow = FlowSource::Auto;  // auto: the cache's velocity_forward when it has one
+  FlowSource flow = FlowSource::Auto;  // auto: fluid_velocity, else velocity_forward, else masks
   std::string format = "png";         // png | exr
   bool resume = true;
   FluidymationOptions options = default_fluidymation_options();
@@ -59,7 +62,9 @@ class FluidymationJob {
   const std::vector<int>& frames() const { return config_.frames; }
   const std::vector<std::string>& warnings() const { return warnings_; }
   std::string output_path(int frame) const;
-  bool flow_from_guides() const { return flow_from_guides_; }
+  // The guide the target's flow is read from (fluid_velocity or
+  // velocity_forward); empty when it is made from the masks.
+  const std::string& flow_guide() const { return flow_guide_; }
 
   // Stylizes frames()[index] (solving earlier frames first when their
   // matches are not on disk), or skips it when current. progress(fraction)
@@ -79,7 +84,7 @@ class FluidymationJob {
   FluidymationJobConfig config_;
   std::vector<std::string> warnings_;
   std::vector<Image> exemplar_, exemplar_masks_, target_masks_, target_flows_;
-  bool flow_from_guides_ = false;
+  std::string flow_guide_;
   std::vector<std::string> keys_;  // per frame index, chained
   std::unique_ptr<Fluidymation> method_;
   std::vector<FluidFrame> both_ways_;  // the bidirectional solve, once
