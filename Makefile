@@ -89,7 +89,7 @@ demo-fluids: build
 	    --out $(DEMO_FLUIDS_OUT)/chimney
 	$(BLENDER) -b --factory-startup --python-exit-code 1 --python scenes/growing_ink.py -- \
 	    --out $(DEMO_FLUIDS_OUT)/ink
-	$(TEMPERA_PY) exemplar smoke --out $(DEMO_FLUIDS_OUT)/exemplars/smoke --size 192x192 --frames 24
+	$(TEMPERA_PY) exemplar smoke --out $(DEMO_FLUIDS_OUT)/exemplars/smoke --size 128x128 --frames 24
 	$(TEMPERA_PY) exemplar ink --out $(DEMO_FLUIDS_OUT)/exemplars/ink --size 160x160 --frames 24 --speed 2
 	$(BUILD)/bin/tempera stylize --method lazyfluids --guides $(DEMO_FLUIDS_OUT)/chimney/guides \
 	    --exemplar $(DEMO_FLUIDS_OUT)/exemplars/smoke --frames 13-36 --out $(DEMO_FLUIDS_OUT)/chimney/lazyfluids
