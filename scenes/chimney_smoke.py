@@ -36,7 +36,7 @@ PLATE_SAMPLES = 16
 CHIMNEY_TOP = (0.9, 0.0, 2.6)
 INITIAL_VELOCITY = (3.0, 0.0, 2.0)  # the smoke leaves the chimney sideways and up (m/s)
 WIND_STRENGTH = 3.5  # a wind along +x keeps blowing it sideways
-SKY = (0.55, 0.68, 0.85)
+SKY = (0.12, 0.25, 0.6)  # linear: a deep blue, so that the sooty smoke and its light rims both read against it
 
 
 def _box(scene, name, size, location, color, rotation=(0.0, 0.0, 0.0)):

@@ -35,8 +35,11 @@ MAX_SIDE = 4096
 MIN_SIDE = 16
 
 # Smoke's colour ramp from thick (in shadow) to thin (lit) smoke, and fire's
-# from its coolest visible to its hottest: (position, r, g, b).
-SMOKE_RAMP = np.array([[0.0, 0.30, 0.33, 0.40], [0.55, 0.58, 0.62, 0.69], [1.0, 0.88, 0.90, 0.93]])
+# from its coolest visible to its hottest: (position, r, g, b). Smoke is a
+# sooty one, charcoal in its core and warm light at its lit rims, so that it
+# reads against any sky (a pale grey ramp vanished into a pale sky).
+SMOKE_RAMP = np.array([[0.0, 0.08, 0.08, 0.10], [0.45, 0.30, 0.29, 0.30], [0.8, 0.70, 0.66, 0.60],
+                       [1.0, 0.95, 0.90, 0.80]])
 FIRE_RAMP = np.array([[0.0, 0.28, 0.03, 0.01], [0.3, 0.80, 0.16, 0.02], [0.6, 1.0, 0.52, 0.08],
                       [0.85, 1.0, 0.82, 0.40], [1.0, 1.0, 0.97, 0.86]])
 
@@ -149,11 +152,14 @@ class _Plume:
         return self._fire(up, centre, detail)
 
     def _smoke(self, up, centre, detail):
-        width = self.width * (0.04 + 0.14 * up)
-        envelope = np.exp(-((self.x - centre) / width) ** 2) * _smoothstep(0.0, 0.06, up) * (1 - up) ** 1.2
-        density = envelope * _smoothstep(0.35, 0.8, detail) * 2.2
+        # A wide, dense plume: most of its pixels are interior ones, the
+        # ones LazyFluids fills the target's inside with.
+        width = self.width * (0.08 + 0.2 * up)
+        envelope = np.exp(-((self.x - centre) / width) ** 2) * _smoothstep(0.0, 0.06, up) * (1 - up) ** 0.8
+        density = envelope * _smoothstep(0.25, 0.7, detail) * 3.0
         alpha = 1 - np.exp(-1.8 * density)
-        lit = np.clip(1.0 - 0.7 * density + 0.8 * (detail - 0.5), 0.0, 1.0)  # thick smoke shades itself
+        # Thick smoke shades itself; the noise lights its billows' tops.
+        lit = np.clip(1.0 - 0.45 * density + 1.4 * (detail - 0.5), 0.0, 1.0)
         return _rgba(_ramp(SMOKE_RAMP, lit), alpha)
 
     def _fire(self, up, centre, detail):
@@ -265,11 +271,13 @@ class _InkDrop:
     def picture(self, t, wet):
         """The paper with the ink at time t: Beer-Lambert of an optical
         density from the pigment, a darker rim, granulation and paper."""
+        # Rim and granulation are strong enough to survive patch synthesis's
+        # averaging (weaker ones came out of Fluidymation as a flat blot).
         inside = np.maximum(self.front(t), 0.0)
-        rim = np.exp(-inside / 2.5)
+        rim = np.exp(-inside / 3.5)
         age = np.maximum(t - (self.r - self.r0) / self.speed, 0.0)  # frames since the front passed
-        granulation = 1 + (1 - np.exp(-age / 6)) * 0.6 * (0.5 - self.grain)
-        density = self.pigment * wet * (0.55 + 0.9 * rim) * granulation * (0.85 + 0.3 * self.paper)
+        granulation = 1 + (1 - np.exp(-age / 6)) * 1.3 * (0.5 - self.grain)
+        density = self.pigment * wet * (0.45 + 1.5 * rim) * granulation * (0.7 + 0.6 * self.paper)
         paper = PAPER * (1 - 0.05 * (self.grain - 0.5))[..., None]
         rgb = paper * np.exp(-density[..., None] * INK_ABSORPTION)
         return np.ascontiguousarray(np.clip(rgb, 0, 1), dtype=np.float32)
