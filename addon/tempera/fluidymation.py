@@ -13,6 +13,7 @@ import os
 import numpy as np
 
 from . import _native
+from .stylize import SequenceJob
 from .synthesis import method_options
 
 FluidymationOptions = _native.FluidymationOptions
@@ -78,7 +79,7 @@ def stylize_sequence(exemplar_frames, exemplar_masks, target_masks, target_flows
                                           flows, options(**values), report)
 
 
-class MediaJob:
+class MediaJob(SequenceJob):
     """Fluidymation over a guide cache, frame by frame.
 
     exemplar        folder of the exemplar's frames (RGBA, or RGB with exemplar_masks)
@@ -106,31 +107,7 @@ class MediaJob:
         self._job = _native.FluidymationJob(config, options(**values))
 
     @property
-    def frames(self) -> list:
-        return self._job.frames
-
-    @property
-    def warnings(self) -> list:
-        return self._job.warnings
-
-    @property
     def flow_guide(self):
         """The guide the target's flow is read from ("fluid_velocity" or
         "velocity_forward"), or None when it is made from the masks."""
         return self._job.flow_guide or None
-
-    def output_path(self, frame: int) -> str:
-        return self._job.output_path(int(frame))
-
-    def run_frame(self, index: int, progress=None) -> dict:
-        """Stylizes frames[index] (solving earlier frames first if their
-        matches are not on disk), or skips it when current. progress(fraction)
-        returning False cancels (tempera.Cancelled), nothing written. Returns
-        dict(status "stylized" | "skipped", seconds)."""
-        report = None if progress is None else (lambda x: progress(x) is not False)
-        status, seconds = self._job.run_frame(int(index), report)
-        return {"status": status, "seconds": seconds}
-
-    def write_contact_sheet(self, path, columns: int = 0) -> None:
-        """The first exemplar frame followed by the frames written so far."""
-        self._job.write_contact_sheet(os.fspath(path), int(columns))

@@ -16,7 +16,7 @@ import os
 import numpy as np
 
 from . import _native
-from .stylize import FrameJob
+from .stylize import SequenceJob
 from .synthesis import method_options
 
 LazyFluidsOptions = _native.LazyFluidsOptions
@@ -66,7 +66,7 @@ def temporal_weights(target_alpha, advected, lam: float):
     return _native.lazyfluids_temporal_weights(_image(target_alpha, 1, "target alpha"), _image(advected), float(lam))
 
 
-class FluidJob(FrameJob):
+class FluidJob(SequenceJob):
     """LazyFluids over a guide cache, frame by frame.
 
     exemplar  an RGBA image file, or a folder of RGBA frames (a video exemplar)
@@ -84,16 +84,3 @@ class FluidJob(FrameJob):
     def __init__(self, exemplar, guides, frames, out, *, format="png", resume=True, **values):
         self._job = _native.LazyFluidsJob(os.fspath(exemplar), os.fspath(guides), [int(f) for f in frames],
                                           os.fspath(out), str(format), bool(resume), options(**values))
-
-    def run_frame(self, index: int, progress=None) -> dict:
-        """Stylizes frames[index] (or skips it when current; the frame before
-        must be done). ``progress(fraction)`` returning False cancels
-        (tempera.Cancelled), nothing written. Returns dict(status "stylized"
-        | "skipped", seconds)."""
-        report = None if progress is None else (lambda x: progress(x) is not False)
-        status, seconds = self._job.run_frame(int(index), report)
-        return {"status": status, "seconds": seconds}
-
-    def write_contact_sheet(self, path, columns: int = 0) -> None:
-        """The exemplar followed by the frames written so far."""
-        self._job.write_contact_sheet(os.fspath(path), int(columns))

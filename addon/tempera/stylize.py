@@ -59,6 +59,24 @@ class FrameJob:
     def output_path(self, frame: int) -> str:
         return self._job.output_path(int(frame))
 
+    def write_contact_sheet(self, path, columns: int = 0) -> None:
+        """The exemplar followed by the frames written so far, on one image under ~2000 px wide."""
+        self._job.write_contact_sheet(os.fspath(path), int(columns))
+
+
+class SequenceJob(FrameJob):
+    """A job whose frames follow one another (the fluid methods: each frame
+    starts from the one before)."""
+
+    def run_frame(self, index: int, progress=None) -> dict:
+        """Stylizes frames[index] (solving the frames before it first where
+        the method needs them), or skips it when current. ``progress(fraction)``
+        returning False cancels (tempera.Cancelled), nothing written. Returns
+        dict(status "stylized" | "skipped", seconds)."""
+        report = None if progress is None else (lambda x: progress(x) is not False)
+        status, seconds = self._job.run_frame(int(index), report)
+        return {"status": status, "seconds": seconds}
+
 
 class StylizeJob(FrameJob):
     """Stylization of the frames of a guide cache with one painted exemplar.
@@ -107,10 +125,6 @@ class StylizeJob(FrameJob):
         (tempera.Cancelled) and nothing is written.
         """
         return self._job.run_frame(int(index), progress)
-
-    def write_contact_sheet(self, path, columns: int = 0) -> None:
-        """The painting followed by the stylized frames so far, on one image under ~2000 px wide."""
-        self._job.write_contact_sheet(os.fspath(path), int(columns))
 
 
 def stylize_frame(style, exemplar: Mapping, target: Mapping, *, previous=None, velocity_backward=None,

@@ -3,6 +3,7 @@
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
+#include "bind_frame_job.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
 #include "tempera/fluidymation.hpp"
@@ -113,35 +114,13 @@ void bind_fluidymation(py::module_& m) {
       },
       py::arg("exemplar"), py::arg("exemplar_masks"), py::arg("target_masks"), py::arg("target_flows"),
       py::arg("options"), py::arg("progress") = nullptr, "Use tempera.fluidymation.stylize_sequence.");
-  py::class_<FluidymationJob>(m, "FluidymationJob", "Fluidymation over a guide cache; use tempera.fluidymation.MediaJob.")
+  auto job_class = py::class_<FluidymationJob>(m, "FluidymationJob", "Fluidymation over a guide cache; use tempera.fluidymation.MediaJob.")
       .def(py::init([](const py::dict& config, const FluidymationOptions& options) {
              FluidymationJobConfig c = job_config(config, options);
              py::gil_scoped_release release;  // reads the exemplar and the target's masks
              return std::make_unique<FluidymationJob>(std::move(c));
            }),
            py::arg("config"), py::arg("options"))
-      .def_property_readonly("frames", &FluidymationJob::frames)
-      .def_property_readonly("warnings", &FluidymationJob::warnings)
-      .def_property_readonly("flow_guide", &FluidymationJob::flow_guide)
-      .def("output_path", &FluidymationJob::output_path)
-      .def(
-          "run_frame",
-          [](FluidymationJob& job, std::size_t index, const std::function<bool(double)>& progress) {
-            ProgressCallback callback;
-            if (progress) callback = py_bridge::with_gil([&](double f) { return progress(f); });
-            FluidJobFrame r;
-            {
-              py::gil_scoped_release release;
-              r = job.run_frame(index, callback);
-            }
-            return py::make_tuple(r.status, r.seconds);
-          },
-          py::arg("index"), py::arg("progress") = nullptr)
-      .def(
-          "write_contact_sheet",
-          [](const FluidymationJob& job, const std::string& path, int columns) {
-            py::gil_scoped_release release;
-            job.write_contact_sheet(path, columns);
-          },
-          py::arg("path"), py::arg("columns") = 0);
+      .def_property_readonly("flow_guide", &FluidymationJob::flow_guide);
+  py_bridge::def_frame_job<FluidymationJob>(job_class);
 }

@@ -3,6 +3,7 @@
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
+#include "bind_frame_job.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
 #include "tempera/lazyfluids.hpp"
@@ -56,7 +57,7 @@ void bind_lazyfluids(py::module_& m) {
                                                     py_bridge::view_of(advected, "advected"), lambda));
       },
       py::arg("target_alpha"), py::arg("advected"), py::arg("lam"), "λ_q of eq. 5.6.");
-  py::class_<LazyFluidsJob>(m, "LazyFluidsJob", "LazyFluids over a guide cache; use tempera.lazyfluids.FluidJob.")
+  auto job_class = py::class_<LazyFluidsJob>(m, "LazyFluidsJob", "LazyFluids over a guide cache; use tempera.lazyfluids.FluidJob.")
       .def(py::init([](const std::string& exemplar, const std::string& guides, const std::vector<int>& frames,
                        const std::string& out, const std::string& format, bool resume,
                        const LazyFluidsOptions& options) {
@@ -65,28 +66,6 @@ void bind_lazyfluids(py::module_& m) {
              return std::make_unique<LazyFluidsJob>(std::move(c));
            }),
            py::arg("exemplar"), py::arg("guides"), py::arg("frames"), py::arg("out"), py::arg("format"),
-           py::arg("resume"), py::arg("options"))
-      .def_property_readonly("frames", &LazyFluidsJob::frames)
-      .def_property_readonly("warnings", &LazyFluidsJob::warnings)
-      .def("output_path", &LazyFluidsJob::output_path)
-      .def(
-          "run_frame",
-          [](LazyFluidsJob& job, std::size_t index, const std::function<bool(double)>& progress) {
-            ProgressCallback callback;
-            if (progress) callback = py_bridge::with_gil([&](double x) { return progress(x); });
-            FrameResult r;
-            {
-              py::gil_scoped_release release;
-              r = job.run_frame(index, callback);
-            }
-            return py::make_tuple(r.status, r.seconds);
-          },
-          py::arg("index"), py::arg("progress") = nullptr)
-      .def(
-          "write_contact_sheet",
-          [](const LazyFluidsJob& job, const std::string& path, int columns) {
-            py::gil_scoped_release release;
-            job.write_contact_sheet(path, columns);
-          },
-          py::arg("path"), py::arg("columns") = 0);
+           py::arg("resume"), py::arg("options"));
+  py_bridge::def_frame_job<LazyFluidsJob>(job_class);
 }
