@@ -85,15 +85,62 @@ def test_methods_and_their_options_in_the_panel(media_scene):
     assert props[props.index("media_exemplar_kind"):props.index("media_exemplar_kind") + 2] == [
         "media_exemplar_kind", "media_exemplar"]
     i = props.index("method")
-    assert props[i + 1:i + 5] == ["lf_lambda", "lf_rotations", "lf_motion_blur", "seed"]
+    assert props[i + 1:i + 8] == ["lf_lambda", "lf_rotations", "lf_motion_blur", "lf_eta", "lf_alpha_weight",
+                                  "lf_warm_start", "seed"]
     assert "usage" not in props and "weight_full" not in props and "exemplar_style" not in props
     media_scene.tempera.method = "FLUIDYMATION"
     props = _panel_props()
     assert "media_masks" in props
     i = props.index("method")
-    assert props[i + 1:i + 5] == ["fm_target_object", "fm_target_collection", "fm_flow", "fm_bidirectional"]
+    assert props[i + 1:i + 10] == ["fm_target_object", "fm_target_collection", "fm_flow", "fm_bidirectional",
+                                   "fm_boundary_weight", "fm_direction_weight", "fm_extent_weight",
+                                   "fm_temporal_weight", "fm_uniformity_weight"]
     media_scene.tempera.fm_target_object = media_scene.objects["MovingCube"]
     assert "fm_target_collection" not in _panel_props()  # the object wins
+
+
+# The panel's table options: defaults and tooltips from the native tables,
+# and a changed value reaches the method's job under its option name.
+PANEL_CHANGES = {"LAZYFLUIDS": {"lf_eta": ("alpha_guide_weight", 1.25), "lf_alpha_weight": ("alpha_weight", 2.5),
+                                "lf_warm_start": ("warm_start", True)},
+                 "FLUIDYMATION": {"fm_boundary_weight": ("boundary_weight", 1.5),
+                                  "fm_direction_weight": ("direction_weight", 0.5),
+                                  "fm_extent_weight": ("extent_weight", 0.75),
+                                  "fm_temporal_weight": ("temporal_weight", 2.0),
+                                  "fm_uniformity_weight": ("uniformity_weight", 0.25)}}
+
+
+@pytest.mark.parametrize("method", sorted(PANEL_CHANGES))
+def test_panel_options_reach_the_job(media_scene, tmp_path, monkeypatch, method):
+    import tempera.fluidymation
+    import tempera.lazyfluids
+    from tempera import settings as limits
+    from tempera.blender.stylize_operator import StylizeRun
+
+    s = media_scene.tempera
+    s.method = method
+    if method == "FLUIDYMATION":
+        s.media_exemplar_kind, s.media_exemplar = "SEQUENCE", str(tmp_path / "ink")
+    for prop, (option, value) in PANEL_CHANGES[method].items():
+        table = limits.PANEL_OPTIONS[prop][0]
+        assert getattr(s, prop) == table[option]["default"]
+        assert s.bl_rna.properties[prop].description.lower() == table[option]["help"].lower()
+        assert value != table[option]["default"]
+        setattr(s, prop, value)
+    made = {}
+
+    class Job:  # the method's job, recording what it was made with
+        def __init__(self, *args, **values):
+            made.update(values)
+            raise RuntimeError("recorded")
+
+    monkeypatch.setattr(tempera.lazyfluids, "FluidJob", Job)
+    monkeypatch.setattr(tempera.fluidymation, "MediaJob", Job)
+    run = StylizeRun.from_settings(media_scene, "ANIMATION")
+    with pytest.raises(RuntimeError, match="recorded"):
+        run.make_method_job()
+    for option, value in PANEL_CHANGES[method].values():
+        assert made[option] == pytest.approx(value), option
 
 
 def _iou(a, b):

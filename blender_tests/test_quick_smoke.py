@@ -57,21 +57,21 @@ def _quick_smoke_scene(cache_dir, style="SMOKE", name=SCENE):
     return scene, domain
 
 
-def _run_cli(guides, exemplar, out, *options):
+def _run_cli(guides, exemplar, out, *options, frames=FRAMES):
     cli = os.environ.get("TEMPERA_CLI") or str(Path(__file__).resolve().parents[1] / "build" / "bin" / "tempera")
     run = subprocess.run([cli, "stylize", "--method", "lazyfluids", "--guides", str(guides), "--exemplar",
-                          str(exemplar), "--frames", f"{FRAMES[0]}-{FRAMES[-1]}", "--out", str(out), *options],
+                          str(exemplar), "--frames", f"{frames[0]}-{frames[-1]}", "--out", str(out), *options],
                          capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
-    return _frames(out / "frames")
+    return _frames(out / "frames", frames)
 
 
-def _panel_settings(scene, tmp, method):
+def _panel_settings(scene, tmp, method, frames=FRAMES):
     s = scene.tempera
     s.method = method
     s.output_dir, s.guide_dir = str(tmp / "out"), str(tmp / "guides")
     s.guide_frame_range = "CUSTOM"
-    s.guide_frame_start, s.guide_frame_end = FRAMES[0], FRAMES[-1]
+    s.guide_frame_start, s.guide_frame_end = frames[0], frames[-1]
     s.guide_samples, s.guide_lpe, s.guide_masks, s.make_video = 32, "", "NONE", False  # alpha without grain
     s.load_result = "SEQUENCER"
     return s
@@ -109,10 +109,10 @@ def _guides(tmp, frame):
     return guide_cache.read_frame(tmp / "guides", frame, ["alpha", "fluid_velocity"])
 
 
-def _frames(folder):
+def _frames(folder, frames=FRAMES):
     import tempera
 
-    return [tempera.read_image(str(folder / f"frame_{f:04d}.png")) for f in FRAMES]
+    return [tempera.read_image(str(folder / f"frame_{f:04d}.png")) for f in frames]
 
 
 def _iou(a, b):
@@ -128,13 +128,13 @@ def _bilinear(image, x, y):
             + fy * ((1 - fx) * image[y0 + 1, x0] + fx * image[y0 + 1, x0 + 1]))
 
 
-def warp_error(frames, tmp):
+def warp_error(frames, tmp, numbers=FRAMES):
     """Mean |RGB| difference between each frame and the next sampled where
     fluid_velocity carries each pixel (p -> p + F), over the opaque pixels
     of both: low when the texture moves with the smoke."""
     errors = []
-    for i in range(len(FRAMES) - 1):
-        flow = _guides(tmp, FRAMES[i])["fluid_velocity"]
+    for i in range(len(numbers) - 1):
+        flow = _guides(tmp, numbers[i])["fluid_velocity"]
         yy, xx = np.mgrid[0:SIZE[1], 0:SIZE[0]].astype(np.float32)
         ahead = _bilinear(frames[i + 1], xx + flow[..., 0], yy + flow[..., 1])
         both = (frames[i][..., 3] > 0.5) & (ahead[..., 3] > 0.5)

@@ -42,8 +42,29 @@ OUTPUT_FORMATS = ("png", "exr")
 
 # The fluid methods' option tables (name -> row, as ENGINE_OPTIONS):
 # LazyFluids (lazyfluids.hpp) and Fluidymation (fluidymation.hpp). The panel
-# shows λ, rotations and motion blur of the one, bidirectional of the other;
-# its sliders stop at these soft maxima (the tables take more, for scripts).
+# shows λ, rotations and motion blur of the one, bidirectional of the other,
+# and the options of PANEL_OPTIONS; its sliders stop at these soft maxima
+# (the tables take more, for scripts).
 LAZYFLUIDS_OPTIONS = {row["name"]: row for row in _native.LazyFluidsOptions.table()}
 FLUIDYMATION_OPTIONS = {row["name"]: row for row in _native.FluidymationOptions.table()}
 PANEL_SOFT_MAX = {"temporal_weight": 1.0, "motion_blur": 16.0}
+# Table options the panel shows as they are (default, limits and tooltip from
+# the table row): Scene.tempera property -> (table, option name, label, soft
+# maximum), in panel order. The job gets each under its option name.
+PANEL_OPTIONS = {
+    "lf_eta": (LAZYFLUIDS_OPTIONS, "alpha_guide_weight", "Boundary Shape (η)", 10.0),
+    "lf_alpha_weight": (LAZYFLUIDS_OPTIONS, "alpha_weight", "Alpha Weight", 10.0),
+    "lf_warm_start": (LAZYFLUIDS_OPTIONS, "warm_start", "Warm Start", None),
+    "fm_boundary_weight": (FLUIDYMATION_OPTIONS, "boundary_weight", "Boundary (w_b)", 10.0),
+    "fm_direction_weight": (FLUIDYMATION_OPTIONS, "direction_weight", "Direction (w_d)", 10.0),
+    "fm_extent_weight": (FLUIDYMATION_OPTIONS, "extent_weight", "Motion Extent (w_e)", 2.0),
+    "fm_temporal_weight": (FLUIDYMATION_OPTIONS, "temporal_weight", "Temporal (w_t)", 10.0),
+    "fm_uniformity_weight": (FLUIDYMATION_OPTIONS, "uniformity_weight", "Uniformity (w_u)", 10.0),
+}
+
+
+def panel_options(settings, prefix):
+    """The PANEL_OPTIONS values of `settings` whose property starts with
+    `prefix` ("lf_", "fm_"), by option name (the jobs' keywords)."""
+    return {option: getattr(settings, prop) for prop, (_table, option, _label, _soft) in PANEL_OPTIONS.items()
+            if prop.startswith(prefix)}

@@ -235,7 +235,9 @@ FluidNnf Fluidymation::shift_nnf(int j, const FluidNnf& prev, Image* shift) cons
 namespace {
 
 // VOTE(S_rgb, nnf) (mean voting with each neighbour's rotation) at the
-// target's size, and where anything voted.
+// target's size, and where anything voted. A fractional exemplar time votes
+// the two frames around it, linearly: rounded, a target at half the
+// exemplar's speed would see its temporal guide stand still and then jump.
 Image vote_matches(const FluidSequence& seq, const FluidNnf& nnf, int radius, Image& voted) {
   const int w = nnf.width(), h = nnf.height(), ch = seq.exemplar[0].channels;
   const int sw = seq.exemplar[0].width, sh = seq.exemplar[0].height, ns = int(seq.exemplar.size());
@@ -254,8 +256,10 @@ Image vote_matches(const FluidSequence& seq, const FluidNnf& nnf, int radius, Im
           const float cs = std::cos(m[3]), sn = std::sin(m[3]);
           // The neighbour's source patch, shifted back by d in source space.
           const int px = clamp_index(m[1] - (cs * dx - sn * dy), sw), py = clamp_index(m[2] - (sn * dx + cs * dy), sh);
-          const float* s = seq.exemplar[std::size_t(clamp_index(m[0], ns))].pixel(px, py);
-          for (int c = 0; c < ch; ++c) sum[std::size_t(c)] += s[c];
+          const int a = std::clamp(int(std::floor(m[0])), 0, ns - 1), b = std::min(a + 1, ns - 1);
+          const float f = std::clamp(m[0] - float(a), 0.0f, 1.0f);
+          const float *sa = seq.exemplar[std::size_t(a)].pixel(px, py), *sb = seq.exemplar[std::size_t(b)].pixel(px, py);
+          for (int c = 0; c < ch; ++c) sum[std::size_t(c)] += (1 - f) * sa[c] + f * sb[c];
           ++count;
         }
       if (!count) continue;

@@ -53,7 +53,10 @@ Image push_pull(const Image& v, const Image& w) {
 }
 
 // The distance fields convolved with a temporal Gaussian (sigma = radius / 2,
-// taps out to the radius, renormalized at the sequence's ends).
+// taps out to the radius). Near the sequence's ends the window shrinks to
+// stay symmetric (k = the frames to the nearer end): a one-sided window
+// there would bend a steadily moving boundary and slow its flow, by half
+// at the first frame.
 std::vector<Image> smooth_in_time(const std::vector<Image>& dist, float radius) {
   if (radius <= 0) return dist;
   const int n = int(dist.size()), r = int(std::ceil(radius));
@@ -62,8 +65,8 @@ std::vector<Image> smooth_in_time(const std::vector<Image>& dist, float radius) 
   parallel_for(n, 0, [&](int i) {
     Image f(dist[0].width(), dist[0].height(), 1);
     double wsum = 0;
-    for (int d = -r; d <= r; ++d) {
-      if (i + d < 0 || i + d >= n) continue;
+    const int k = std::min({r, i, n - 1 - i});
+    for (int d = -k; d <= k; ++d) {
       const float wt = std::exp(-0.5f * float(d * d) / (sigma * sigma));
       wsum += wt;
       const Image& src = dist[std::size_t(i + d)];

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <set>
 #include <tuple>
 #include <vector>
@@ -297,6 +298,99 @@ TEST(Fluidymation, F6UniformityCoversMoreOfTheExemplar) {
     return double(total);
   };
   EXPECT_GT(coverage(1.0f), 1.1 * coverage(0.0f));
+}
+
+namespace {
+
+// The wet region x < front of a w x h frame (the medium spreading right).
+Image wet(int w, int h, float front) {
+  Image m(w, h, 1);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) m.at(x, y, 0) = x < front ? 1.0f : 0.0f;
+  return m;
+}
+
+// A pigment front: the wet region x < `front` whose pigment (channel 0,
+// dark) reaches `lag` px behind the wet front, over a light wet halo, with
+// paper texture fixed in space (channels 1, 2) for the matches to hold on.
+Image pigment(const Image& mask, float front, float lag) {
+  Image out(mask.width(), mask.height(), 3);
+  for (int y = 0; y < mask.height(); ++y)
+    for (int x = 0; x < mask.width(); ++x) {
+      if (mask.at(x, y, 0) <= 0.5f) continue;
+      const float inside = std::clamp(0.5f + (front - lag - float(x)) / 2.0f, 0.0f, 1.0f);  // a 2 px soft edge
+      out.at(x, y, 0) = 0.8f - 0.65f * inside;
+      out.at(x, y, 1) = 0.4f + 0.1f * std::cos(0.7f * x) * std::sin(0.5f * y);
+      out.at(x, y, 2) = 0.5f + 0.1f * std::sin(0.9f * x + 0.4f * y);
+    }
+  return out;
+}
+
+// The output's pigment front: going right, where the mean over the rows of
+// channel 0 last crosses the middle of pigment and halo (linear in between).
+float pigment_front(const Image& image, const Image& mask) {
+  const float middle = 0.475f;
+  float last = 0, previous = 0;
+  for (int x = 0; x < image.width() && mask.at(x, image.height() / 2, 0) > 0.5f; ++x) {
+    double sum = 0;
+    for (int y = 0; y < image.height(); ++y) sum += image.at(x, y, 0);
+    const float value = float(sum / image.height());
+    if (x > 0 && previous < middle && value >= middle) last = float(x) - 1 + (middle - previous) / (value - previous);
+    previous = value;
+  }
+  return last;
+}
+
+// Least-squares slope of v over the indices [0, n).
+double slope(const std::vector<double>& v, std::size_t n) {
+  double sj = 0, sx = 0, sjj = 0, sjx = 0;
+  for (std::size_t j = 0; j < n; ++j) sj += double(j), sx += v[j], sjj += double(j * j), sjx += double(j) * v[j];
+  return (double(n) * sjx - sj * sx) / (double(n) * sjj - sj * sj);
+}
+
+// Stylizes a wet front moving right at c from the pigment exemplar spreading
+// at s and returns the output's pigment-front position per frame.
+std::vector<double> output_fronts(float s, float c, TimeShift mode, int frames) {
+  const int w = 90, h = 24, n = 70;  // exemplar time to spare after any cold start at 2s
+  const float x0 = 12, lag = 6;
+  std::vector<Image> ex_masks, ex_frames, target;
+  for (int i = 0; i < n; ++i) {
+    ex_masks.push_back(wet(w, h, x0 + s * i));
+    ex_frames.push_back(pigment(ex_masks.back(), x0 + s * i, lag));
+  }
+  for (int j = 0; j < frames; ++j) target.push_back(wet(w, h, x0 + c * j));
+  FluidSequence seq;
+  seq.exemplar = views(ex_frames);
+  seq.exemplar_masks = views(ex_masks);
+  seq.target_masks = views(target);
+  FluidymationOptions o = small_options();
+  o.time_shift = mode;
+  const std::vector<FluidFrame> out = stylize_fluid_sequence(seq, o);
+  std::vector<double> fronts;
+  for (int j = 0; j < frames; ++j) fronts.push_back(pigment_front(out[std::size_t(j)].image, target[std::size_t(j)]));
+  return fronts;
+}
+
+}  // namespace
+
+// F3 at the output: the synthesized pigment front moves at the target's
+// speed (s/2, s and 2s within 15%, over 12 frames: at s/2 the front moves
+// in whole pixels every other frame). With a fixed delta i = 1 it falls
+// behind at 2s. Over the first 8 frames, since after that m(q) releases the
+// lagging matches and the extent guide re-matches them (docs/fluidymation.md).
+TEST(Fluidymation, F3OutputPigmentFrontMovesAtTheTargetSpeed) {
+  const float s = 1.0f;
+  for (float c : {0.5f * s, s, 2 * s}) {
+    const std::vector<double> fronts = output_fronts(s, c, TimeShift::Extent, 12);
+    std::printf("  target %.2f px/frame: pigment front %.3f px/frame (%.3f over 8 frames)\n", c, slope(fronts, 12),
+                slope(fronts, 8));
+    EXPECT_NEAR(slope(fronts, 12), c, 0.15 * c) << c;
+    if (c == 2 * s) EXPECT_NEAR(slope(fronts, 8), c, 0.15 * c);
+  }
+  const std::vector<double> fixed = output_fronts(s, 2 * s, TimeShift::One, 12);
+  std::printf("  fixed delta i = 1 at 2.00 px/frame: %.3f px/frame (%.3f over 8 frames)\n", slope(fixed, 12),
+              slope(fixed, 8));
+  EXPECT_GT(std::abs(slope(fixed, 8) - 2 * s), 0.15 * 2 * s);
 }
 
 TEST(Fluidymation, SameResultForAnyThreadCount) {

@@ -7,7 +7,7 @@ import os
 import bpy
 from bpy.types import Panel
 
-from .. import __version__
+from .. import __version__, settings as limits
 from .guide_operator import TEMPERA_OT_render_guides, cache_status
 from .keyframes import TEMPERA_OT_add_keyframe, TEMPERA_OT_import_keyframe, TEMPERA_OT_remove_keyframe
 from .kit_operators import (TEMPERA_OT_choose_painting, TEMPERA_OT_painting_template, TEMPERA_OT_register_painting,
@@ -194,6 +194,7 @@ def draw_lazyfluids(col, settings):
     wide_prop(col, settings, "lf_lambda")
     col.prop(settings, "lf_rotations")
     col.prop(settings, "lf_motion_blur")
+    draw_panel_options(col, settings, "lf_")
 
 
 def draw_fluidymation(col, settings):
@@ -203,6 +204,14 @@ def draw_fluidymation(col, settings):
         col.prop(settings, "fm_target_collection")
     col.prop(settings, "fm_flow")
     col.prop(settings, "fm_bidirectional")
+    draw_panel_options(col, settings, "fm_")
+
+
+def draw_panel_options(col, settings, prefix):
+    """The method's table options the panel shows (settings.PANEL_OPTIONS)."""
+    for prop in limits.PANEL_OPTIONS:
+        if prop.startswith(prefix):
+            wide_prop(col, settings, prop)
 
 
 MEDIA_METHODS = {"LAZYFLUIDS": draw_lazyfluids, "FLUIDYMATION": draw_fluidymation}

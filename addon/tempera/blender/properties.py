@@ -72,6 +72,18 @@ def _weight(guide):
                          description=f"Weight of {guide['help']} ({guide['expression']})")
 
 
+def _option_property(prop):
+    """The panel property `prop` of settings.PANEL_OPTIONS: default, limits
+    and tooltip from its row of the method's native option table."""
+    table, option, label, soft_max = limits.PANEL_OPTIONS[prop]
+    row = table[option]
+    text = row["help"]
+    common = dict(name=label, default=row["default"], description=text[0].upper() + text[1:])
+    if isinstance(row["default"], bool):
+        return BoolProperty(**common)
+    return FloatProperty(min=row["min"], max=row["max"], soft_max=soft_max, **common)
+
+
 def _keep_patch_size_odd(self, _context):
     size = limits.odd_patch_size(self.patch_size)
     if size != self.patch_size:
@@ -373,6 +385,9 @@ class TemperaSettings(PropertyGroup):
         name="Motion Blur", default=_LF["motion_blur"]["default"], min=_LF["motion_blur"]["min"],
         soft_max=limits.PANEL_SOFT_MAX["motion_blur"],
         subtype="PIXEL", description="Length in pixels of the blur along the flow; 0 = none")
+    for _prop in limits.PANEL_OPTIONS:
+        __annotations__[_prop] = _option_property(_prop)
+    del _prop
     fm_target_object: PointerProperty(
         name="Target Object", type=bpy.types.Object,
         description="The object the medium fills (its mask guide); empty: the collection below, else everything "

@@ -540,7 +540,8 @@ class FluidRun(RgbaRun):
 
     def job_options(self, settings):
         return {"temporal_weight": float(settings.lf_lambda), "rotations": bool(settings.lf_rotations),
-                "motion_blur": float(settings.lf_motion_blur), "seed": int(settings.seed)}
+                "motion_blur": float(settings.lf_motion_blur), "seed": int(settings.seed),
+                **limits.panel_options(settings, "lf_")}
 
     def make_method_job(self):
         from ..lazyfluids import FluidJob
@@ -576,7 +577,7 @@ class MediaRun(RgbaRun):
 
     def job_options(self, settings):
         return {"flow": settings.fm_flow.lower(), "bidirectional": bool(settings.fm_bidirectional),
-                "seed": int(settings.seed)}
+                "seed": int(settings.seed), **limits.panel_options(settings, "fm_")}
 
     def make_method_job(self):
         from ..fluidymation import MediaJob
