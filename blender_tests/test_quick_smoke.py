@@ -160,9 +160,9 @@ def test_lazyfluids_from_the_panel_follows_the_smoke(smoke):
 def test_the_cli_on_the_same_cache_and_the_temporal_term(smoke):
     """`tempera stylize --method lazyfluids` on the panel's guide cache; with
     λ = 0 (no temporal term) the warp error along fluid_velocity rises.
-    Measured (Blender 3.4): 0.0176 at the panel's λ = 0.2, 0.0216 at λ = 0
-    (0.81x; frames 14-16: 0.79x). The same seed keeps even λ = 0 frames alike,
-    hence not the 0.5x of tests/cpp's rotating disc; λ = 0 on both sides gives 1x."""
+    Measured (Blender 3.4): 0.0226 at the panel's λ = 0.2, 0.0404 at λ = 0
+    (0.56x: 0.41x inside, 0.61x in the boundary segment, which is two thirds
+    of the plume; docs/fluids.md); λ = 0 on both sides gives 1x."""
     tmp = smoke["tmp"]
     independent = _run_cli(tmp / "guides", smoke["still"], tmp / "cli", "--lambda", "0")
     coherent = _frames(tmp / "out" / "lazyfluids" / "frames")

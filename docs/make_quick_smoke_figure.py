@@ -1,12 +1,16 @@
-"""The contact sheet of docs/fluids.md's "On Blender's Quick Smoke", from the
-outputs of blender_tests/test_quick_smoke.py kept by pytest's --basetemp:
+"""The contact sheets of docs/fluids.md's "On Blender's Quick Smoke" and "On
+Blender's Quick Liquid", from the outputs of blender_tests/test_quick_smoke.py
+(or test_quick_liquid.py, -k quick_liquid) kept by pytest's --basetemp:
 
     make addon-zip
     blender -b --factory-startup --python-exit-code 1 --python blender_tests/run.py -- \
         --addon-zip dist/tempera-addon-0.1.0.zip -k quick_smoke --basetemp /tmp/quick_smoke
     PYTHONPATH=addon /usr/bin/python3 docs/make_quick_smoke_figure.py /tmp/quick_smoke/quick_smoke0
 
-writes docs/images/quick_smoke.png (rows: Cycles' render, LazyFluids with the
+    PYTHONPATH=addon /usr/bin/python3 docs/make_quick_smoke_figure.py /tmp/quick_smoke/quick_liquid0 \
+        --name quick_liquid
+
+writes docs/images/quick_smoke.png (or NAME.png; rows: Cycles' render, LazyFluids with the
 smoke still, Fluidymation with the ink video; each over grey) and prints the
 alpha IoU of both methods per frame.
 """
@@ -37,7 +41,8 @@ def frame_numbers(folder):
 
 def main():
     parser = argparse.ArgumentParser()
-    parser.add_argument("run", type=Path, help="the test's quick_smoke0 folder")
+    parser.add_argument("run", type=Path, help="the test's quick_smoke0 (quick_liquid0) folder")
+    parser.add_argument("--name", default="quick_smoke", help="the picture's name in docs/images")
     args = parser.parse_args()
     frames = frame_numbers(args.run / ROWS[1][1])
     rows = []
@@ -51,8 +56,9 @@ def main():
                 iou = (alpha & opaque).sum() / max((alpha | opaque).sum(), 1)
                 print(f"{name} frame {f}: alpha IoU {iou:.3f}")
     IMAGES.mkdir(exist_ok=True)
-    tempera.write_image(str(IMAGES / "quick_smoke.png"), np.clip(np.concatenate(rows, axis=0), 0, 1), [])
-    print(f"wrote {IMAGES / 'quick_smoke.png'}")
+    path = IMAGES / f"{args.name}.png"
+    tempera.write_image(str(path), np.clip(np.concatenate(rows, axis=0), 0, 1), [])
+    print(f"wrote {path}")
 
 
 if __name__ == "__main__":
