@@ -258,7 +258,8 @@ Image vote_matches(const FluidSequence& seq, const FluidNnf& nnf, int radius, Im
           const int px = clamp_index(m[1] - (cs * dx - sn * dy), sw), py = clamp_index(m[2] - (sn * dx + cs * dy), sh);
           const int a = std::clamp(int(std::floor(m[0])), 0, ns - 1), b = std::min(a + 1, ns - 1);
           const float f = std::clamp(m[0] - float(a), 0.0f, 1.0f);
-          const float *sa = seq.exemplar[std::size_t(a)].pixel(px, py), *sb = seq.exemplar[std::size_t(b)].pixel(px, py);
+          const float* sa = seq.exemplar[std::size_t(a)].pixel(px, py);
+          const float* sb = seq.exemplar[std::size_t(b)].pixel(px, py);
           for (int c = 0; c < ch; ++c) sum[std::size_t(c)] += (1 - f) * sa[c] + f * sb[c];
           ++count;
         }
