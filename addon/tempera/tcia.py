@@ -2,8 +2,9 @@
 coarse to fine with forward and backward sweeps along the rendered motion, so
 the paint stays on the surfaces (native/src/tcia.cpp, docs/engine.md).
 
-Painted keyframes are hard constraints and extra exemplars; lines, ribbons
-and layers are still to come (issue 12).
+Painted keyframes are hard constraints and extra exemplars. Layers
+(objects or collections) are solved separately, each with its motion
+extrapolated into its background, and composited (native/src/tcia_layers.cpp).
 
 `ShotJob` runs the method over a guide cache as `tempera stylize --method
 tcia` does (native/src/tcia_job.cpp): the shot in independent segments from
@@ -72,6 +73,9 @@ class ShotJob:
     segment   (first, last): only that segment (a farm task)
     lines     {weight, d_max, ink}: the line term of eq. 9 (tcia_job.hpp TciaLineOptions;
               weight > 0 needs the cache's line_distance)
+    layers    [(name, mask guide, painting path or None), ...]: solved separately
+              (frames RGBA in OUT/layers/NAME/) and composited into the frames
+    layer_order  "depth" (per frame, by the cache's depth) or "given" (first at the back)
     **values  the method's and engine options (tempera.tcia.options)
 
     Construction checks every file, key and guide (FileNotFoundError,
@@ -79,7 +83,7 @@ class ShotJob:
     """
 
     def __init__(self, style, exemplar_guides, guides, frames, out, *, exemplar_frame=None, keys=(), segment=None,
-                 weights=None, format="png", resume=True, lines=None, **values):
+                 weights=None, format="png", resume=True, lines=None, layers=(), layer_order="depth", **values):
         config = dict(style=os.fspath(style), exemplar_guides=os.fspath(exemplar_guides), guides=os.fspath(guides),
                       frames=[int(f) for f in frames], out=os.fspath(out), format=str(format), resume=bool(resume),
                       exemplar_frame=None if exemplar_frame is None else int(exemplar_frame),
@@ -87,7 +91,10 @@ class ShotJob:
                       keys=[(int(k[0]), os.fspath(k[1]), None if len(k) < 3 or not k[2] else os.fspath(k[2]))
                             for k in keys],
                       segment=None if segment is None else (int(segment[0]), int(segment[1])),
-                      lines=dict(lines or {}))
+                      lines=dict(lines or {}),
+                      layers=[(str(l[0]), str(l[1]), None if len(l) < 3 or not l[2] else os.fspath(l[2]))
+                              for l in layers],
+                      layer_order=str(layer_order))
         self._job = _native.TciaJob(config, options(**values))
 
     @property
@@ -105,6 +112,10 @@ class ShotJob:
 
     def output_path(self, frame: int) -> str:
         return self._job.output_path(int(frame))
+
+    def layer_path(self, layer: int, frame: int) -> str:
+        """Layer `layer`'s RGBA frame (its mask as alpha)."""
+        return self._job.layer_path(int(layer), int(frame))
 
     def run_segment(self, index: int, progress=None) -> dict:
         """Solves segment `index` (or skips it when current) and writes its

@@ -39,6 +39,11 @@ TciaJobConfig job_config(const py::dict& d, const TciaOptions& options) {
     const auto t = key.cast<py::tuple>();
     c.keys.push_back({t[0].cast<int>(), t[1].cast<std::string>(), t[2].is_none() ? "" : t[2].cast<std::string>()});
   }
+  for (const auto& layer : d["layers"].cast<py::list>()) {
+    const auto t = layer.cast<py::tuple>();
+    c.layers.push_back({t[0].cast<std::string>(), t[1].cast<std::string>(), t[2].is_none() ? "" : t[2].cast<std::string>()});
+  }
+  c.layer_order = d["layer_order"].cast<std::string>();
   if (!d["segment"].is_none()) c.segment = d["segment"].cast<std::pair<int, int>>();
   c.tcia = options;
   py_bridge::set_from_dict(c.lines, tcia_line_option_table(), d["lines"].cast<py::dict>(), "line option");
@@ -66,6 +71,7 @@ void bind_tcia(py::module_& m) {
       .def_property_readonly("warnings", &TciaJob::warnings)
       .def("output_path", [](const TciaJob& job, int frame) { return job.frames_job().output_path(frame); })
       .def("record_path", &TciaJob::record_path)
+      .def("layer_path", &TciaJob::layer_path, py::arg("layer"), py::arg("frame"))
       .def(
           "run_segment",
           [](TciaJob& job, std::size_t index, const std::function<bool(py::dict)>& progress) {
