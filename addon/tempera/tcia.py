@@ -46,11 +46,41 @@ def stylize_shot(style, guides, frames, *, keys=(), progress=None, **values):
     keys    painted keyframes [(frame index, painting (h, w, C)[, mask (h, w)]), ...]
             in frame order: each comes out as painted and steers its neighbours
     """
+    g, f, k = _frames_and_keys(guides, frames, keys)
+    report = None if progress is None else (lambda x: progress(x) is not False)
+    return _native.stylize_shot(_image(style), g, f, k, options(**values), report)
+
+
+def _frames_and_keys(guides, frames, keys):
     g = [(str(n), _image(s), float(w)) for n, s, w in guides]
     f = [{k: ([_image(x) for x in v] if k == "guides" else _image(v)) for k, v in d.items()} for d in frames]
     k = [(int(key[0]), _image(key[1]), None if len(key) < 3 or key[2] is None else _image(key[2])) for key in keys]
+    return g, f, k
+
+
+def stylize_layers(style, guides, frames, layers, *, keys=(), extrapolate=True, progress=None, **values):
+    """Each layer of a shot solved alone (Bénard 2013 Figs. 9, 10): its
+    velocities and guides extended past its outline from its nearest pixel,
+    χ recomputed from them. Arguments as stylize_shot, and
+
+    layers       [(masks, painting or None), ...]: per frame a coverage mask (h, w)
+                 and the layer's own painting (the style's shape; None = `style`)
+    extrapolate  False keeps the shot's motion (the Fig. 10(c) baseline)
+
+    Returns per layer its frames; tempera.tcia.composite stacks them."""
+    g, f, k = _frames_and_keys(guides, frames, keys)
+    spec = [(f"layer {i}", [_image(m) for m in masks], None if painting is None else _image(painting))
+            for i, (masks, painting) in enumerate(layers)]
     report = None if progress is None else (lambda x: progress(x) is not False)
-    return _native.stylize_shot(_image(style), g, f, k, options(**values), report)
+    return _native.stylize_shot_layers(_image(style), g, f, k, spec, bool(extrapolate), options(**values), report)
+
+
+def composite(images, masks, depth=None):
+    """One frame of layers stacked back to front: in list order, or with
+    `depth` (h, w) farthest first by each mask's median depth. The back-most
+    is opaque; each next one goes over it with its mask as alpha."""
+    return _native.composite_layers([_image(i) for i in images], [_image(m) for m in masks],
+                                    None if depth is None else _image(depth))
 
 
 def segments(frames, key_frames=()):
