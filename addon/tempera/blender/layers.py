@@ -26,7 +26,9 @@ def layer_list(settings):
             raise ValueError(f"Layer {i + 1} has no collection: pick one or remove the layer.")
         name = layer_name(layer.collection.name)
         if name in names:
-            raise ValueError(f"The collection '{layer.collection.name}' is in the Layers list twice.")
+            raise ValueError(f"Two layers are named '{name}' (the collection '{layer.collection.name}' is in the "
+                             "Layers list twice, or two collections differ only in characters a folder name "
+                             "cannot have): remove or rename one.")
         names.add(name)
         painting = resolve_path(layer.painting, f"painting of layer '{name}'") if layer.painting.strip() else None
         out.append((name, guide_cache.mask_guide("CO", layer.collection.name), painting))
