@@ -85,11 +85,24 @@ std::string TciaJob::layer_key(const TciaSegment& segment, std::size_t layer) co
                          l.painting.empty() ? "shared" : file_stamp(l.painting)));
 }
 
+// The layer's part of the exemplar render: its mask guide in the exemplar's
+// cache, if there and covering at least a patch's area; else empty (the whole exemplar).
+Image TciaJob::exemplar_mask(const LayerFile& l) const {
+  const std::string path = frames_.exemplar_path();
+  if (!has_guide(inspect_image(path), l.mask)) return {};
+  const Image& style = frames_.style();
+  Image m = pick_resize(coverage(GuideFrame::read(path, {l.mask}).get(l.mask)).view(), style.width(), style.height());
+  const int patch = config_.tcia.synthesis.patch_size;
+  const auto inside = std::count_if(m.data(), m.data() + m.pixel_count(), [](float v) { return v > 0.5f; });
+  return inside >= patch * patch ? m : Image{};
+}
+
 void TciaJob::check_layers() {
   std::set<std::string> names;
   for (const LayerFile& l : config_.layers) {
     check_name(l.name);
     if (!names.insert(l.name).second) throw ValueError(concat("layer '", l.name, "' is given twice"));
+    layer_style_masks_.push_back(exemplar_mask(l));
     layer_paintings_.emplace_back();
     if (l.painting.empty()) continue;
     std::error_code ec;
@@ -135,7 +148,7 @@ std::vector<Image> TciaJob::run_layers(std::size_t index, const Shot& shot, cons
     std::vector<std::string> files;
     for (int f : segment.writes) files.push_back(layer_path(l, f));
     if (config_.frames.resume && record_current(layer_record_path(index, l), layer_key(segment, l), files)) continue;
-    ShotLayer layer{config_.layers[l].name, {}, layer_paintings_[l].view()};
+    ShotLayer layer{config_.layers[l].name, {}, layer_paintings_[l].view(), layer_style_masks_[l].view()};
     for (const Image& m : masks[l]) layer.masks.push_back(m.view());
     std::deque<Image> keep;
     SweepCallback progress;

@@ -37,6 +37,10 @@ void check_layer(const Shot& shot, const ShotLayer& layer) {
       throw ValueError(concat("the mask of layer '", layer.name, "' at frame ", t, " is ", m.width, "x", m.height, "x",
                               m.channels, "; it must be ", v.width, "x", v.height, "x1"));
   }
+  const ImageView& m = layer.style_mask;
+  if (!m.empty() && (m.width != shot.style.width || m.height != shot.style.height || m.channels != 1))
+    throw ValueError(concat("the exemplar mask of layer '", layer.name, "' is ", m.width, "x", m.height, "x",
+                            m.channels, "; it must be the exemplar's ", shot.style.width, "x", shot.style.height, "x1"));
   if (!layer.style.empty() && (layer.style.width != shot.style.width || layer.style.height != shot.style.height ||
                                layer.style.channels != shot.style.channels))
     throw ValueError(concat("the painting of layer '", layer.name, "' is ", layer.style.width, "x",
@@ -55,6 +59,7 @@ Shot layer_shot(const Shot& shot, const ShotLayer& layer, std::deque<Image>& kee
   check_layer(shot, layer);
   Shot out = shot;
   if (!layer.style.empty()) out.style = layer.style;
+  if (!layer.style_mask.empty()) out.style_mask = layer.style_mask;
   if (!extrapolate) return out;
   const std::size_t n = shot.frames.size();
   for (std::size_t t = 0; t < n; ++t) {

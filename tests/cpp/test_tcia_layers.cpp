@@ -7,6 +7,8 @@
 #include <deque>
 #include <iostream>
 #include <random>
+#include <set>
+#include <array>
 
 #include "tempera/distance_transform.hpp"
 #include "tempera/error.hpp"
@@ -194,6 +196,31 @@ TEST(TciaLayers, CompositeIsEachLayerWhereMasksAreExclusive) {
       EXPECT_EQ(differ, 0) << "frame " << t;
     }
   }
+}
+
+TEST(TciaLayers, MatchesComeOnlyFromTheLayersPartOfTheExemplar) {
+  // §4: with the layer's part of the exemplar given, every output pixel
+  // (centre output copies pixels) is a colour of that part, even where the
+  // guides point elsewhere (the square's coordinates are in the exemplar's right part).
+  const SquareOverBackground s(3);
+  Image left(80, 64, 1);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 40; ++x) left.at(x, y, 0) = 1;
+  std::set<std::array<float, 3>> colours;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 40; ++x) colours.insert({s.style.at(x, y, 0), s.style.at(x, y, 1), s.style.at(x, y, 2)});
+  auto outside = [&](const ShotLayer& layer) {
+    std::deque<Image> keep;
+    int n = 0;
+    for (const Image& f : stylize_shot(layer_shot(s.shot, layer, keep), fast()))
+      for (int y = 0; y < s.H; ++y)
+        for (int x = 0; x < s.W; ++x) n += !colours.count({f.at(x, y, 0), f.at(x, y, 1), f.at(x, y, 2)});
+    return n;
+  };
+  ShotLayer layer = s.layer("square", s.fg_mask);
+  EXPECT_GT(outside(layer), 100);  // unconstrained: the square's paint comes from the right part
+  layer.style_mask = left.view();
+  EXPECT_EQ(outside(layer), 0);
 }
 
 TEST(TciaLayers, DepthPutsTheNearerLayerOnTop) {

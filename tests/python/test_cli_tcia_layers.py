@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import tempera
-from synthetic_cache import H, W, layer_masks, make_cache, make_exemplar
+from synthetic_cache import H, W, layer_masks, make_cache, make_exemplar, write_frame
 from test_cli_stylize import stylize
 
 FRAMES = range(1, 5)
@@ -20,6 +20,7 @@ def shot(tmp_path_factory):
     p = tmp_path_factory.mktemp("tcia_layers")
     make_cache(p / "cache", frames=tuple(FRAMES), forward=True, masks=True)
     make_exemplar(p / "exemplar", p / "paint.png")
+    write_frame(p / "exemplar", 1, W / 2, 0.0, masks=True)  # the exemplar's own layer masks
     paint = tempera.read_image(str(p / "paint.png"))
     tempera.write_image(str(p / "blue.png"), paint[:, :, ::-1].copy())  # the blob's own painting
     return p
@@ -66,6 +67,12 @@ def test_each_layer_is_written_rgba_and_the_frames_are_their_composite(cli_path,
         # The blob's own painting (the channels swapped) is what paints the blob.
         assert blob[inside][:, 2].mean() > blob[inside][:, 0].mean()
         assert rest[~inside][:, 0].mean() > rest[~inside][:, 2].mean()
+        # Each layer's matches come from its part of the exemplar (the exemplar cache's same mask).
+        for layer, painting, part in ((blob, "blue.png", "mask.CO_Blob"), (rest, "paint.png", "mask.CO_Rest")):
+            source = tempera.read_image(str(shot / painting))[layer_masks(W / 2)[part] > 0.5]
+            allowed = {tuple(c) for c in np.round(source * 255).astype(int)}
+            used = {tuple(c) for c in np.round(layer[:, :, :3].reshape(-1, 3) * 255).astype(int)}
+            assert used <= allowed, (painting, len(used - allowed))
 
 
 def test_resume_per_layer_equals_an_uninterrupted_run(cli_path, shot):

@@ -31,6 +31,8 @@ KeyFile parse_key(const std::string& text);
 // A layer (tcia_layers.hpp) of the job: its name (a folder name), the
 // guide cache's mask of its object or collection ("mask.CO_Suit") and its
 // own painting over the shared exemplar render (empty = the shared one).
+// When the exemplar's guide cache has the same mask (covering at least a
+// patch's area), the layer's matches come only from there (§4).
 struct LayerFile {
   std::string name, mask, painting;
 };
@@ -124,6 +126,7 @@ class TciaJob {
   // Layers (tcia_job_layers.cpp): checked up front; each solved (or skipped
   // when its record is current) and written, then composited from the files.
   void check_layers();
+  Image exemplar_mask(const LayerFile& layer) const;
   std::vector<Image> run_layers(std::size_t index, const Shot& shot, const SweepCallback& sweeps);
 
   static TciaJobConfig checked(TciaJobConfig config);  // frames consecutive, keys sorted and in the shot
@@ -135,6 +138,7 @@ class TciaJob {
   StylizeJob frames_;  // validates the per-frame inputs, names the outputs, writes the contact sheet
   std::vector<Image> paintings_, masks_;  // per key (masks_ empty for a whole key)
   std::vector<Image> layer_paintings_;    // per layer (empty: the shared painting)
+  std::vector<Image> layer_style_masks_;  // per layer: its part of the exemplar (empty: all of it)
   std::string settings_;
 };
 

@@ -31,6 +31,10 @@ struct ShotLayer {
   std::string name;
   std::vector<ImageView> masks;  // per frame of the shot: coverage in [0, 1], 1 channel
   ImageView style;               // the layer's own painting over the shared exemplar guides; empty = Shot::style
+  // Optional: the layer's part of the exemplar render (> 0.5); matches come
+  // only from there ("constraining the search space to colors of the same
+  // layer", §4). Empty: the whole exemplar.
+  ImageView style_mask;
 };
 
 // `image` (a velocity field, a guide: any channels) where mask > 0.5, and
