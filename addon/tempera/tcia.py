@@ -63,14 +63,19 @@ def stylize_layers(style, guides, frames, layers, *, keys=(), extrapolate=True, 
     velocities and guides extended past its outline from its nearest pixel,
     χ recomputed from them. Arguments as stylize_shot, and
 
-    layers       [(masks, painting or None), ...]: per frame a coverage mask (h, w)
-                 and the layer's own painting (the style's shape; None = `style`)
+    layers       [(masks, painting or None[, exemplar mask]), ...]: per frame a coverage
+                 mask (h, w), the layer's own painting (the style's shape; None = `style`)
+                 and optionally its part of the exemplar (> 0.5), the only place its
+                 matches may come from
     extrapolate  False keeps the shot's motion (the Fig. 10(c) baseline)
 
     Returns per layer its frames; tempera.tcia.composite stacks them."""
     g, f, k = _frames_and_keys(guides, frames, keys)
-    spec = [(f"layer {i}", [_image(m) for m in masks], None if painting is None else _image(painting))
-            for i, (masks, painting) in enumerate(layers)]
+    spec = []
+    for i, (masks, painting, *part) in enumerate(layers):
+        part = part[0] if part else None
+        spec.append((f"layer {i}", [_image(m) for m in masks], None if painting is None else _image(painting),
+                     None if part is None else _image(part)))
     report = None if progress is None else (lambda x: progress(x) is not False)
     return _native.stylize_shot_layers(_image(style), g, f, k, spec, bool(extrapolate), options(**values), report)
 

@@ -177,6 +177,7 @@ void bind_tcia(py::module_& m) {
           l.name = t[0].cast<std::string>();
           for (const auto& m : t[1].cast<py::list>()) l.masks.push_back(keep_view(m, "the mask of layer " + l.name, keep));
           if (!t[2].is_none()) l.style = keep_view(t[2], "the painting of layer " + l.name, keep);
+          if (!t[3].is_none()) l.style_mask = keep_view(t[3], "the exemplar mask of layer " + l.name, keep);
         }
         std::vector<std::vector<Image>> out;
         {

@@ -52,6 +52,16 @@ def test_layers_and_their_composite():
     assert band_change(square) < 0.5 * band_change(plain)
 
 
+def test_a_layer_copies_only_from_its_part_of_the_exemplar():
+    style, guides, frames, masks = square_shot()
+    left = np.zeros(style.shape[:2], np.float32)
+    left[:, :32] = 1  # the square's guides point to the exemplar's right part
+    allowed = {tuple(c) for c in style[:, :32].reshape(-1, 3)}
+    for part, inside in ((None, False), (left, True)):
+        out = tcia.stylize_layers(style, guides, frames, [(masks, None, part)], levels=2, patch_size=7, threads=2)[0]
+        assert all(tuple(c) in allowed for c in out[-1].reshape(-1, 3)) == inside
+
+
 def test_bad_layers_name_the_problem():
     style, guides, frames, masks = square_shot()
     with pytest.raises(ValueError, match="layer 'layer 0' has 2 mask"):
