@@ -11,6 +11,10 @@ options (9 x 9 Gaussian window, automatic levels, one forward and one
 backward sweep per level, 4 PatchMatch iterations per visit).
 
     PYTHONPATH=addon /usr/bin/python3 bench/bench_tcia.py --mpix 0.25 --frames 4 [--json out.json]
+
+With `--layers N` the frame is also solved as N layers (vertical strips,
+tempera.tcia.stylize_layers: motion and guides extended past each strip, one
+solve per layer) in the same run, beside the one-layer solve.
 """
 import argparse
 import json
@@ -49,6 +53,7 @@ def main():
     parser.add_argument("--frames", type=int, default=4)
     parser.add_argument("--speed", type=int, default=3, help="pan in pixels per frame")
     parser.add_argument("--threads", type=int, default=0)
+    parser.add_argument("--layers", type=int, default=0, help="also solve as this many layers (strips)")
     parser.add_argument("--json", help="also write the figures here")
     args = parser.parse_args()
     side = int(round((args.mpix * 1e6) ** 0.5))
@@ -61,6 +66,16 @@ def main():
                   s_per_frame=round(wall / args.frames, 2),
                   peak_rss_mb=round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024),
                   machine=f"{platform.system()} {platform.machine()}, {__import__('os').cpu_count()} cores")
+    if args.layers:
+        strips = np.array_split(np.arange(side), args.layers)
+        masks = [np.zeros((side, side), np.float32) for _ in strips]
+        for m, cols in zip(masks, strips):
+            m[:, cols] = 1
+        started, cpu = time.monotonic(), time.process_time()
+        tcia.stylize_layers(style, guides, frames, [([m] * args.frames, None) for m in masks], threads=args.threads)
+        wall_layers, cpu = time.monotonic() - started, time.process_time() - cpu
+        result.update(layers=args.layers, layers_wall_s=round(wall_layers, 2), layers_cpu_s=round(cpu, 2),
+                      layers_s_per_frame=round(wall_layers / args.frames, 2))
     print(json.dumps(result, indent=2))
     if args.json:
         with open(args.json, "w") as f:

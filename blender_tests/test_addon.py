@@ -13,7 +13,8 @@ from conftest import ADDON, INSTALL, disable, enable, is_enabled, registered_tem
 EXPECTED_CLASSES = ["TEMPERA_OT_choose_painting", "TEMPERA_OT_painting_template", "TEMPERA_OT_register_painting",
                     "TEMPERA_OT_render_guides", "TEMPERA_OT_stylize", "TEMPERA_PT_output", "TemperaPreferences",
                     "TemperaSettings", "TemperaKeyframe", "TEMPERA_UL_keyframes", "TEMPERA_OT_add_keyframe",
-                    "TEMPERA_OT_import_keyframe", "TEMPERA_OT_remove_keyframe"]
+                    "TEMPERA_OT_import_keyframe", "TEMPERA_OT_remove_keyframe", "TemperaLayer",
+                    "TEMPERA_UL_tcia_layers", "TEMPERA_OT_add_tcia_layer", "TEMPERA_OT_remove_tcia_layer"]
 
 
 

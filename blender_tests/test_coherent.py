@@ -144,3 +144,44 @@ def test_temporal_noise_after_the_coherent_method(coherent, tmp_path):
         frame = tempera.read_image(str(tmp_path / "out" / "frames" / f"frame_{f:04d}.png"))
         boiled = tempera.read_image(str(tmp_path / "out" / "noisy" / f"frame_{f:04d}.png"))
         assert boiled.shape == frame.shape and np.abs(boiled - frame).mean() > 0.005, f
+
+
+def test_layers_picked_from_collections_give_per_layer_frames_and_their_composite(coherent, tmp_path):
+    """Layers (Bénard 2013 Fig. 10): two collections, the moving cube's and
+    the backdrop's, each solved alone into OUT/frames/layers/NAME/ (RGBA, its
+    collection's mask as alpha) and composited by depth into the frames."""
+    import tempera
+    from test_addon import _Recorder
+    from tempera import guide_cache
+    from tempera.blender.stylize_operator import StylizeRun
+
+    scene, settings = coherent, coherent.tempera
+    back = bpy.data.collections.new("Back")
+    scene.collection.children.link(back)
+    backdrop = bpy.data.objects["Backdrop"]
+    back.objects.link(backdrop)
+    scene.collection.objects.unlink(backdrop)
+    bpy.context.window.scene = scene
+    for _ in range(2):
+        assert bpy.ops.tempera.add_tcia_layer() == {"FINISHED"}
+    assert [l.collection.name for l in settings.tcia_layers] == ["Movers", "Back"]
+    calls = []
+    bpy.types.TEMPERA_PT_output.draw(type("FakePanel", (), {"layout": _Recorder(calls)})(), bpy.context)
+    assert ("template_list", "tcia_layers") in calls and ("prop", "tcia_layer_order") in [c[:2] for c in calls]
+    run = StylizeRun.from_settings(scene, "ANIMATION")
+    assert run.layers == [("Movers", "mask.CO_Movers", None), ("Back", "mask.CO_Back", None)]
+    assert bpy.ops.tempera.stylize(mode="ANIMATION") == {"FINISHED"}
+    out = tmp_path / "out" / "frames"
+    for f in FRAMES:
+        masks = guide_cache.read_frame(str(tmp_path / "guides"), f, ["mask.CO_Movers", "mask.CO_Back"])
+        cube = tempera.read_image(str(out / "layers" / "Movers" / f"frame_{f:04d}.png"))
+        wall = tempera.read_image(str(out / "layers" / "Back" / f"frame_{f:04d}.png"))
+        frame = tempera.read_image(str(out / f"frame_{f:04d}.png"))
+        assert cube.shape == (SIZE[1], SIZE[0], 4) and wall.shape == cube.shape
+        assert np.abs(cube[:, :, 3] - masks["mask.CO_Movers"]).max() <= 1 / 255
+        on_cube, on_wall = cube[:, :, 3] == 1, (cube[:, :, 3] == 0) & (wall[:, :, 3] == 1)
+        assert on_cube.sum() > 50 and on_wall.sum() > 500, f
+        # The cube is nearer: on top where it is, the wall elsewhere.
+        assert np.abs(frame[on_cube][:, :3] - cube[on_cube][:, :3]).max() <= 1 / 255
+        assert np.abs(frame[on_wall][:, :3] - wall[on_wall][:, :3]).max() <= 1 / 255
+        assert np.abs(cube[on_cube][:, :3] - wall[on_cube][:, :3]).mean() > 0.01  # two solves, not one

@@ -4,10 +4,12 @@
 The shot pictures come from the demo's output (`make demo`: per-frame StyLit
 in OUT/frames, the coherent method with two painted keys in OUT/coherent and
 OUT/keys); the histogram picture from the procedural panning shot of
-bench/bench_tcia.py, with the usage histogram on and off.
+bench/bench_tcia.py, with the usage histogram on and off; the layers picture
+(Fig. 10) from a procedural square moving over a static background.
 
     make demo
     PYTHONPATH=addon /usr/bin/python3 docs/make_coherent_figures.py --demo out/demo
+    PYTHONPATH=addon /usr/bin/python3 docs/make_coherent_figures.py --only layers
 """
 import argparse
 import sys
@@ -75,13 +77,84 @@ def histogram_figure():
     return [float(m.max()) for m in maps]
 
 
+def square_shot(w=120, h=72, frames=8, side=28, speed=3):
+    """A textured square moving right by `speed` px per frame over a static
+    textured background: each surface's guide is its own coordinates in a
+    smooth-noise painting (a texture-coordinate AOV). Returns (style, guides,
+    frames, square masks, left edge per frame)."""
+    rng = np.random.default_rng(7)
+    noise = rng.random((100, 160, 3)).astype(np.float32)
+    k = np.ones(5) / 5
+    for axis in (0, 1, 0, 1):  # blobs a few pixels wide, stretched to full contrast
+        noise = np.apply_along_axis(lambda r: np.convolve(r, k, "same"), axis, noise)
+    noise = np.clip((noise - noise.mean()) / (4 * noise.std()) + 0.5, 0, 1)
+    style = (0.1 + 0.9 * noise * np.array([1.0, 0.85, 0.7], np.float32)).astype(np.float32)
+    yy, xx = np.mgrid[0:100, 0:160].astype(np.float32)
+    uv = np.stack([xx / 160, yy / 100], -1).astype(np.float32)
+    y, x = np.mgrid[0:h, 0:w].astype(np.float32)
+    top, lefts, shot, masks = (h - side) // 2, [], [], []
+    for t in range(frames):
+        left = 10 + speed * t
+        inside = (x >= left) & (x < left + side) & (y >= top) & (y < top + side)
+        g = np.where(inside[..., None], np.stack([(125 + x - left) / 160, (60 + y - top) / 100], -1),
+                     np.stack([(x + 2) / 160, (y + 2) / 100], -1)).astype(np.float32)
+        v = np.zeros((h, w, 2), np.float32)
+        v[inside, 0] = speed
+        chi = np.ones((h, w), np.float32)
+        shot.append(dict(guides=[g], velocity_backward=v, velocity_forward=v, occlusion_backward=chi * (t > 0),
+                         occlusion_forward=chi * (t < frames - 1)))
+        masks.append(inside.astype(np.float32))
+        lefts.append(left)
+    return style, [("uv", uv, 4.0)], shot, masks, lefts
+
+
+def layers_figure():
+    """Fig. 10 as rows: the last frame (square's outline in white) and its
+    change along the square's motion (black = the paint moved with the
+    square), solved as one layer, as the square's layer with the shot's
+    motion, and as the square's layer with its motion extended; then the
+    composite of the two layers. Returns the change in a band 6 px around
+    the square per row."""
+    style, guides, frames, masks, lefts = square_shot()
+    speed = lefts[1] - lefts[0]
+    one = tcia.stylize_shot(style, guides, frames, threads=2)
+    layers = [(masks, None), ([1 - m for m in masks], None)]
+    plain = tcia.stylize_layers(style, guides, frames, layers[:1], extrapolate=False, threads=2)[0]
+    square, rest = tcia.stylize_layers(style, guides, frames, layers, threads=2)
+    composite = [tcia.composite([rest[t], square[t]], [1 - masks[t], masks[t]]) for t in range(len(frames))]
+    inside = masks[-1] > 0
+    grown = np.zeros_like(inside)  # the square grown by 6 px (Chebyshev)
+    for dy in range(-6, 7):
+        for dx in range(-6, 7):
+            grown |= np.roll(np.roll(inside, dy, 0), dx, 1)
+    band = grown & ~inside  # just outside the outline, where overpaint would be
+    edge = inside & ~(np.roll(inside, 1, 0) & np.roll(inside, -1, 0) & np.roll(inside, 1, 1) & np.roll(inside, -1, 1))
+    cells, bands = [], []
+    for run in (one, plain, square):
+        last = run[-1].copy()
+        last[edge] = 1.0
+        change = np.abs(run[-1] - np.roll(run[-2], speed, axis=1)).mean(-1)
+        cells += [last, np.repeat(np.clip(4 * change, 0, 1)[:, :, None], 3, -1).astype(np.float32)]
+        bands.append(float(change[band].mean()))
+    cells += [composite[-1], rest[-1]]
+    tempera.write_image(str(OUT / "coherent_layers.png"), sheet(cells, 2))
+    return bands
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--demo", default=str(ROOT / "out" / "demo"), help="the demo's output folder")
+    parser.add_argument("--only", choices=("shot", "histogram", "layers"), help="make only this picture")
     args = parser.parse_args()
-    shot_figures(Path(args.demo))
-    none, histogram = histogram_figure()
-    print(f"blurred usage peak: histogram off {none:.1f}, on {histogram:.1f}")
+    if args.only in (None, "shot"):
+        shot_figures(Path(args.demo))
+    if args.only in (None, "histogram"):
+        none, histogram = histogram_figure()
+        print(f"blurred usage peak: histogram off {none:.1f}, on {histogram:.1f}")
+    if args.only in (None, "layers"):
+        one, plain, extended = layers_figure()
+        print(f"change along the square's motion, 6 px around it: one layer {one:.4f}, "
+              f"layer not extended {plain:.4f}, extended {extended:.4f}")
     print(f"pictures in {OUT}")
 
 

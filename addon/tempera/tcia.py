@@ -2,8 +2,9 @@
 coarse to fine with forward and backward sweeps along the rendered motion, so
 the paint stays on the surfaces (native/src/tcia.cpp, docs/engine.md).
 
-Painted keyframes are hard constraints and extra exemplars; lines, ribbons
-and layers are still to come (issue 12).
+Painted keyframes are hard constraints and extra exemplars. Layers
+(objects or collections) are solved separately, each with its motion
+extrapolated into its background, and composited (native/src/tcia_layers.cpp).
 
 `ShotJob` runs the method over a guide cache as `tempera stylize --method
 tcia` does (native/src/tcia_job.cpp): the shot in independent segments from
@@ -45,11 +46,46 @@ def stylize_shot(style, guides, frames, *, keys=(), progress=None, **values):
     keys    painted keyframes [(frame index, painting (h, w, C)[, mask (h, w)]), ...]
             in frame order: each comes out as painted and steers its neighbours
     """
+    g, f, k = _frames_and_keys(guides, frames, keys)
+    report = None if progress is None else (lambda x: progress(x) is not False)
+    return _native.stylize_shot(_image(style), g, f, k, options(**values), report)
+
+
+def _frames_and_keys(guides, frames, keys):
     g = [(str(n), _image(s), float(w)) for n, s, w in guides]
     f = [{k: ([_image(x) for x in v] if k == "guides" else _image(v)) for k, v in d.items()} for d in frames]
     k = [(int(key[0]), _image(key[1]), None if len(key) < 3 or key[2] is None else _image(key[2])) for key in keys]
+    return g, f, k
+
+
+def stylize_layers(style, guides, frames, layers, *, keys=(), extrapolate=True, progress=None, **values):
+    """Each layer of a shot solved alone (Bénard 2013 Figs. 9, 10): its
+    velocities and guides extended past its outline from its nearest pixel,
+    χ recomputed from them. Arguments as stylize_shot, and
+
+    layers       [(masks, painting or None[, exemplar mask]), ...]: per frame a coverage
+                 mask (h, w), the layer's own painting (the style's shape; None = `style`)
+                 and optionally its part of the exemplar (> 0.5), the only place its
+                 matches may come from
+    extrapolate  False keeps the shot's motion (the Fig. 10(c) baseline)
+
+    Returns per layer its frames; tempera.tcia.composite stacks them."""
+    g, f, k = _frames_and_keys(guides, frames, keys)
+    spec = []
+    for i, (masks, painting, *part) in enumerate(layers):
+        part = part[0] if part else None
+        spec.append((f"layer {i}", [_image(m) for m in masks], None if painting is None else _image(painting),
+                     None if part is None else _image(part)))
     report = None if progress is None else (lambda x: progress(x) is not False)
-    return _native.stylize_shot(_image(style), g, f, k, options(**values), report)
+    return _native.stylize_shot_layers(_image(style), g, f, k, spec, bool(extrapolate), options(**values), report)
+
+
+def composite(images, masks, depth=None):
+    """One frame of layers stacked back to front: in list order, or with
+    `depth` (h, w) farthest first by each mask's median depth. The back-most
+    is opaque; each next one goes over it with its mask as alpha."""
+    return _native.composite_layers([_image(i) for i in images], [_image(m) for m in masks],
+                                    None if depth is None else _image(depth))
 
 
 def segments(frames, key_frames=()):
@@ -72,6 +108,9 @@ class ShotJob:
     segment   (first, last): only that segment (a farm task)
     lines     {weight, d_max, ink}: the line term of eq. 9 (tcia_job.hpp TciaLineOptions;
               weight > 0 needs the cache's line_distance)
+    layers    [(name, mask guide, painting path or None), ...]: solved separately
+              (frames RGBA in OUT/layers/NAME/) and composited into the frames
+    layer_order  "depth" (per frame, by the cache's depth) or "given" (first at the back)
     **values  the method's and engine options (tempera.tcia.options)
 
     Construction checks every file, key and guide (FileNotFoundError,
@@ -79,7 +118,7 @@ class ShotJob:
     """
 
     def __init__(self, style, exemplar_guides, guides, frames, out, *, exemplar_frame=None, keys=(), segment=None,
-                 weights=None, format="png", resume=True, lines=None, **values):
+                 weights=None, format="png", resume=True, lines=None, layers=(), layer_order="depth", **values):
         config = dict(style=os.fspath(style), exemplar_guides=os.fspath(exemplar_guides), guides=os.fspath(guides),
                       frames=[int(f) for f in frames], out=os.fspath(out), format=str(format), resume=bool(resume),
                       exemplar_frame=None if exemplar_frame is None else int(exemplar_frame),
@@ -87,7 +126,10 @@ class ShotJob:
                       keys=[(int(k[0]), os.fspath(k[1]), None if len(k) < 3 or not k[2] else os.fspath(k[2]))
                             for k in keys],
                       segment=None if segment is None else (int(segment[0]), int(segment[1])),
-                      lines=dict(lines or {}))
+                      lines=dict(lines or {}),
+                      layers=[(str(l[0]), str(l[1]), None if len(l) < 3 or not l[2] else os.fspath(l[2]))
+                              for l in layers],
+                      layer_order=str(layer_order))
         self._job = _native.TciaJob(config, options(**values))
 
     @property
@@ -105,6 +147,10 @@ class ShotJob:
 
     def output_path(self, frame: int) -> str:
         return self._job.output_path(int(frame))
+
+    def layer_path(self, layer: int, frame: int) -> str:
+        """Layer `layer`'s RGBA frame (its mask as alpha)."""
+        return self._job.layer_path(int(layer), int(frame))
 
     def run_segment(self, index: int, progress=None) -> dict:
         """Solves segment `index` (or skips it when current) and writes its

@@ -82,6 +82,14 @@ const char* kStylizeHelpText =
     "                          (where MASK > 0.5 if given) and steers its neighbours\n"
     "  --segment A-B           tcia: solve only the segment from key A to key B (a farm\n"
     "                          task); the shot splits at keys into independent segments\n"
+    "  --layer NAME=MASK[,PAINTING]  tcia: a layer (repeatable), solved alone with its motion\n"
+    "                          extrapolated past its outline (Benard 2013 Fig. 10): MASK is the\n"
+    "                          guide cache's mask of its object or collection (mask.CO_Suit),\n"
+    "                          PAINTING its own painting over the exemplar render (default: the\n"
+    "                          shared one); frames RGBA in OUT/frames/layers/NAME/, composited\n"
+    "                          into OUT/frames (the back-most layer fills what no mask covers)\n"
+    "  --layer-order O         depth (default: per frame, by the guide cache's depth) | given\n"
+    "                          (the --layer order, first at the back)\n"
     "@TCIA@"
     "@LINES@"
     "  tcia's engine defaults: 9x9 Gaussian window, centre output, histogram usage, automatic levels;\n"
@@ -145,6 +153,8 @@ struct Options {
   // in order) on its own defaults, and --temporal if given.
   std::string method = "stylit";
   std::vector<KeyFile> keys;
+  std::vector<LayerFile> layers;
+  std::optional<std::string> layer_order;
   std::optional<std::pair<int, int>> segment;
   TciaOptions tcia = default_tcia_options();
   TciaLineOptions lines;
@@ -180,8 +190,12 @@ void check_method(Options& o) {
   if (o.method != "stylit" && o.method != "tcia")
     throw ValueError(concat("unknown --method '", o.method, "' (choose stylit, tcia, lazyfluids or fluidymation)"));
   if (o.method == "stylit") {
-    if (!o.keys.empty() || o.segment || !o.tcia_flags.empty())
-      throw ValueError(concat(!o.keys.empty() ? "--key" : o.segment ? "--segment" : o.tcia_flags.front(),
+    if (!o.keys.empty() || o.segment || !o.tcia_flags.empty() || !o.layers.empty() || o.layer_order)
+      throw ValueError(concat(!o.keys.empty()         ? "--key"
+                              : o.segment             ? "--segment"
+                              : !o.layers.empty()     ? "--layer"
+                              : o.layer_order         ? "--layer-order"
+                                                      : o.tcia_flags.front(),
                               " needs --method tcia"));
     return;
   }
@@ -218,6 +232,8 @@ Options parse(const Args& args) {
     else if (flag == "--max-image-pixels") set_max_image_pixels(r.number<std::int64_t>(flag));
     else if (flag == "--method") o.method = r.value(flag);
     else if (flag == "--key") o.keys.push_back(parse_key(r.value(flag)));
+    else if (flag == "--layer") o.layers.push_back(parse_layer(r.value(flag)));
+    else if (flag == "--layer-order") o.layer_order = r.value(flag);
     else if (flag == "--segment") o.segment = parse_segment(r.value(flag));
     else if (flag == "--noise-map") o.noise_map = r.value(flag);
     else if (flag == "--noise-reference") o.noise_reference = r.value(flag);
@@ -461,7 +477,7 @@ int run_stylize(const Args& args) {
     config.stylit = o.stylit;
     config.resume = o.resume;
     if (o.method == "tcia") {
-      TciaJob job({config, o.keys, o.tcia, o.lines, o.segment});
+      TciaJob job({config, o.keys, o.tcia, o.lines, o.layers, o.layer_order.value_or("depth"), o.segment});
       for (const auto& w : job.warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
       if (!run_segments(job, o)) return interrupted_segments();
       if (!o.segment) write_extras(job.frames_job(), o);  // a segment is a farm task: the finish writes them

@@ -1,4 +1,7 @@
 // Python binding of Bénard et al. 2013 (tcia.hpp); tempera.tcia wraps it.
+#include <deque>
+#include <numeric>
+
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
@@ -6,6 +9,7 @@
 #include "numpy_bridge.hpp"
 #include "tempera/tcia.hpp"
 #include "tempera/tcia_job.hpp"
+#include "tempera/tcia_layers.hpp"
 
 namespace py = pybind11;
 using namespace tempera;
@@ -39,10 +43,51 @@ TciaJobConfig job_config(const py::dict& d, const TciaOptions& options) {
     const auto t = key.cast<py::tuple>();
     c.keys.push_back({t[0].cast<int>(), t[1].cast<std::string>(), t[2].is_none() ? "" : t[2].cast<std::string>()});
   }
+  for (const auto& layer : d["layers"].cast<py::list>()) {
+    const auto t = layer.cast<py::tuple>();
+    c.layers.push_back({t[0].cast<std::string>(), t[1].cast<std::string>(), t[2].is_none() ? "" : t[2].cast<std::string>()});
+  }
+  c.layer_order = d["layer_order"].cast<std::string>();
   if (!d["segment"].is_none()) c.segment = d["segment"].cast<std::pair<int, int>>();
   c.tcia = options;
   py_bridge::set_from_dict(c.lines, tcia_line_option_table(), d["lines"].cast<py::dict>(), "line option");
   return c;
+}
+
+// The Shot of tempera.tcia.stylize_shot's arguments; its views point into `keep`.
+Shot shot_from(const FloatArray& style, const py::list& guides, const py::list& frames, const py::list& keys,
+               std::vector<FloatArray>& keep) {
+  Shot shot;
+  shot.style = py_bridge::view_of(style, "style");
+  for (const auto& g : guides) {
+    const auto t = g.cast<py::tuple>();
+    shot.guide_names.push_back(t[0].cast<std::string>());
+    shot.style_guides.push_back(keep_view(t[1], "exemplar guide '" + shot.guide_names.back() + "'", keep));
+    shot.guide_weights.push_back(t[2].cast<float>());
+  }
+  std::size_t k = 0;
+  for (const auto& item : frames) {
+    const py::dict d = item.cast<py::dict>();
+    const std::string what = concat("frame ", k++);
+    ShotFrame f;
+    for (const char* key : {"guides", "velocity_backward", "velocity_forward", "occlusion_backward", "occlusion_forward"})
+      if (!d.contains(key)) throw ValueError(concat(what, " needs '", key, "'"));
+    for (const auto& g : d["guides"].cast<py::list>()) f.guides.push_back(keep_view(g, what + " guide", keep));
+    f.velocity_backward = keep_view(d["velocity_backward"], what + " velocity_backward", keep);
+    f.velocity_forward = keep_view(d["velocity_forward"], what + " velocity_forward", keep);
+    f.occlusion_backward = keep_view(d["occlusion_backward"], what + " occlusion_backward", keep);
+    f.occlusion_forward = keep_view(d["occlusion_forward"], what + " occlusion_forward", keep);
+    shot.frames.push_back(std::move(f));
+  }
+  for (const auto& item : keys) {
+    const auto t = item.cast<py::tuple>();
+    ShotKey key;
+    key.frame = t[0].cast<int>();
+    key.painting = keep_view(t[1], concat("the painting of key ", key.frame), keep);
+    if (!t[2].is_none()) key.mask = keep_view(t[2], concat("the mask of key ", key.frame), keep);
+    shot.keys.push_back(key);
+  }
+  return shot;
 }
 
 }  // namespace
@@ -66,6 +111,7 @@ void bind_tcia(py::module_& m) {
       .def_property_readonly("warnings", &TciaJob::warnings)
       .def("output_path", [](const TciaJob& job, int frame) { return job.frames_job().output_path(frame); })
       .def("record_path", &TciaJob::record_path)
+      .def("layer_path", &TciaJob::layer_path, py::arg("layer"), py::arg("frame"))
       .def(
           "run_segment",
           [](TciaJob& job, std::size_t index, const std::function<bool(py::dict)>& progress) {
@@ -103,36 +149,7 @@ void bind_tcia(py::module_& m) {
       [](const FloatArray& style, const py::list& guides, const py::list& frames, const py::list& keys,
          const TciaOptions& options, const std::function<bool(double)>& progress) {
         std::vector<FloatArray> keep;
-        Shot shot;
-        shot.style = py_bridge::view_of(style, "style");
-        for (const auto& g : guides) {
-          const auto t = g.cast<py::tuple>();
-          shot.guide_names.push_back(t[0].cast<std::string>());
-          shot.style_guides.push_back(keep_view(t[1], "exemplar guide '" + shot.guide_names.back() + "'", keep));
-          shot.guide_weights.push_back(t[2].cast<float>());
-        }
-        std::size_t k = 0;
-        for (const auto& item : frames) {
-          const py::dict d = item.cast<py::dict>();
-          const std::string what = concat("frame ", k++);
-          ShotFrame f;
-          for (const char* key : {"guides", "velocity_backward", "velocity_forward", "occlusion_backward", "occlusion_forward"})
-            if (!d.contains(key)) throw ValueError(concat(what, " needs '", key, "'"));
-          for (const auto& g : d["guides"].cast<py::list>()) f.guides.push_back(keep_view(g, what + " guide", keep));
-          f.velocity_backward = keep_view(d["velocity_backward"], what + " velocity_backward", keep);
-          f.velocity_forward = keep_view(d["velocity_forward"], what + " velocity_forward", keep);
-          f.occlusion_backward = keep_view(d["occlusion_backward"], what + " occlusion_backward", keep);
-          f.occlusion_forward = keep_view(d["occlusion_forward"], what + " occlusion_forward", keep);
-          shot.frames.push_back(std::move(f));
-        }
-        for (const auto& item : keys) {
-          const auto t = item.cast<py::tuple>();
-          ShotKey key;
-          key.frame = t[0].cast<int>();
-          key.painting = keep_view(t[1], concat("the painting of key ", key.frame), keep);
-          if (!t[2].is_none()) key.mask = keep_view(t[2], concat("the mask of key ", key.frame), keep);
-          shot.keys.push_back(key);
-        }
+        const Shot shot = shot_from(style, guides, frames, keys, keep);
         ProgressCallback callback = py_bridge::with_gil([&](double f) { return progress ? progress(f) : true; });
         std::vector<Image> out;
         {
@@ -146,4 +163,55 @@ void bind_tcia(py::module_& m) {
       py::arg("style"), py::arg("guides"), py::arg("frames"), py::arg("keys"), py::arg("options"),
       py::arg("progress") = nullptr,
       "A whole shot with Bénard et al. 2013's sweeps; use tempera.tcia.stylize_shot.");
+  m.def(
+      "stylize_shot_layers",
+      [](const FloatArray& style, const py::list& guides, const py::list& frames, const py::list& keys,
+         const py::list& layers, bool extrapolate, const TciaOptions& options,
+         const std::function<bool(double)>& progress) {
+        std::vector<FloatArray> keep;
+        const Shot shot = shot_from(style, guides, frames, keys, keep);
+        std::vector<ShotLayer> spec;
+        for (const auto& item : layers) {
+          const auto t = item.cast<py::tuple>();
+          ShotLayer& l = spec.emplace_back();
+          l.name = t[0].cast<std::string>();
+          for (const auto& m : t[1].cast<py::list>()) l.masks.push_back(keep_view(m, "the mask of layer " + l.name, keep));
+          if (!t[2].is_none()) l.style = keep_view(t[2], "the painting of layer " + l.name, keep);
+          if (!t[3].is_none()) l.style_mask = keep_view(t[3], "the exemplar mask of layer " + l.name, keep);
+        }
+        std::vector<std::vector<Image>> out;
+        {
+          py::gil_scoped_release release;
+          for (std::size_t i = 0; i < spec.size(); ++i) {
+            ProgressCallback callback = py_bridge::with_gil(
+                [&](double f) { return progress ? progress((double(i) + f) / double(spec.size())) : true; });
+            std::deque<Image> hold;
+            out.push_back(stylize_shot(layer_shot(shot, spec[i], hold, extrapolate), options, callback));
+          }
+        }
+        py::list result;
+        for (auto& frames_of_layer : out) {
+          py::list l;
+          for (auto& image : frames_of_layer) l.append(py_bridge::to_numpy(std::move(image)));
+          result.append(l);
+        }
+        return result;
+      },
+      py::arg("style"), py::arg("guides"), py::arg("frames"), py::arg("keys"), py::arg("layers"),
+      py::arg("extrapolate"), py::arg("options"), py::arg("progress") = nullptr,
+      "Each layer of a shot solved alone (tcia_layers.hpp); use tempera.tcia.stylize_layers.");
+  m.def(
+      "composite_layers",
+      [](const py::list& images, const py::list& masks, const py::object& depth) {
+        std::vector<FloatArray> keep;
+        std::vector<ImageView> i, a;
+        for (const auto& x : images) i.push_back(keep_view(x, "layer image", keep));
+        for (const auto& x : masks) a.push_back(keep_view(x, "layer mask", keep));
+        std::vector<int> order(i.size());
+        std::iota(order.begin(), order.end(), 0);
+        if (!depth.is_none()) order = depth_order(keep_view(depth, "depth", keep), a);
+        return py_bridge::to_numpy(composite_layers(i, a, order));
+      },
+      py::arg("images"), py::arg("masks"), py::arg("depth") = py::none(),
+      "The layers composited back to front (tcia_layers.hpp); use tempera.tcia.composite.");
 }

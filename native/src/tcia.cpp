@@ -128,6 +128,7 @@ class Sweeper {
     placeholder_ = Image(sized.width, sized.height, shot_.style.channels);
     SynthesisInput in;
     in.style = shot_.style;
+    in.source_mask = shot_.style_mask;
     for (std::size_t g = 0; g < shot_.style_guides.size(); ++g)
       in.guides.add(shot_.guide_names[g], shot_.style_guides[g], f.guides[g], shot_.guide_weights[g]);
     if (in.guides.empty()) {

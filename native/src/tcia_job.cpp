@@ -191,6 +191,7 @@ TciaJob::TciaJob(TciaJobConfig config)
     << settings_text(config_.lines, tcia_line_option_table()) << "format=" << config_.frames.format << ";"
     << file_stamp(config_.frames.style) << ";" << file_stamp(frames_.exemplar_path());
   settings_ = s.str();
+  check_layers();
   std::error_code ec;
   fs::create_directories(fs::path(config_.frames.out) / "tempera_tcia", ec);
 }
@@ -200,6 +201,8 @@ TciaJobConfig TciaJob::checked(TciaJobConfig c) {
   validate_fields(c.tcia, tcia_option_table());
   validate_fields(c.lines, tcia_line_option_table());
   validate(c.tcia.synthesis);
+  if (c.layer_order != "depth" && c.layer_order != "given")
+    throw ValueError(concat("the layer order must be 'depth' or 'given', got '", c.layer_order, "'"));
   c.keys = sorted_keys(std::move(c.keys), c.frames.frames);
   return c;
 }
@@ -225,19 +228,42 @@ std::string TciaJob::segment_key(const TciaSegment& segment) const {
   return hash_hex(text);
 }
 
-bool TciaJob::is_current(std::size_t index) const {
-  std::ifstream in(record_path(index));
+bool TciaJob::record_current(const std::string& record, const std::string& key, const std::vector<std::string>& files) {
+  std::ifstream in(record);
   std::string line;
   if (!in || !std::getline(in, line) || line != kRecordFormat) return false;
-  if (!std::getline(in, line) || line != segment_key(segments_[index])) return false;
-  for (int f : segments_[index].writes) {
-    const FileDigest digest = file_digest(frames_.output_path(f));
+  if (!std::getline(in, line) || line != key) return false;
+  for (const std::string& path : files) {
+    const FileDigest digest = file_digest(path);
     std::string name;
     FileDigest recorded;
     if (!(in >> name >> recorded.size >> recorded.checksum)) return false;
-    if (name != fs::path(frames_.output_path(f)).filename().string() || !(digest == recorded)) return false;
+    if (name != fs::path(path).filename().string() || !(digest == recorded)) return false;
   }
   return true;
+}
+
+void TciaJob::write_record(const std::string& record, const std::string& key, const std::vector<std::string>& files) {
+  std::ostringstream text;
+  text << kRecordFormat << "\n" << key << "\n";
+  for (const std::string& path : files) {
+    const FileDigest d = file_digest(path);
+    text << fs::path(path).filename().string() << " " << d.size << " " << d.checksum << "\n";
+  }
+  write_text_atomically(record, text.str(), "the segment record");
+}
+
+std::string TciaJob::composite_key(const TciaSegment& segment) const {
+  if (config_.layers.empty()) return segment_key(segment);
+  std::string text = concat(segment_key(segment), "\nlayer order ", config_.layer_order);
+  for (std::size_t l = 0; l < config_.layers.size(); ++l) text += "\n" + layer_key(segment, l);
+  return hash_hex(text);
+}
+
+bool TciaJob::is_current(std::size_t index) const {
+  std::vector<std::string> files;
+  for (int f : segments_[index].writes) files.push_back(frames_.output_path(f));
+  return record_current(record_path(index), composite_key(segments_[index]), files);
 }
 
 Shot TciaJob::load_shot(const TciaSegment& segment, std::deque<Image>& keep) const {
@@ -303,16 +329,14 @@ SegmentResult TciaJob::run_segment(std::size_t index, const SegmentProgress& pro
       here.frame += segment.first;
       return progress(here);
     };
-  const std::vector<Image> images = stylize_shot_sweeps(shot, config_.tcia, sweeps);
-  std::ostringstream record;
-  record << kRecordFormat << "\n" << segment_key(segment) << "\n";
+  const std::vector<Image> images =
+      config_.layers.empty() ? stylize_shot_sweeps(shot, config_.tcia, sweeps) : run_layers(index, shot, sweeps);
+  std::vector<std::string> files;
   for (int f : segment.writes) {
-    const std::string path = frames_.output_path(f);
-    write_image(path, images[std::size_t(f - segment.first)].view());  // atomic
-    const FileDigest d = file_digest(path);
-    record << fs::path(path).filename().string() << " " << d.size << " " << d.checksum << "\n";
+    files.push_back(frames_.output_path(f));
+    write_image(files.back(), images[std::size_t(f - segment.first)].view());  // atomic
   }
-  write_text_atomically(record_path(index), record.str(), "the segment record");
+  write_record(record_path(index), composite_key(segment), files);
   result.status = "stylized";
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;

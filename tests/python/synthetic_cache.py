@@ -19,7 +19,14 @@ def light_paths(blob_x, h=H, w=W):
     return {"FULL": tint + spec + indirect, "LDE": tint, "LSE": spec, "LDDE": indirect}
 
 
-def write_frame(cache, frame, blob_x, speed, forward=False):
+def layer_masks(blob_x):
+    """Collection masks of the blob (a disk) and the rest, and a depth with the blob in front."""
+    yy, xx = np.mgrid[0:H, 0:W].astype(np.float32)
+    blob = (np.hypot(xx - blob_x, yy - H / 2) < H / 5).astype(np.float32)
+    return {"mask.CO_Blob": blob, "mask.CO_Rest": 1 - blob, "depth": np.where(blob > 0, 2.0, 10.0).astype(np.float32)}
+
+
+def write_frame(cache, frame, blob_x, speed, forward=False, masks=False):
     guides = light_paths(blob_x)
     guides["velocity_backward"] = np.stack([np.full((H, W), speed, np.float32), np.zeros((H, W), np.float32)], -1)
     visible = np.ones((H, W), np.float32)
@@ -36,12 +43,14 @@ def write_frame(cache, frame, blob_x, speed, forward=False):
         guides["lines"] = (np.abs(np.hypot(xx - blob_x, yy - H / 2) - H / 4) < 0.75).astype(np.float32)
         guides["line_distance"] = line_distance(guides["lines"], 10.0)
     guides["alpha"] = np.ones((H, W), np.float32)
+    if masks:  # layers of the coherent method
+        guides.update(layer_masks(blob_x))
     return guide_cache.write_frame(cache, frame, guides)
 
 
-def make_cache(cache, frames=(1, 2, 3), speed=2.0, start=20.0, forward=False):
+def make_cache(cache, frames=(1, 2, 3), speed=2.0, start=20.0, forward=False, masks=False):
     for i, frame in enumerate(frames):
-        write_frame(cache, frame, start + speed * i, speed, forward)
+        write_frame(cache, frame, start + speed * i, speed, forward, masks)
     guide_cache.write_manifest(cache, {"frames": {str(f): {"key": "synthetic"} for f in frames},
                                        "guides": ["FULL", "LDE", "LSE", "LDDE", "velocity_backward",
                                                   "occlusion_backward", "alpha"]})

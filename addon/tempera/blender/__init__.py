@@ -7,22 +7,24 @@ and come back when the add-on is enabled again).
 """
 import bpy
 
-from . import job_operator, keyframes, kit_operators
+from . import job_operator, keyframes, kit_operators, layers
 from .guide_operator import TEMPERA_OT_render_guides
 from .panels import TEMPERA_PT_output
 from .preferences import TemperaPreferences
-from .properties import TemperaKeyframe, TemperaSettings
+from .properties import TemperaKeyframe, TemperaLayer, TemperaSettings
 from .stylize_operator import TEMPERA_OT_stylize
 
 # Registration order: property groups before the pointers and panels using them.
 CLASSES = (
     TemperaPreferences,
     TemperaKeyframe,
+    TemperaLayer,
     TemperaSettings,
     TEMPERA_OT_render_guides,
     TEMPERA_OT_stylize,
     *kit_operators.CLASSES,
     *keyframes.CLASSES,
+    *layers.CLASSES,
     TEMPERA_PT_output,
 )
 

@@ -10,6 +10,7 @@ from bpy.types import Panel
 from .. import __version__, settings as limits
 from .guide_operator import TEMPERA_OT_render_guides, cache_status
 from .keyframes import TEMPERA_OT_add_keyframe, TEMPERA_OT_import_keyframe, TEMPERA_OT_remove_keyframe
+from .layers import TEMPERA_OT_add_tcia_layer, TEMPERA_OT_remove_tcia_layer
 from .kit_operators import (TEMPERA_OT_choose_painting, TEMPERA_OT_painting_template, TEMPERA_OT_register_painting,
                             painting_preview)
 from .properties import WEIGHT_PROPERTIES
@@ -235,6 +236,24 @@ def draw_keyframes(box, settings):
         col.prop(key, "mask")
     box.prop(settings, "keyframe_dir")
     box.prop(settings, "line_weight")
+    draw_layers(box, settings)
+
+
+def draw_layers(box, settings):
+    """The coherent method's layers, picked from collections."""
+    box.label(text="Layers (collections painted separately)")
+    row = box.row()
+    row.template_list("TEMPERA_UL_tcia_layers", "", settings, "tcia_layers", settings, "tcia_layer_index", rows=2)
+    side = row.column(align=True)
+    side.operator(TEMPERA_OT_add_tcia_layer.bl_idname, text="", icon="ADD")
+    side.operator(TEMPERA_OT_remove_tcia_layer.bl_idname, text="", icon="REMOVE")
+    if 0 <= settings.tcia_layer_index < len(settings.tcia_layers):
+        layer = settings.tcia_layers[settings.tcia_layer_index]
+        col = box.column(align=True)
+        col.prop(layer, "collection")
+        col.prop(layer, "painting")
+    if len(settings.tcia_layers):
+        box.prop(settings, "tcia_layer_order")
 
 
 def draw_output(box, settings):

@@ -156,6 +156,22 @@ class TemperaKeyframe(PropertyGroup):
                          description="Optional: where the key is painted (white); empty: the whole frame")
 
 
+class TemperaLayer(PropertyGroup):
+    """A layer of the coherent method (tempera.blender.layers): a collection painted and synthesized alone."""
+
+    collection: PointerProperty(name="Collection", type=bpy.types.Collection,
+                                description="The collection of this layer (its mask guide)")
+    painting: StringProperty(name="Painting", subtype="FILE_PATH", default="",
+                             description="Optional: this layer's own painting over the exemplar render (the "
+                             "exemplar's size); empty: the shared painting")
+
+
+LAYER_ORDERS = (
+    ("depth", "By Depth", "Per frame, the nearer layer (median depth of its pixels) on top"),
+    ("given", "List Order", "The first layer of the list at the back, the last on top"),
+)
+
+
 class TemperaSettings(PropertyGroup):
     output_dir: StringProperty(
         name="Output Folder",
@@ -343,6 +359,10 @@ class TemperaSettings(PropertyGroup):
         description="For line paintings (ink on paper): pulls the painting's ink onto the scene's lines (the "
         "guide cache's line distance, Bénard 2013 eq. 9); 0 = off, 4 typical",
         default=0.0, min=0.0, soft_max=10.0)
+    tcia_layers: CollectionProperty(type=TemperaLayer, name="Layers")
+    tcia_layer_index: IntProperty(name="Active Layer", default=0, min=0)
+    tcia_layer_order: EnumProperty(name="Layer Order", items=LAYER_ORDERS, default="depth",
+                                   description="How the layers' frames are stacked into the composite")
     keyframe_dir: StringProperty(
         name="Keyframe Folder",
         description="Where Add Keyframe saves the images to paint over ('//' is beside the .blend file)",

@@ -291,8 +291,9 @@ class CoherentRun(StylizeRun):
     """Guides of every frame, then the coherent method, one segment per step."""
 
     def __init__(self, scene, frames, mode="ANIMATION"):
-        from .. import tcia
+        from .. import guide_cache, tcia
         from .keyframes import key_list
+        from .layers import layer_list
 
         super().__init__(scene, frames, mode)
         require_consecutive(self.frames, "The coherent method")
@@ -300,6 +301,10 @@ class CoherentRun(StylizeRun):
         self.segments = tcia.segments(self.frames, [k[0] for k in self.keys])
         self.segment_results = []
         self.line_weight = float(scene.tempera.line_weight)
+        self.layers = layer_list(scene.tempera)
+        self.layer_order = scene.tempera.tcia_layer_order
+        if self.layers:  # their collections' masks
+            self.guides.params["masks"] = guide_cache.masks_including(self.guides.params["masks"], "CO")
 
     @property
     def stylize_steps(self):
@@ -313,7 +318,8 @@ class CoherentRun(StylizeRun):
             self.job = ShotJob(c["style"], c["exemplar_guides"], c["guides"], self.frames, c["out"],
                                exemplar_frame=c.get("exemplar_frame"), keys=self.keys, weights=c["weights"],
                                format=c["format"], seed=c["seed"],
-                               lines={"weight": self.line_weight, "d_max": self.guides.params["line_d_max"]})
+                               lines={"weight": self.line_weight, "d_max": self.guides.params["line_d_max"]},
+                               layers=self.layers, layer_order=self.layer_order)
             self.warnings = list(self.job.warnings)
         i = self.index - len(self.frames)
         started = time.monotonic()

@@ -19,4 +19,9 @@ Image line_distance(const ImageView& mask, float d_max = 10.0f);
 // mask > 0.5 (0 on them); +inf everywhere if there is none. Same algorithm.
 Image euclidean_distance(const ImageView& mask, std::string_view what = "mask");
 
+// The nearest pixel with mask > 0.5 of each pixel (the argmin of
+// euclidean_distance; itself on the mask), as 2 channels (x, y); (-1, -1)
+// everywhere if there is none. Ties go to one of the nearest, always the same.
+Image nearest_mask_pixel(const ImageView& mask, std::string_view what = "mask");
+
 }  // namespace tempera

@@ -46,6 +46,7 @@ struct ShotKey {
 
 struct Shot {
   ImageView style;                      // Ŝ
+  ImageView style_mask;                 // optional, 1 channel: > 0.5 = where matches in Ŝ may come from (a layer's part)
   std::vector<std::string> guide_names;
   std::vector<ImageView> style_guides;  // S per guide layer
   std::vector<float> guide_weights;     // w_in per guide layer

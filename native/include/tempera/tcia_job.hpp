@@ -28,6 +28,18 @@ struct KeyFile {
 // "12=key.png" or "12=key.png,mask.png" (the CLI's --key); ValueError naming the text.
 KeyFile parse_key(const std::string& text);
 
+// A layer (tcia_layers.hpp) of the job: its name (a folder name), the
+// guide cache's mask of its object or collection ("mask.CO_Suit") and its
+// own painting over the shared exemplar render (empty = the shared one).
+// When the exemplar's guide cache has the same mask (covering at least a
+// patch's area), the layer's matches come only from there (§4).
+struct LayerFile {
+  std::string name, mask, painting;
+};
+
+// "suit=mask.CO_Suit" or "suit=mask.CO_Suit,suit.png" (the CLI's --layer); ValueError naming the text.
+LayerFile parse_layer(const std::string& text);
+
 // The distance-transform term for line exemplars (eq. 9): one more guide
 // pair, D(S) of the painting's ink against the guide cache's line_distance
 // D(I), so that ink goes where the frame has lines.
@@ -53,6 +65,12 @@ struct TciaJobConfig {
   std::vector<KeyFile> keys;
   TciaOptions tcia = default_tcia_options();
   TciaLineOptions lines;
+  // Layers solved separately and composited (none: the frame as one layer).
+  // Each writes its frames, RGBA with the mask as alpha, to
+  // OUT/layers/NAME/; the frames are their composite, back to front in
+  // `layer_order`: "depth" (per frame, the guide cache's depth) or "given".
+  std::vector<LayerFile> layers;
+  std::string layer_order = "depth";
   // Only the segment from frame A to B (a farm task): only its guide frames
   // and bounding keys are read. ValueError listing the shot's segments if
   // A-B is not one.
@@ -86,6 +104,9 @@ class TciaJob {
   const StylizeJob& frames_job() const { return frames_; }
   const std::vector<std::string>& warnings() const { return frames_.warnings(); }
   std::string record_path(std::size_t index) const;
+  // Layer `layer`'s frame (OUT/layers/NAME/frame_0001.png) and its record for segment `index`.
+  std::string layer_path(std::size_t layer, int frame) const;
+  std::string layer_record_path(std::size_t index, std::size_t layer) const;
 
   // Solves segment `index` (one of selected()) (or skips it when its record is current) and
   // writes its frames. `progress` returning false cancels: CancelledError,
@@ -96,6 +117,17 @@ class TciaJob {
   std::string segment_key(const TciaSegment& segment) const;
   bool is_current(std::size_t index) const;
   Shot load_shot(const TciaSegment& segment, std::deque<Image>& keep) const;
+  std::string composite_key(const TciaSegment& segment) const;  // segment_key and the layers
+  std::string layer_key(const TciaSegment& segment, std::size_t layer) const;
+  // A record (format line, key, then "file size checksum" per file) is current when all three match.
+  static bool record_current(const std::string& record, const std::string& key, const std::vector<std::string>& files);
+  static void write_record(const std::string& record, const std::string& key, const std::vector<std::string>& files);
+
+  // Layers (tcia_job_layers.cpp): checked up front; each solved (or skipped
+  // when its record is current) and written, then composited from the files.
+  void check_layers();
+  Image exemplar_mask(const LayerFile& layer) const;
+  std::vector<Image> run_layers(std::size_t index, const Shot& shot, const SweepCallback& sweeps);
 
   static TciaJobConfig checked(TciaJobConfig config);  // frames consecutive, keys sorted and in the shot
   bool is_read(int frame) const;                       // in the frames this job reads
@@ -105,6 +137,8 @@ class TciaJob {
   std::vector<std::size_t> selected_;
   StylizeJob frames_;  // validates the per-frame inputs, names the outputs, writes the contact sheet
   std::vector<Image> paintings_, masks_;  // per key (masks_ empty for a whole key)
+  std::vector<Image> layer_paintings_;    // per layer (empty: the shared painting)
+  std::vector<Image> layer_style_masks_;  // per layer: its part of the exemplar (empty: all of it)
   std::string settings_;
 };
 
