@@ -28,6 +28,12 @@ The breaks handled:
 * 4.1: Mesh.calc_normals_split() is gone, corner normals are always there
   (Mesh.corner_normals): `corner_normals()`.
 * 4.0: lights have a soft falloff, on by default: `hard_light_falloff()`.
+* 4.0: Cycles' lights changed: area lights emit their power (radiance
+  P / (pi A), was P / (4 A)), spot lights lost the cosine to their axis, and
+  point and spot lights with a radius are spheres unless Soft Falloff is on
+  (then the disk facing the shaded point of 3.x): `cycles_light_model()`.
+* 4.0: the Glass, Refraction and Glossy nodes lost the SHARP distribution
+  (roughness 0 renders sharp): `set_sharp_distribution()`.
 * 4.x: the AOV Output node names its AOV in .aov_name: `set_aov_output_name()`.
 * 5.0: the sequencer's Scene.sequence_editor.sequences became .strips
   (available since 4.4): `sequencer_strips()`.
@@ -155,6 +161,28 @@ def corner_normals(mesh):
         flat = np.empty(len(mesh.loops) * 3, np.float64)
         mesh.loops.foreach_get("normal", flat)
     return flat.reshape(-1, 3)
+
+
+def cycles_light_model(light):
+    """How this Cycles renders `light` (a bpy Light), as the tracer's light
+    fields: {"soft_shape": "disk" | "sphere", "spot_axis_cosine": bool,
+    "area_emits_power": bool}. Cycles 4.0's lights came with the Soft Falloff
+    option, so its presence tells them apart."""
+    cycles4 = "use_soft_falloff" in bpy.types.PointLight.bl_rna.properties
+    soft_falloff = bool(getattr(light, "use_soft_falloff", True))
+    return {"soft_shape": "sphere" if cycles4 and not soft_falloff else "disk",
+            "spot_axis_cosine": not cycles4, "area_emits_power": cycles4}
+
+
+def set_sharp_distribution(node):
+    """Makes a Glass, Refraction or Glossy BSDF node perfectly sharp: the SHARP
+    distribution where it exists (3.x), else GGX of roughness 0, which Cycles
+    4.0+ renders as sharp."""
+    if "SHARP" in _enum_ids(node, "distribution"):
+        node.distribution = "SHARP"
+    else:
+        node.distribution = "GGX"
+        node.inputs["Roughness"].default_value = 0.0
 
 
 def hard_light_falloff(light):
