@@ -34,6 +34,7 @@ The breaks handled:
   (then the disk facing the shaded point of 3.x): `cycles_light_model()`.
 * 4.0: the Glass, Refraction and Glossy nodes lost the SHARP distribution
   (roughness 0 renders sharp): `set_sharp_distribution()`.
+* 4.0: the Velvet BSDF node became the Sheen BSDF: `sheen_bsdf_node_type()`.
 * 4.x: the AOV Output node names its AOV in .aov_name: `set_aov_output_name()`.
 * 5.0: the sequencer's Scene.sequence_editor.sequences became .strips
   (available since 4.4): `sequencer_strips()`.
@@ -183,6 +184,11 @@ def set_sharp_distribution(node):
     else:
         node.distribution = "GGX"
         node.inputs["Roughness"].default_value = 0.0
+
+
+def sheen_bsdf_node_type():
+    """The node type of the Velvet BSDF (3.x), called Sheen BSDF since 4.0."""
+    return "ShaderNodeBsdfVelvet" if hasattr(bpy.types, "ShaderNodeBsdfVelvet") else "ShaderNodeBsdfSheen"
 
 
 def hard_light_falloff(light):
