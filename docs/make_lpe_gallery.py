@@ -22,12 +22,11 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "scenes"))
 sys.path.insert(0, str(ROOT / "blender_tests"))
 
+import bpy  # noqa: E402  (before the scene scripts: PyPI's bpy provides bmesh once imported)
 import lpe_gallery  # noqa: E402
 import tempera  # noqa: E402
 import test_lpe_gallery as gallery  # noqa: E402
 from tempera.color import linear_to_srgb  # noqa: E402
-
-import bpy  # noqa: E402
 
 _SUFFIX = "" if bpy.app.version < (4, 0, 0) else "_{}.{}".format(*bpy.app.version[:2])
 OUT = ROOT / "docs" / "images" / f"lpe_gallery{_SUFFIX}.png"

@@ -146,9 +146,9 @@ def principled_rough_texture(name):
     rough = 0.25 + 0.2 * np.sin(2 * np.pi * x)
     tex = _node(tree, "ShaderNodeTexImage")
     tex.image = _image(f"{name} roughness", np.dstack([rough, rough, rough]), colorspace="Non-Color")
-    sep = _node(tree, "ShaderNodeSeparateRGB")
-    tree.links.new(tex.outputs["Color"], sep.inputs["Image"])
-    tree.links.new(sep.outputs["R"], bsdf.inputs["Roughness"])
+    sep = _compat().new_separate_rgb_node(tree)
+    tree.links.new(tex.outputs["Color"], sep.inputs[0])
+    tree.links.new(sep.outputs[0], bsdf.inputs["Roughness"])
     return mat
 
 
@@ -516,7 +516,7 @@ def s_ray_visibility(name):
     glossy_only = add_light(scene, "POINT", 800.0, (-2.0, -1.5, 2.5), shadow_soft_size=0.3)
     glossy_only.visible_diffuse = False
     unshadowed = add_light(scene, "AREA", 150.0, (-0.5, 1.0, 2.8), (0, 0, 0), shape="SQUARE", size=0.5)
-    unshadowed.data.cycles.cast_shadow = False
+    _compat().set_light_cast_shadow(unshadowed.data, False)
     return scene
 
 

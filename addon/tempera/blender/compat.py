@@ -35,6 +35,11 @@ The breaks handled:
 * 4.0: the Glass, Refraction and Glossy nodes lost the SHARP distribution
   (roughness 0 renders sharp): `set_sharp_distribution()`.
 * 4.0: the Velvet BSDF node became the Sheen BSDF: `sheen_bsdf_node_type()`.
+* 5.0: the Separate RGB node is gone (Separate Color, since 3.3, stays):
+  `new_separate_rgb_node()`; the Cycles light setting Cast Shadow became
+  Light.use_shadow: `set_light_cast_shadow()`; an empty material slot
+  renders Blender's default material, a Principled BSDF, no longer Cycles'
+  diffuse default surface: `default_surface_is_principled()`.
 * 4.x: the AOV Output node names its AOV in .aov_name: `set_aov_output_name()`.
 * 5.0: the sequencer's Scene.sequence_editor.sequences became .strips
   (available since 4.4): `sequencer_strips()`.
@@ -189,6 +194,30 @@ def set_sharp_distribution(node):
 def sheen_bsdf_node_type():
     """The node type of the Velvet BSDF (3.x), called Sheen BSDF since 4.0."""
     return "ShaderNodeBsdfVelvet" if hasattr(bpy.types, "ShaderNodeBsdfVelvet") else "ShaderNodeBsdfSheen"
+
+
+def new_separate_rgb_node(tree):
+    """A node in `tree` splitting a colour (input 0) into R, G, B (outputs
+    0-2): Separate RGB where it exists (3.x, 4.x), else Separate Color."""
+    kind = "ShaderNodeSeparateRGB" if hasattr(bpy.types, "ShaderNodeSeparateRGB") else "ShaderNodeSeparateColor"
+    return tree.nodes.new(kind)
+
+
+def set_light_cast_shadow(light, value):
+    """A light's Cast Shadow: its Cycles setting before 5.0, Light.use_shadow in 5.0."""
+    cycles = getattr(light, "cycles", None)
+    if cycles is not None and "cast_shadow" in cycles.bl_rna.properties:
+        cycles.cast_shadow = value
+    else:
+        light.use_shadow = value
+
+
+def default_surface_is_principled():
+    """Whether an empty material slot renders as Blender's default material
+    (a Principled BSDF of its defaults: Blender 5.0, where every material
+    renders its nodes: Material.use_nodes is deprecated there) rather than
+    Cycles' default surface, a diffuse BSDF of 0.8 grey."""
+    return bpy.app.version >= (5, 0, 0)
 
 
 def hard_light_falloff(light):

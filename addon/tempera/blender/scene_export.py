@@ -264,9 +264,15 @@ def _get(collection, attribute, shape, dtype):
 # --------------------------------------------------------------------------- materials
 
 def default_surface():
-    """Cycles' default surface (empty or missing material slots): diffuse 0.8 grey."""
-    return {"base_color": np.array(FALLBACK_GREY, np.float32),
-            "closures": [{"type": "diffuse", "color": np.array(FALLBACK_GREY, np.float32)}]}
+    """What empty or missing material slots render as: Cycles' default
+    surface, diffuse 0.8 grey, or in Blender 5.0 its default material, a
+    Principled BSDF of 0.8 grey, roughness 0.5, IOR 1.5 (compat)."""
+    grey = np.array(FALLBACK_GREY, np.float32)
+    if compat.default_surface_is_principled():
+        return {"base_color": grey, "closures": [{"type": "principled", "color": grey, "metallic": 0.0,
+                                                  "specular": 0.5, "roughness": 0.5, "transmission": 0.0,
+                                                  "ior": 1.5}]}
+    return {"base_color": grey, "closures": [{"type": "diffuse", "color": grey}]}
 
 
 class _Materials:
