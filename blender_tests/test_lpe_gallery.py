@@ -30,13 +30,21 @@ import lpe_gallery  # noqa: E402
 
 import bpy  # noqa: E402
 
-# The tracer follows Cycles 3.x, which renders the guides in Debian's Blender
-# 3.4, where every scene must pass. Cycles 4.0 changed its lights (spheres, no
-# spot cosine, new area sampling) and the Principled BSDF (v2), and the
-# tracer does not model those yet: in blender.org 4.2, 4.5 and 5.0 most scenes
-# disagree (docs/lpe_guides.md, issue 17 open). Not strict: some scenes agree.
-pytestmark = pytest.mark.xfail(bpy.app.version >= (4, 0, 0), strict=False,
-                               reason="the tracer models Cycles 3.x lights and Principled v1")
+# The exporter tells the tracer which Cycles renders the guides
+# (compat.cycles_light_model: 3.x's or 4.0's lights), so every scene must
+# pass in Debian's 3.4 and in blender.org 4.2, 4.5 and 5.0, except the
+# buffers named here: what Cycles 4.0+ does that the tracer does not model
+# yet, with the figure measured in 4.5 (docs/lpe_guides.md, "Blender 4.x").
+CYCLES_4 = bpy.app.version >= (4, 0, 0)
+CYCLES_4_DEVIATIONS = {
+    "principled_layers": {"LSE": "Principled v2's coat is not modelled (ignored, with a warning): the tracer's "
+                                 "LSE is 45 % below Cycles'"},
+    "layer_weight": {"LSE": "Cycles 4's glossy highlights under Layer Weight mixes are 5 % brighter than 3.4's; "
+                            "the tracer follows 3.4: 7.3 % below"},
+    "bounce_limits": {"LSE": "as layer_weight: Cycles 4's glossy 5.6 % brighter than 3.4's; the tracer 6.4 % "
+                             "below"},
+    "rough_glass": {"LSE": "Cycles 4's rough glass reflects 8 % less than 3.4's; the tracer 7.8 % above"},
+}
 
 SAMPLES = int(os.environ.get("GALLERY_SAMPLES", 128))  # Cycles and the tracer alike (override to study noise)
 MEAN_TOLERANCE = 0.05
@@ -147,6 +155,12 @@ def test_gallery_scene_matches_cycles(key, tmp_path):
         if not (error <= MEAN_TOLERANCE and correlation >= CORRELATION_TOLERANCE):
             failures.append(f"{buffer}: mean error {error:.4f}, correlation {correlation:.4f}")
     print(f"{key} warnings: {warnings}")
+    expected = CYCLES_4_DEVIATIONS.get(key, {}) if CYCLES_4 else {}
+    if expected:  # a strict expected failure of exactly these buffers: one that passes must leave the list
+        failing = {f.split(":")[0] for f in failures}
+        assert failing == set(expected), f"{key}: expected to fail {sorted(expected)}; " + (
+            "; ".join(failures) or "all buffers pass")
+        pytest.xfail(f"{key}: " + "; ".join(f"{b}: {expected[b]}" for b in sorted(expected)))
     assert not failures, f"{key}: " + "; ".join(failures)
 
 

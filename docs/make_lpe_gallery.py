@@ -1,9 +1,11 @@
-"""Regenerates docs/images/lpe_gallery.png and docs/lpe_gallery.json: every
+"""Regenerates docs/images/lpe_gallery.png and docs/lpe_gallery.json (Blender
+3.x; other Blenders write lpe_gallery_X.Y.png and lpe_gallery_X.Y.json): every
 scene of the validation gallery (scenes/lpe_gallery.py) rendered by Cycles
 and traced by Tempera at the test's settings (blender_tests/test_lpe_gallery.py:
 80 x 60, 128 samples each, caustics off), with the test's figures.
 
     PYTHONPATH=addon blender -b --factory-startup --python docs/make_lpe_gallery.py
+    PYTHONPATH=addon ~/.cache/tempera/venv-bpy45/bin/python docs/make_lpe_gallery.py  # PyPI bpy 4.5
 
 One row per scene; columns: FULL, LDE, LSE, L.*DDE, each as Cycles then the
 tracer, every buffer scaled by the same gain in both (its Cycles 99th
@@ -20,13 +22,15 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "scenes"))
 sys.path.insert(0, str(ROOT / "blender_tests"))
 
+import bpy  # noqa: E402  (before the scene scripts: PyPI's bpy provides bmesh once imported)
 import lpe_gallery  # noqa: E402
 import tempera  # noqa: E402
 import test_lpe_gallery as gallery  # noqa: E402
 from tempera.color import linear_to_srgb  # noqa: E402
 
-OUT = ROOT / "docs" / "images" / "lpe_gallery.png"
-FIGURES = ROOT / "docs" / "lpe_gallery.json"
+_SUFFIX = "" if bpy.app.version < (4, 0, 0) else "_{}.{}".format(*bpy.app.version[:2])
+OUT = ROOT / "docs" / "images" / f"lpe_gallery{_SUFFIX}.png"
+FIGURES = ROOT / "docs" / f"lpe_gallery{_SUFFIX}.json"
 
 
 def show(image, gain):

@@ -42,6 +42,13 @@ def _node(tree, kind, **inputs):
     return node
 
 
+def _compat():
+    """tempera.blender.compat, imported when a scene is built (the add-on is installed by then)."""
+    from tempera.blender import compat
+
+    return compat
+
+
 def _rgba(c):
     return (*c, 1.0)
 
@@ -139,9 +146,9 @@ def principled_rough_texture(name):
     rough = 0.25 + 0.2 * np.sin(2 * np.pi * x)
     tex = _node(tree, "ShaderNodeTexImage")
     tex.image = _image(f"{name} roughness", np.dstack([rough, rough, rough]), colorspace="Non-Color")
-    sep = _node(tree, "ShaderNodeSeparateRGB")
-    tree.links.new(tex.outputs["Color"], sep.inputs["Image"])
-    tree.links.new(sep.outputs["R"], bsdf.inputs["Roughness"])
+    sep = _compat().new_separate_rgb_node(tree)
+    tree.links.new(tex.outputs["Color"], sep.inputs[0])
+    tree.links.new(sep.outputs[0], bsdf.inputs["Roughness"])
     return mat
 
 
@@ -178,7 +185,8 @@ def veil(name):
 
 def glass(name):
     mat, tree, out = _tree(name)
-    node = _node(tree, "ShaderNodeBsdfGlass", Color=(0.9, 0.95, 1.0, 1), IOR=1.45, _distribution="SHARP")
+    node = _node(tree, "ShaderNodeBsdfGlass", Color=(0.9, 0.95, 1.0, 1), IOR=1.45)
+    _compat().set_sharp_distribution(node)
     tree.links.new(node.outputs[0], out.inputs["Surface"])
     return mat
 
@@ -371,15 +379,16 @@ def s_principled_layers(name):
     bsdf = coat.node_tree.nodes["Principled BSDF"]
     bsdf.inputs["Base Color"].default_value = (0.6, 0.05, 0.05, 1)
     bsdf.inputs["Roughness"].default_value = 0.6
-    bsdf.inputs["Clearcoat"].default_value = 1.0
-    bsdf.inputs["Clearcoat Roughness"].default_value = 0.15
+    _compat().principled_socket(bsdf, "Clearcoat").default_value = 1.0
+    _compat().principled_socket(bsdf, "Clearcoat Roughness").default_value = 0.15
     _sphere(scene, coat)
     skin = bpy.data.materials.new(f"{name} skin")
     skin.use_nodes = True
     bsdf = skin.node_tree.nodes["Principled BSDF"]
     bsdf.inputs["Base Color"].default_value = (0.8, 0.6, 0.5, 1)
-    bsdf.inputs["Subsurface"].default_value = 0.5
-    bsdf.inputs["Subsurface Color"].default_value = (0.9, 0.3, 0.2, 1)
+    _compat().principled_socket(bsdf, "Subsurface").default_value = 0.5
+    if "Subsurface Color" in bsdf.inputs:  # Principled v1 only; v2 scatters the base colour
+        bsdf.inputs["Subsurface Color"].default_value = (0.9, 0.3, 0.2, 1)
     bsdf.inputs["Subsurface Radius"].default_value = (0.05, 0.02, 0.01)
     _cube(scene, skin)
     _key(scene, radius=0.5)
@@ -507,7 +516,7 @@ def s_ray_visibility(name):
     glossy_only = add_light(scene, "POINT", 800.0, (-2.0, -1.5, 2.5), shadow_soft_size=0.3)
     glossy_only.visible_diffuse = False
     unshadowed = add_light(scene, "AREA", 150.0, (-0.5, 1.0, 2.8), (0, 0, 0), shape="SQUARE", size=0.5)
-    unshadowed.data.cycles.cast_shadow = False
+    _compat().set_light_cast_shadow(unshadowed.data, False)
     return scene
 
 
@@ -517,7 +526,8 @@ def s_glass(name):
     scene = base_scene(name)
     _sphere(scene, glass(f"{name} sphere"))
     mat, tree, out = _tree(f"{name} cube")
-    node = _node(tree, "ShaderNodeBsdfRefraction", Color=(0.8, 0.9, 0.8, 1), IOR=1.3, _distribution="SHARP")
+    node = _node(tree, "ShaderNodeBsdfRefraction", Color=(0.8, 0.9, 0.8, 1), IOR=1.3)
+    _compat().set_sharp_distribution(node)
     tree.links.new(node.outputs[0], out.inputs["Surface"])
     _cube(scene, mat)
     _key(scene, radius=1.0)  # a large reflection in the glass: LSE not dominated by noise

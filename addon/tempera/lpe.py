@@ -166,6 +166,7 @@ def _light(value, index):
             light.direction = r.required("direction")
             light.spot_half_angle = r.number("spot_half_angle")
             light.spot_blend = r.number("spot_blend", 0.0)
+            light.spot_axis_cosine = bool(r.get("spot_axis_cosine", True))
         light.soft_shape = _enum(_native.Light.SoftShape, r.text("soft_shape", ("disk", "sphere"), "disk"))
     elif kind == "sun":
         light.direction, light.irradiance = r.required("direction"), r.required("irradiance")

@@ -2,15 +2,16 @@
 light-path tracer (tempera.lpe), with numpy only (no bpy): the Blender side,
 tempera.blender.scene_export, reads the settings and calls these.
 
-The light conversions reproduce Cycles 3.4, measured with Cycles renders of a
-diffuse floor (docs/lpe_guides.md, "Validation"):
+The light conversions reproduce Cycles 3.4 and 4.x, measured with Cycles
+renders of a diffuse floor (docs/lpe_guides.md, "Validation"):
 
 * point and spot lights of power P watts have a radiant intensity of
   P / (4 pi) W/sr (spots in the centre of their cone); a radius r makes them
   a disk of radius r facing the shaded point, of radiance I / (pi r^2);
 * a sun of strength S gives an irradiance of S W/m^2 on a surface facing it;
 * an area light of power P and area A has a radiance of P / (4 A) W/m^2/sr
-  on its front side: it emits pi P / 4 watts, not P (Cycles' convention);
+  on its front side in Cycles 3.x: it emits pi P / 4 watts, not P; Cycles 4.0
+  made it P / (pi A), a Lambertian emitter of P watts (`emits_power`);
 * emission shaders and the world background: radiance = colour x strength.
 """
 from __future__ import annotations
@@ -43,11 +44,12 @@ def area_size(shape, size, size_y):
     return u, v, area
 
 
-def area_radiance(power, color, area):
-    """Radiance (W/m^2/sr, RGB) of an area light of `power` watts and `area` m^2."""
+def area_radiance(power, color, area, emits_power=False):
+    """Radiance (W/m^2/sr, RGB) of an area light of `power` watts and `area`
+    m^2: Cycles 3.x's P / (4 A), or with `emits_power` Cycles 4.0's P / (pi A)."""
     if area <= 0:
         raise ValueError(f"an area light needs a positive area, got {area}")
-    return np.asarray(color, np.float64)[:3] * (power / (4.0 * area))
+    return np.asarray(color, np.float64)[:3] * (power / ((math.pi if emits_power else 4.0) * area))
 
 
 def resolve_sensor_fit(fit, width, height):

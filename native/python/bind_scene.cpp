@@ -174,6 +174,7 @@ void bind_scene_types(py::module_& m) {
       .def_readwrite("radius", &Light::radius)
       .def_readwrite("spot_half_angle", &Light::spot_half_angle)
       .def_readwrite("spot_blend", &Light::spot_blend)
+      .def_readwrite("spot_axis_cosine", &Light::spot_axis_cosine)
       .def_readwrite("angle", &Light::angle)
       .def_readwrite("size_u", &Light::size_u)
       .def_readwrite("size_v", &Light::size_v)

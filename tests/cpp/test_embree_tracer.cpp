@@ -320,6 +320,29 @@ TEST(Tracer, SpotLightIsAPointLightInsideItsCone) {
   EXPECT_NEAR(r.images[0].at(8, 7, 0), 0.5 / kPi * 10 / std::pow(d2, 2.0), 0.03);
 }
 
+TEST(Tracer, SpotLightAxisCosineIsCycles3Only) {
+  // Cycles 4.0 dropped the cosine to the spot's axis: off the axis the spot
+  // is then the plain point light law, with it 3.x's cosine darker.
+  for (const bool axis_cosine : {true, false}) {
+    Scene s;
+    s.materials = {lambert(0.5f)};
+    add_floor(s, 100, 0);
+    Light spot;
+    spot.type = Light::Type::spot;
+    spot.position = {0, 0, 1};
+    spot.direction = {0, 0, -1};
+    spot.intensity = {10, 10, 10};
+    spot.spot_half_angle = 0.6f;
+    spot.spot_axis_cosine = axis_cosine;
+    s.lights = {spot};
+    s.camera = top_camera(5, 4, 16);
+    const TraceResult r = trace_lpe(s, {"LDE"}, options(16));
+    const double d2 = 0.375 * 0.375 + 0.125 * 0.125 + 1, cosine = 1 / std::sqrt(d2);  // pixel (0.375, 0.125) m
+    const double expected = 0.5 / kPi * 10 / (d2 * std::sqrt(d2)) * (axis_cosine ? cosine : 1.0);
+    EXPECT_NEAR(r.images[0].at(8, 9, 0), expected, 0.02 * expected) << axis_cosine;
+  }
+}
+
 // ------------------------------------------------------------------ Cycles closures
 
 namespace {

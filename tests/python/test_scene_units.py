@@ -17,6 +17,7 @@ def test_light_conversions():
     assert (u, v) == (2.0, 2.0) and area == pytest.approx(math.pi)
     assert su.area_size("ELLIPSE", 2.0, 1.0)[2] == pytest.approx(math.pi / 2)
     np.testing.assert_allclose(su.area_radiance(100.0, (1, 1, 1), 0.25), [100.0] * 3)
+    np.testing.assert_allclose(su.area_radiance(100.0, (1, 1, 1), 0.25, emits_power=True), [400 / math.pi] * 3)
     with pytest.raises(ValueError, match="positive area"):
         su.area_radiance(1.0, (1, 1, 1), 0.0)
     with pytest.raises(ValueError, match="shape"):

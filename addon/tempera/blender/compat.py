@@ -28,6 +28,18 @@ The breaks handled:
 * 4.1: Mesh.calc_normals_split() is gone, corner normals are always there
   (Mesh.corner_normals): `corner_normals()`.
 * 4.0: lights have a soft falloff, on by default: `hard_light_falloff()`.
+* 4.0: Cycles' lights changed: area lights emit their power (radiance
+  P / (pi A), was P / (4 A)), spot lights lost the cosine to their axis, and
+  point and spot lights with a radius are spheres unless Soft Falloff is on
+  (then the disk facing the shaded point of 3.x): `cycles_light_model()`.
+* 4.0: the Glass, Refraction and Glossy nodes lost the SHARP distribution
+  (roughness 0 renders sharp): `set_sharp_distribution()`.
+* 4.0: the Velvet BSDF node became the Sheen BSDF: `sheen_bsdf_node_type()`.
+* 5.0: the Separate RGB node is gone (Separate Color, since 3.3, stays):
+  `new_separate_rgb_node()`; the Cycles light setting Cast Shadow became
+  Light.use_shadow: `set_light_cast_shadow()`; an empty material slot
+  renders Blender's default material, a Principled BSDF, no longer Cycles'
+  diffuse default surface: `default_surface_is_principled()`.
 * 4.x: the AOV Output node names its AOV in .aov_name: `set_aov_output_name()`.
 * 5.0: the sequencer's Scene.sequence_editor.sequences became .strips
   (available since 4.4): `sequencer_strips()`.
@@ -155,6 +167,57 @@ def corner_normals(mesh):
         flat = np.empty(len(mesh.loops) * 3, np.float64)
         mesh.loops.foreach_get("normal", flat)
     return flat.reshape(-1, 3)
+
+
+def cycles_light_model(light):
+    """How this Cycles renders `light` (a bpy Light), as the tracer's light
+    fields: {"soft_shape": "disk" | "sphere", "spot_axis_cosine": bool,
+    "area_emits_power": bool}. Cycles 4.0's lights came with the Soft Falloff
+    option, so its presence tells them apart."""
+    cycles4 = "use_soft_falloff" in bpy.types.PointLight.bl_rna.properties
+    soft_falloff = bool(getattr(light, "use_soft_falloff", True))
+    return {"soft_shape": "sphere" if cycles4 and not soft_falloff else "disk",
+            "spot_axis_cosine": not cycles4, "area_emits_power": cycles4}
+
+
+def set_sharp_distribution(node):
+    """Makes a Glass, Refraction or Glossy BSDF node perfectly sharp: the SHARP
+    distribution where it exists (3.x), else GGX of roughness 0, which Cycles
+    4.0+ renders as sharp."""
+    if "SHARP" in _enum_ids(node, "distribution"):
+        node.distribution = "SHARP"
+    else:
+        node.distribution = "GGX"
+        node.inputs["Roughness"].default_value = 0.0
+
+
+def sheen_bsdf_node_type():
+    """The node type of the Velvet BSDF (3.x), called Sheen BSDF since 4.0."""
+    return "ShaderNodeBsdfVelvet" if hasattr(bpy.types, "ShaderNodeBsdfVelvet") else "ShaderNodeBsdfSheen"
+
+
+def new_separate_rgb_node(tree):
+    """A node in `tree` splitting a colour (input 0) into R, G, B (outputs
+    0-2): Separate RGB where it exists (3.x, 4.x), else Separate Color."""
+    kind = "ShaderNodeSeparateRGB" if hasattr(bpy.types, "ShaderNodeSeparateRGB") else "ShaderNodeSeparateColor"
+    return tree.nodes.new(kind)
+
+
+def set_light_cast_shadow(light, value):
+    """A light's Cast Shadow: its Cycles setting before 5.0, Light.use_shadow in 5.0."""
+    cycles = getattr(light, "cycles", None)
+    if cycles is not None and "cast_shadow" in cycles.bl_rna.properties:
+        cycles.cast_shadow = value
+    else:
+        light.use_shadow = value
+
+
+def default_surface_is_principled():
+    """Whether an empty material slot renders as Blender's default material
+    (a Principled BSDF of its defaults: Blender 5.0, where every material
+    renders its nodes: Material.use_nodes is deprecated there) rather than
+    Cycles' default surface, a diffuse BSDF of 0.8 grey."""
+    return bpy.app.version >= (5, 0, 0)
 
 
 def hard_light_falloff(light):

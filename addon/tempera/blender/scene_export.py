@@ -264,9 +264,15 @@ def _get(collection, attribute, shape, dtype):
 # --------------------------------------------------------------------------- materials
 
 def default_surface():
-    """Cycles' default surface (empty or missing material slots): diffuse 0.8 grey."""
-    return {"base_color": np.array(FALLBACK_GREY, np.float32),
-            "closures": [{"type": "diffuse", "color": np.array(FALLBACK_GREY, np.float32)}]}
+    """What empty or missing material slots render as: Cycles' default
+    surface, diffuse 0.8 grey, or in Blender 5.0 its default material, a
+    Principled BSDF of 0.8 grey, roughness 0.5, IOR 1.5 (compat)."""
+    grey = np.array(FALLBACK_GREY, np.float32)
+    if compat.default_surface_is_principled():
+        return {"base_color": grey, "closures": [{"type": "principled", "color": grey, "metallic": 0.0,
+                                                  "specular": 0.5, "roughness": 0.5, "transmission": 0.0,
+                                                  "ior": 1.5}]}
+    return {"base_color": grey, "closures": [{"type": "diffuse", "color": grey}]}
 
 
 class _Materials:
@@ -353,15 +359,14 @@ def _light(obj, matrix, warnings):
     position = matrix[:3, 3]
     z_axis = matrix[:3, 2] / np.linalg.norm(matrix[:3, 2])  # Blender lights shine down their local -Z
     tint = _light_node_tint(obj, warnings)
+    model = compat.cycles_light_model(light)  # Cycles 3.x's lights or 4.0's
     if light.type in ("POINT", "SPOT"):
-        # Cycles 4.0 made soft point and spot lights spheres; before, disks facing the shaded point.
-        import bpy  # noqa: PLC0415  (the version decides the shape)
         out = {"type": "point", "position": position, "radius": float(light.shadow_soft_size),
                "intensity": scene_units.point_intensity(light.energy, light.color),
-               "soft_shape": "sphere" if bpy.app.version >= (4, 0, 0) else "disk"}
+               "soft_shape": model["soft_shape"]}
         if light.type == "SPOT":
             out.update(type="spot", direction=-z_axis, spot_half_angle=float(light.spot_size) / 2,
-                       spot_blend=float(light.spot_blend))
+                       spot_blend=float(light.spot_blend), spot_axis_cosine=model["spot_axis_cosine"])
     elif light.type == "SUN":
         out = {"type": "sun", "direction": z_axis, "angle": float(light.angle),
                "irradiance": scene_units.sun_irradiance(light.energy, light.color)}
@@ -373,7 +378,7 @@ def _light(obj, matrix, warnings):
         out = {"type": "area", "center": position, "axis_u": matrix[:3, 0] / u_len,
                "axis_v": matrix[:3, 1] / v_len, "normal": -z_axis, "size_u": float(u), "size_v": float(v),
                "shape": "disk" if light.shape in ("DISK", "ELLIPSE") else "rect",
-               "radiance": scene_units.area_radiance(light.energy, light.color, area)}
+               "radiance": scene_units.area_radiance(light.energy, light.color, area, model["area_emits_power"])}
         if getattr(light, "spread", np.pi) < np.pi - 1e-4:
             warnings.append(f"Light '{obj.name}': area light spread is not modelled by the light-path tracer "
                             "(it emits over the full hemisphere).")

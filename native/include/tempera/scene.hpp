@@ -117,6 +117,9 @@ struct Light {
   Float3 intensity;       // point, spot: W/sr
   float spot_half_angle = 0.7853982f;  // spot cone half-angle, radians
   float spot_blend = 0;                // spot: Blender's smoothstep blend in [0, 1]
+  // spot: Cycles 3.x also weights by the cosine to the axis; 4.0 dropped it
+  // (the smoothstep alone).
+  bool spot_axis_cosine = true;
   float angle = 0;        // sun: angular diameter, radians
   Float3 irradiance;      // sun: W/m^2 on a surface facing the sun
   Float3 center, axis_u, axis_v, normal;  // area: unit axes; emits along +normal only

@@ -8,13 +8,13 @@ namespace {
 
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
-// Cycles' spot attenuation: the cosine to the axis, zero outside the cone,
-// smoothstep over the blend region.
+// Cycles' spot attenuation: zero outside the cone, smoothstep over the blend
+// region, times the cosine to the axis in Cycles 3.x (spot_axis_cosine).
 float spot_attenuation(const Light& l, Float3 from_light) {
   const float cos_a = dot(l.direction, from_light), cos_edge = std::cos(l.spot_half_angle);
   if (cos_a <= cos_edge) return 0;
   const float smooth = (1 - cos_edge) * l.spot_blend, t = cos_a - cos_edge;
-  float attenuation = cos_a;
+  float attenuation = l.spot_axis_cosine ? cos_a : 1.0f;
   if (smooth > 0 && t < smooth) {
     const float x = t / smooth;
     attenuation *= x * x * (3 - 2 * x);

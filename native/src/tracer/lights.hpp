@@ -1,7 +1,7 @@
 #pragma once
 // Light sampling as Cycles does it: point and spot lights with a radius
 // (a disk facing the shaded point, or a sphere), the spot cone with its
-// smoothstep blend and Cycles' extra cosine to the axis, suns with an angular
+// smoothstep blend and Cycles 3.x's extra cosine to the axis, suns with an angular
 // diameter, one-sided rectangle and ellipse area lights, and the world: a
 // constant colour or an importance-sampled equirectangular environment.
 #include <vector>
