@@ -1,30 +1,24 @@
 """The rigid-body method on a scene made the way a new user makes one, only
-with Blender's own operators and their defaults: a cube broken by the
-bundled Cell Fracture add-on (Object > Quick Effects > Cell Fracture, Source
-Own Verts since a fresh cube has no particles), the shards made rigid with
-Object > Rigid Body > Add Active, a plane with Add Passive, the world baked
-with Bake All Dynamics, a camera added with Add > Camera. The method then
+with Blender's own operators and their defaults (scenes/rigid_fractured_cube.py:
+a cube broken by Cell Fracture falling onto a plane). The method then
 runs from the panel (Stylize Animation) and from the CLI on the guide cache
 (`tempera stylize --method rigid`): every shard is drawn where it is, its
 first collision is on the floor, no drawing goes through the floor at a
 contact, no map folds, and the CLI's frames are the panel's."""
 import math
+import sys
+from pathlib import Path
 
-import addon_utils
 import bpy
 import numpy as np
 import pytest
 
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "scenes"))
+import rigid_fractured_cube  # noqa: E402
+
 SCENE = "Rigid user scene"
 SIZE = (240, 135)
 FRAMES = (8, 23)  # the fall, the impact (frame ~14) and the scatter: two chunks
-END = 30
-
-
-def _enable_cell_fracture():
-    if addon_utils.enable("object_fracture_cell", default_set=False) is None:
-        pytest.skip("this Blender has no Cell Fracture add-on")
-    return True
 
 
 def _exemplar(folder):
@@ -38,37 +32,14 @@ def _exemplar(folder):
         _native.write_image(str(folder / "drawn" / f"{1 + i:04d}.png"), d, [])
 
 
-def _select(objects):
-    bpy.ops.object.select_all(action="DESELECT")
-    for o in objects:
-        o.select_set(True)
-    bpy.context.view_layer.objects.active = objects[0]
-
-
 @pytest.fixture
 def fractured_scene(tmp_path):
-    _enable_cell_fracture()
+    if not rigid_fractured_cube.has_cell_fracture():
+        pytest.skip("this Blender has no Cell Fracture add-on")
     scene = bpy.data.scenes.new(SCENE)
     shown = bpy.context.window.scene
     bpy.context.window.scene = scene
-    bpy.ops.mesh.primitive_plane_add(size=20)
-    assert bpy.ops.rigidbody.object_add(type="PASSIVE") == {"FINISHED"}  # Rigid Body > Add Passive
-    bpy.ops.mesh.primitive_cube_add(size=1, location=(0, 0, 2), rotation=(0, 0.3, 0))
-    cube = bpy.context.object
-    _select([cube])
-    before = set(scene.objects)
-    assert bpy.ops.object.add_fracture_cell_objects(source={"VERT_OWN"}) == {"FINISHED"}
-    shards = [o for o in scene.objects if o not in before]
-    bpy.data.objects.remove(cube)  # the user deletes the unbroken cube
-    _select(shards)
-    assert bpy.ops.rigidbody.objects_add(type="ACTIVE") == {"FINISHED"}  # Rigid Body > Add Active, defaults
-    scene.frame_start, scene.frame_end = 1, END
-    scene.rigidbody_world.point_cache.frame_end = END
-    assert bpy.ops.ptcache.bake_all(bake=True) == {"FINISHED"}  # Rigid Body World > Cache > Bake All Dynamics
-    bpy.ops.object.camera_add(location=(0, -9, 1.2), rotation=(math.pi / 2, 0, 0))  # Add > Camera (perspective)
-    scene.camera = bpy.context.object
-    scene.render.resolution_x, scene.render.resolution_y = SIZE
-    scene.render.resolution_percentage = 100
+    shards = rigid_fractured_cube.build(scene, SIZE)
     _exemplar(tmp_path / "examples" / "box")
     settings = scene.tempera
     settings.method, settings.rigid_shape = "RIGID", "box"
