@@ -34,7 +34,8 @@ def stroke_guide(rgba, d_max):
     return 1.0 - guides.line_distance(alpha > INK, d_max)
 
 
-def _segment_distance(xs, ys, a, b):
+def segment_distance(xs, ys, a, b):
+    """Distance of the pixel grid (xs, ys) to the segment a-b (px)."""
     d = b - a
     t = np.clip(((xs - a[0]) * d[0] + (ys - a[1]) * d[1]) / max(float(d @ d), 1e-9), 0, 1)
     return np.hypot(xs - (a[0] + t * d[0]), ys - (a[1] + t * d[1]))
@@ -55,7 +56,7 @@ def generated_stroke_exemplar(size=160, width=4.0, seed=0):
         points = centre + radius * np.stack([np.cos(t), np.sin(t) * rng.uniform(0.6, 1.0)], 1)
         pressure = 0.6 + 0.4 * np.sin(np.linspace(0, math.pi, len(t)))
         for a, b, p in zip(points, points[1:], pressure):
-            d = _segment_distance(xs, ys, a, b)
+            d = segment_distance(xs, ys, a, b)
             alpha = np.maximum(alpha, np.clip(width * p / 2 + 0.5 - d, 0, 1))
     grain = rng.uniform(0.55, 1.0, (size, size)).astype(np.float32)
     rgba = np.zeros((size, size, 4), np.float32)
