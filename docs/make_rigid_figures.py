@@ -15,8 +15,13 @@ rigid_strokes.png   stroke re-synthesis (tempera.rigid_strokes): the drawn
                     line, the stroke exemplar, the line re-made on the
                     stroke-position guide, and the same with the guide off.
 
+With --demo DIR (the output of `make demo-rigid`, out/demo-rigid) it
+makes rigid_demo.png only: demo frames 20, 40, 60, the output (top) and
+the oracle (bottom), at half size.
+
 docs/make_rigid_user_scene_figure.py makes rigid_user_scene.png (Blender).
 """
+import argparse
 import sys
 from pathlib import Path
 
@@ -115,5 +120,16 @@ def strokes_figure(drawn, centre):
     _native.write_image(str(OUT / "rigid_strokes.png"), strip.astype(np.float32), [])
 
 
+def demo_figure(folder):
+    half = lambda img: img[::2, ::2, :3]  # noqa: E731
+    read = lambda name: np.asarray(_native.read_image(str(Path(folder) / name), None), np.float32)  # noqa: E731
+    rows = [np.concatenate([half(read(f"{kind}_{f:04d}.png")) for f in (20, 40, 60)], 1) for kind in ("frame", "oracle")]
+    _native.write_image(str(OUT / "rigid_demo.png"), np.ascontiguousarray(np.concatenate(rows, 0)), [])
+    print("wrote rigid_demo.png")
+
+
 if __name__ == "__main__":
-    main()
+    parser = argparse.ArgumentParser(description="the pictures of docs/rigid_bodies.md")
+    parser.add_argument("--demo", help="make rigid_demo.png from this `make demo-rigid` output folder")
+    args = parser.parse_args()
+    demo_figure(args.demo) if args.demo else main()

@@ -137,8 +137,8 @@ def main():
     out.mkdir(parents=True, exist_ok=True)
     scene = bpy.context.scene
     bodies, planes = build(scene)
-    segments = scenery_segments(scene, planes)
     tracks, gravity, warnings = brt.extract_tracks(scene, bodies)
+    segments = scenery_segments(scene, planes)  # after frame_set: the camera's matrix is evaluated
     for w in warnings:
         print("rigid demo: warning:", w)
     rigid_tracks.write_tracks(out, tracks, scene.frame_start, gravity)

@@ -78,7 +78,7 @@ const char* kStylizeHelpText =
     "                          flow; own options: tempera stylize --method lazyfluids --help)\n"
     "                          | fluidymation (natural media from a video exemplar; see\n"
     "                          'tempera stylize --method fluidymation --help')\n"
-    "                          | rigid (hand-drawn rigid bodies, Dvorozak 2017: run by the\n"
+    "                          | rigid (hand-drawn rigid bodies, Dvoroznak 2017: run by the\n"
     "                          Python package, 'python -m tempera stylize --method rigid --help')\n"
     "  --key F=PATH[,MASK]     tcia: a painted keyframe (repeatable); comes out as painted\n"
     "                          (where MASK > 0.5 if given) and steers its neighbours\n"
