@@ -123,7 +123,8 @@ def strokes_figure(drawn, centre):
 def demo_figure(folder):
     half = lambda img: img[::2, ::2, :3]  # noqa: E731
     read = lambda name: np.asarray(_native.read_image(str(Path(folder) / name), None), np.float32)  # noqa: E731
-    rows = [np.concatenate([half(read(f"{kind}_{f:04d}.png")) for f in (20, 40, 60)], 1) for kind in ("frame", "oracle")]
+    rows = [np.concatenate([half(read(f"{kind}_{f:04d}.png")) for f in (20, 40, 60)], 1)
+            for kind in ("frame", "oracle")]
     _native.write_image(str(OUT / "rigid_demo.png"), np.ascontiguousarray(np.concatenate(rows, 0)), [])
     print("wrote rigid_demo.png")
 
