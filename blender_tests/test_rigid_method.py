@@ -145,3 +145,31 @@ def test_esc_within_a_step_writes_nothing_then_resume(rigid_scene, tmp_path):
     while not rerun.finished:
         rerun.step()
     assert [r["status"] for r in rerun.step_results] == ["kept", "stylized", "composited", "composited"]
+
+
+def test_panel_options_reach_the_job(rigid_scene):
+    """K, augmentation, damping and the strokes of the panel are the job's
+    (names of the method's option table), and the panel shows them."""
+    from test_addon import _Recorder
+    from tempera import settings as limits
+    from tempera.blender.stylize_operator import StylizeRun
+
+    settings = rigid_scene.tempera
+    assert settings.rigid_k == limits.RIGID_OPTIONS["k"]["default"]
+    settings.rigid_k, settings.rigid_augment, settings.rigid_damp = 1, False, False
+    settings.rigid_strokes, settings.rigid_stroke_weight = "GENERATED", 2.5
+    calls = []
+    bpy.types.TEMPERA_PT_output.draw(type("FakePanel", (), {"layout": _Recorder(calls)})(), bpy.context)
+    props = [name for kind, name in calls if kind == "prop"]
+    for name in ("rigid_k", "rigid_augment", "rigid_damp", "rigid_strokes", "rigid_stroke_weight"):
+        assert name in props
+    run = StylizeRun.from_settings(rigid_scene, "ANIMATION")
+    while run.in_guide_phase:
+        run.step()
+    job = run._rigid_job()
+    assert {k: job.values[k] for k in ("k", "augment", "damp", "stroke_weight")} == {
+        "k": 1, "augment": False, "damp": False, "stroke_weight": 2.5}
+    assert job.strokes == "generated" and job._stroke_exemplar is not None
+    settings.rigid_strokes, settings.rigid_stroke_image = "IMAGE", "/nowhere/strokes.png"
+    with pytest.raises(FileNotFoundError, match="strokes.png' does not exist"):
+        StylizeRun.from_settings(rigid_scene, "ANIMATION")

@@ -10,8 +10,18 @@ rigid_residual.png  one squashed frame: the drawing f^e, its residual
                     f^r = D^-1(f^e), D applied to f^r again;
 rigid_transfer.png  target frames around two bounces: the output (graphite)
                     over the oracle's outline (D_gen of the target, red);
-rigid_onion.png     the whole target sequence, every second frame, on paper.
+rigid_onion.png     the whole target sequence, every second frame, on paper;
+rigid_strokes.png   stroke re-synthesis (tempera.rigid_strokes): the drawn
+                    line, the stroke exemplar, the line re-made on the
+                    stroke-position guide, and the same with the guide off.
+
+With --demo DIR (the output of `make demo-rigid`, out/demo-rigid) it
+makes rigid_demo.png only: demo frames 20, 40, 60, the output (top) and
+the oracle (bottom), at half size.
+
+docs/make_rigid_user_scene_figure.py makes rigid_user_scene.png (Blender).
 """
+import argparse
 import sys
 from pathlib import Path
 
@@ -19,7 +29,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "addon"))
-from tempera import _native, rigid  # noqa: E402
+from tempera import _native, rigid, rigid_strokes  # noqa: E402
 
 W, H = 320, 200
 OUT = ROOT / "docs" / "images"
@@ -95,8 +105,32 @@ def main():
     img = over_paper(onion)
     img[185:187, :, :] = 0.3  # the floor
     _native.write_image(str(OUT / "rigid_onion.png"), img.astype(np.float32), [])
+    strokes_figure(frames[target["events"][0]["frame"]][0], target["centre"][target["events"][0]["frame"]])
     print("wrote", ", ".join(p.name for p in sorted(OUT.glob("rigid_*.png"))))
 
 
+def strokes_figure(drawn, centre):
+    exemplar = rigid_strokes.generated_stroke_exemplar()
+    made = rigid_strokes.resynthesize(drawn, exemplar)
+    unguided = rigid_strokes.resynthesize(drawn, exemplar, weight=0)
+    big = lambda img: np.repeat(np.repeat(img, 2, 0), 2, 1)  # noqa: E731
+    tiles = [big(crop(over_paper(x), centre)) for x in (drawn, made, unguided)]
+    ex = over_paper(exemplar)[:160, :160]
+    strip = np.concatenate([tiles[0], ex, tiles[1], tiles[2]], 1)
+    _native.write_image(str(OUT / "rigid_strokes.png"), strip.astype(np.float32), [])
+
+
+def demo_figure(folder):
+    half = lambda img: img[::2, ::2, :3]  # noqa: E731
+    read = lambda name: np.asarray(_native.read_image(str(Path(folder) / name), None), np.float32)  # noqa: E731
+    rows = [np.concatenate([half(read(f"{kind}_{f:04d}.png")) for f in (20, 40, 60)], 1)
+            for kind in ("frame", "oracle")]
+    _native.write_image(str(OUT / "rigid_demo.png"), np.ascontiguousarray(np.concatenate(rows, 0)), [])
+    print("wrote rigid_demo.png")
+
+
 if __name__ == "__main__":
-    main()
+    parser = argparse.ArgumentParser(description="the pictures of docs/rigid_bodies.md")
+    parser.add_argument("--demo", help="make rigid_demo.png from this `make demo-rigid` output folder")
+    args = parser.parse_args()
+    demo_figure(args.demo) if args.demo else main()

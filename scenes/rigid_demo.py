@@ -9,7 +9,8 @@ the tracks (tempera.blender.rigid_tracks), fits the generated exemplars (a
 thrown ball, and a tumbling box for the box) and writes, per frame, the
 stylized objects composited by depth on paper (frame_NNNN.png), the oracle
 outlines (D_gen applied to the target tracks, oracle_NNNN.png) and
-tracks.json.
+tracks.json. The floor and the ramps are drawn in the same pencil, with a
+fresh jitter every frame.
 """
 import argparse
 import math
@@ -21,12 +22,44 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "addon"))
-from tempera import _native, rigid, rigid_tracks  # noqa: E402
+from tempera import _native, rigid, rigid_strokes, rigid_tracks  # noqa: E402
 from tempera.blender import rigid_tracks as brt  # noqa: E402
 
 W, H = 640, 360
 FRAMES = 96
 PAPER = np.asarray((0.97, 0.96, 0.92), np.float32)
+GRAPHITE = np.asarray((0.16, 0.16, 0.20), np.float32)  # the generated exemplar's pencil (rigid_exemplar.cpp)
+
+
+def scenery_segments(scene, planes):
+    """The passive planes seen edge-on by the camera along +Y: each one's
+    image segment (its leftmost and rightmost projected vertices)."""
+    from bpy_extras.object_utils import world_to_camera_view
+
+    segments = []
+    for plane in planes:
+        points = [world_to_camera_view(scene, scene.camera, plane.matrix_world @ v.co) for v in plane.data.vertices]
+        pixels = sorted((p.x * W, (1 - p.y) * H) for p in points)
+        segments.append((np.asarray(pixels[0]), np.asarray(pixels[-1])))
+    return segments
+
+
+def draw_scenery(segments, frame, width=2.5, wobble=0.6):
+    """Alpha of the scenery in pencil (the exemplar's line width and wobble):
+    each segment a line whose path wobbles by a smooth random offset, fresh
+    every frame, as the drawn bodies boil."""
+    rng = np.random.default_rng(1000 + frame)
+    ys, xs = np.mgrid[0:H, 0:W].astype(np.float32)
+    alpha = np.zeros((H, W), np.float32)
+    for a, b in segments:
+        a, b = np.clip(a, -10, W + 10), np.clip(b, -10, W + 10)
+        n = max(2, int(np.hypot(*(b - a)) / 12))
+        t = np.linspace(0, 1, n + 1)[:, None]
+        normal = np.array([a[1] - b[1], b[0] - a[0]]) / max(np.hypot(*(b - a)), 1e-6)
+        points = a + t * (b - a) + normal * rng.uniform(-wobble, wobble, (n + 1, 1))
+        for p, q in zip(points, points[1:]):
+            alpha = np.maximum(alpha, np.clip(width / 2 + 0.5 - rigid_strokes.segment_distance(xs, ys, p, q), 0, 1))
+    return alpha
 
 
 def _body(obj, passive=False, shape="SPHERE"):
@@ -45,10 +78,10 @@ def build(scene):
         bpy.ops.rigidbody.world_add()
     scene.rigidbody_world.point_cache.frame_end = FRAMES
     bpy.ops.mesh.primitive_plane_add(size=40, location=(0, 0, 0))
-    _body(bpy.context.object, passive=True, shape="MESH")
+    planes = [_body(bpy.context.object, passive=True, shape="MESH")]
     for x, z, angle in ((-3.2, 2.6, 25), (3.0, 1.6, -20)):
         bpy.ops.mesh.primitive_plane_add(size=2.6, location=(x, 0, z), rotation=(0, math.radians(angle), 0))
-        _body(bpy.context.object, passive=True, shape="MESH")
+        planes.append(_body(bpy.context.object, passive=True, shape="MESH"))
     balls = []
     for i, (x, z) in enumerate(((-3.4, 5.0), (3.2, 4.4), (0.3, 5.6))):
         bpy.ops.mesh.primitive_uv_sphere_add(radius=0.3, location=(x, 0, z))
@@ -68,7 +101,7 @@ def build(scene):
     scene.camera = cam
     scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = W, H, 100
     scene.frame_start, scene.frame_end = 1, FRAMES
-    return balls + [box]
+    return balls + [box], planes
 
 
 def exemplars():
@@ -103,8 +136,9 @@ def main():
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     scene = bpy.context.scene
-    bodies = build(scene)
+    bodies, planes = build(scene)
     tracks, gravity, warnings = brt.extract_tracks(scene, bodies)
+    segments = scenery_segments(scene, planes)  # after frame_set: the camera's matrix is evaluated
     for w in warnings:
         print("rigid demo: warning:", w)
     rigid_tracks.write_tracks(out, tracks, scene.frame_start, gravity)
@@ -121,6 +155,8 @@ def main():
     for f in range(FRAMES):
         img = np.broadcast_to(PAPER, (H, W, 3)).copy()
         ora = img.copy()
+        ground = draw_scenery(segments, f)[:, :, None]
+        img = GRAPHITE * ground + img * (1 - ground)
         for name, frames, oracle, shape in layers:
             rgba = frames[f][0]
             a = rgba[:, :, 3:4]

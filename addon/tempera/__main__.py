@@ -2,8 +2,9 @@
 `python -m tempera`.
 
 `tempera farm ...` and `tempera stylize --scheduler ADDRESS ...` run a shot on
-a Dask cluster (tempera.farm); `tempera rigid ...` runs the rigid-body method
-on a guide cache's tracks (tempera.rigid_cli); `tempera exemplar ...` writes one of the
+a Dask cluster (tempera.farm); `tempera rigid ...` and `tempera stylize
+--method rigid ...` run the rigid-body method on a guide cache's tracks
+(tempera.rigid_cli); `tempera exemplar ...` writes one of the
 project's own smoke/fire/ink exemplars (tempera.exemplar_cli); every other command is the
 native batch CLI
 (tempera_native/bin/tempera: synth, stylize, render-guides), run with this
@@ -35,6 +36,16 @@ def native_cli():
     return path
 
 
+def stylize_method(args):
+    """The value of `--method M` or `--method=M` in stylize's arguments, or None."""
+    for a, b in zip(args, args[1:] + [None]):
+        if a == "--method":
+            return b
+        if a.startswith("--method="):
+            return a.split("=", 1)[1]
+    return None
+
+
 def main(argv=None):
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv[:1] == ["farm"] or (argv[:1] == ["stylize"] and any(
@@ -46,6 +57,10 @@ def main(argv=None):
         from .rigid_cli import main as rigid_main
 
         return rigid_main(argv[1:])
+    if argv[:1] == ["stylize"] and stylize_method(argv[1:]) == "rigid":
+        from .rigid_cli import stylize_main
+
+        return stylize_main(argv[1:])
     if argv[:1] == ["exemplar"]:
         from .exemplar_cli import main as exemplar_main
 

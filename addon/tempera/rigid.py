@@ -19,6 +19,8 @@ from . import _native
 RigidOptions = _native.RigidOptions
 QuadraticFitOptions = _native.QuadraticFitOptions
 ExemplarStyle = _native.ExemplarStyle
+# The proxy shapes and their rotational symmetry (Diff's rotation term; 0 = a circle).
+SYMMETRY = {"circle": 0, "box": 4}
 
 
 def _rgba(a, what):

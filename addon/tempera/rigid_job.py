@@ -2,13 +2,16 @@
 "Rigid Bodies (hand-drawn)" method; no bpy. OUT is the method's own folder
 (the panel's Output Folder/rigid): files of other settings there are removed.
 
-    job = RigidJob(cache, examples, out, frames, objects=None, shape="circle", paper=False)
+    job = RigidJob(cache, examples, out, frames, objects=None, shape="circle", paper=False, strokes=None,
+                   **rigid_options)
     for i in range(job.total): job.run_step(i, progress)
 
 CACHE is a guide cache with tracks.json (rendering the guides of a scene with
 a rigid-body world writes it); EXAMPLES is one exemplar folder as `tempera
 rigid --exemplar` takes it (tracks.json and drawn/NNNN.png) or a folder of
-such folders. The steps: one per target object and chunk of CHUNK frames
+such folders; STROKES a stroke exemplar to re-synthesize the lines from
+(tempera.rigid_strokes; None: the drawn lines as they are); rigid_options are
+RigidOptions keywords (k, augment, damp, stroke_weight...). The steps: one per target object and chunk of CHUNK frames
 (the object's layer, OUT/layers/<object>/frame_NNNN.png, RGBA), then one per
 chunk compositing the layers by depth, far to near, into OUT/frames (RGBA
 to lay over the render, or opaque on paper). Every file is written to a
@@ -24,13 +27,12 @@ from pathlib import Path
 
 import numpy as np
 
-from . import _native, rigid, rigid_cli, rigid_tracks
+from . import _native, rigid, rigid_cli, rigid_strokes, rigid_tracks
 
 CHUNK = 8  # frames per step: Esc and resume lose at most this many frames of one object
 LAYERS_DIR = "layers"
 FRAMES_DIR = "frames"
 STATE = "rigid.json"
-SYMMETRY = {"circle": 0, "box": 4}  # the proxy's rotational symmetry (Diff's rotation term)
 
 
 def exemplar_folders(examples):
@@ -62,8 +64,8 @@ def _over(below, rgba):
 
 class RigidJob:
     def __init__(self, cache, examples, out, frames, objects=None, shape="circle", paper=False, chunk=CHUNK,
-                 **values):
-        if shape not in SYMMETRY:
+                 strokes=None, **values):
+        if shape not in rigid.SYMMETRY:
             raise ValueError(f"unknown proxy shape '{shape}' (circle or box)")
         self.cache, self.out, self.shape, self.paper = Path(cache), Path(out), shape, bool(paper)
         self.tracks = rigid_tracks.read_tracks(cache)
@@ -84,7 +86,10 @@ class RigidJob:
             raise ValueError(f"frames {outside[0]}.. are outside the tracked range {start}-{start + count - 1}: "
                              "render the guides of the whole simulation")
         self.examples = exemplar_folders(examples)
-        self.values = {"symmetry": SYMMETRY[shape], **values}
+        self.values = {"symmetry": rigid.SYMMETRY[shape], **values}
+        rigid.RigidOptions(**self.values)  # a named error now, not in the first step
+        self.strokes = strokes or None
+        self._stroke_exemplar = rigid_strokes.load_stroke_exemplar(strokes) if self.strokes else None
         self.key = self._settings_key()
         self.steps = [(name, c) for name in self.objects for c in _chunks(self.frames, chunk)]
         self.steps += [(None, c) for c in _chunks(self.frames, chunk)]  # None: composite
@@ -105,7 +110,8 @@ class RigidJob:
         # The tracks by content: rendering the guides rewrites tracks.json each time, unchanged.
         tracks = hashlib.sha256((self.cache / rigid_tracks.TRACKS_NAME).read_bytes()).hexdigest()
         parts = [tracks, self.shape, str(self.paper),
-                 json.dumps(self.values, sort_keys=True), ",".join(self.objects)]
+                 json.dumps(self.values, sort_keys=True), ",".join(self.objects),
+                 rigid_cli.strokes_stamp(self.strokes) or ""]
         for d in self.examples:
             parts += [rigid_cli._stamp(d / rigid_tracks.TRACKS_NAME)]
             parts += sorted(rigid_cli._stamp(p) for p in (d / "drawn").glob("*.png"))
@@ -163,9 +169,16 @@ class RigidJob:
 
         images = rigid.stylize(self._fitted(), self.tracks["objects"][name], self.width, self.height,
                                progress=step_progress, only=only, **self.values)
+        layers = [images[i][0] for i in only]
+        if self._stroke_exemplar is not None:  # before any write: Esc here too writes nothing of the step
+            def keep_going(_fraction):
+                return progress is None or progress(len(only) / (len(only) + 1)) is not False
+
+            layers = [rigid_strokes.restyle(rgba, self._stroke_exemplar, self.values, keep_going)
+                      for rgba in layers]
         paths[0].parent.mkdir(parents=True, exist_ok=True)
-        for i, path in zip(only, paths):
-            rgba = np.ascontiguousarray(images[i][0], np.float32)
+        for layer, path in zip(layers, paths):
+            rgba = np.ascontiguousarray(layer, np.float32)
             rigid_cli._write_atomic(path, lambda p, img=rgba: _native.write_image(str(p), img, []))
 
     def depth_order(self, frame):

@@ -48,6 +48,9 @@ OUTPUT_FORMATS = ("png", "exr")
 LAZYFLUIDS_OPTIONS = {row["name"]: row for row in _native.LazyFluidsOptions.table()}
 FLUIDYMATION_OPTIONS = {row["name"]: row for row in _native.FluidymationOptions.table()}
 PANEL_SOFT_MAX = {"temporal_weight": 1.0, "motion_blur": 16.0}
+# The rigid-body method's option table (rigid.hpp, name -> row); the panel
+# shows K, augmentation, damping and the stroke guide's weight.
+RIGID_OPTIONS = {row["name"]: row for row in _native.RigidOptions.table()}
 # Table options the panel shows as they are (default, limits and tooltip from
 # the table row): Scene.tempera property -> (table, option name, label, soft
 # maximum), in panel order. The job gets each under its option name.

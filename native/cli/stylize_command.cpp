@@ -78,6 +78,8 @@ const char* kStylizeHelpText =
     "                          flow; own options: tempera stylize --method lazyfluids --help)\n"
     "                          | fluidymation (natural media from a video exemplar; see\n"
     "                          'tempera stylize --method fluidymation --help')\n"
+    "                          | rigid (hand-drawn rigid bodies, Dvoroznak 2017: run by the\n"
+    "                          Python package, 'python -m tempera stylize --method rigid --help')\n"
     "  --key F=PATH[,MASK]     tcia: a painted keyframe (repeatable); comes out as painted\n"
     "                          (where MASK > 0.5 if given) and steers its neighbours\n"
     "  --segment A-B           tcia: solve only the segment from key A to key B (a farm\n"
@@ -186,9 +188,17 @@ bool set_engine_flag(Options& o, const std::string& flag, ArgReader& r) {
   return true;
 }
 
+// The rigid-body method is the Python package's (tempera.rigid_cli): the
+// wheel's `tempera` command and `python -m tempera` run it before this CLI.
+constexpr const char* kRigidElsewhere =
+    "--method rigid runs in the Python package: use the pip-installed 'tempera stylize --method rigid ...' "
+    "or 'python -m tempera stylize --method rigid ...' (docs/rigid_bodies.md)";
+
 void check_method(Options& o) {
   if (o.method != "stylit" && o.method != "tcia")
-    throw ValueError(concat("unknown --method '", o.method, "' (choose stylit, tcia, lazyfluids or fluidymation)"));
+    throw ValueError(o.method == "rigid" ? std::string(kRigidElsewhere)
+                                         : concat("unknown --method '", o.method,
+                                                  "' (choose stylit, tcia, lazyfluids, fluidymation or rigid)"));
   if (o.method == "stylit") {
     if (!o.keys.empty() || o.segment || !o.tcia_flags.empty() || !o.layers.empty() || o.layer_order)
       throw ValueError(concat(!o.keys.empty()         ? "--key"
@@ -444,6 +454,8 @@ int interrupted_segments() {
 int run_stylize(const Args& args) {
   if (wants_lazyfluids(args)) return run_lazyfluids(args);
   if (wants_fluidymation(args)) return run_stylize_fluidymation(args);
+  for (std::size_t i = 0; i + 1 < args.size(); ++i)  // before its options are taken for stylit's
+    if (args[i] == "--method" && args[i + 1] == "rigid") throw ValueError(kRigidElsewhere);
   if (ArgReader(args, "stylize").wants_help() || args.empty()) {
     std::cout << stylize_help();
     return args.empty() ? 2 : 0;

@@ -69,3 +69,47 @@ def test_bad_input_is_named(inputs, capsys):
     assert "no rigid-body tracks" in capsys.readouterr().err
     assert _run(inputs, "--object", "Nope") == 2
     assert "no object 'Nope'" in capsys.readouterr().err
+
+
+def _stylize(inputs, *extra):
+    return main(["stylize", "--method", "rigid", "--guides", str(inputs / "cache"), "--exemplar", str(inputs / "ex"),
+                 "--out", str(inputs / "out"), *extra])
+
+
+def test_stylize_method_rigid_is_the_same_run(inputs, capsys):
+    """`tempera stylize --method rigid` runs tempera rigid's job: the same
+    frames, the same resume record (a rigid run after it keeps them all)."""
+    assert _stylize(inputs, "--k", "2", "--frames", "3-6") == 0
+    assert sorted(p.name for p in (inputs / "out").glob("frame_*.png")) == [f"frame_{f:04d}.png" for f in range(3, 7)]
+    assert "4 frames written" in capsys.readouterr().out
+    assert _run(inputs, "--k", "2") == 0
+    assert "20 frames written, 4 kept" in capsys.readouterr().out
+    first = _native.read_image(str(inputs / "out" / "frame_0004.png"), None)
+    (inputs / "out" / "frame_0004.png").unlink()
+    assert main(["stylize", "--method=rigid", "--guides", str(inputs / "cache"), "--exemplar", str(inputs / "ex"),
+                 "--out", str(inputs / "out"), "--k", "2"]) == 0
+    assert "1 frames written, 23 kept" in capsys.readouterr().out
+    np.testing.assert_array_equal(_native.read_image(str(inputs / "out" / "frame_0004.png"), None), first)
+
+
+def test_stylize_method_rigid_bad_input_exits_2(inputs, capsys):
+    assert _stylize(inputs, "--frames", "20-40") == 2
+    assert "frame 25 is outside the tracked frames 1-24" in capsys.readouterr().err
+    assert _stylize(inputs, "--frames", "x") == 2
+    assert "cannot read 'x'" in capsys.readouterr().err
+    assert _stylize(inputs, "--lambda-dir", "-1") == 2
+    assert "lambda dir must be in [0," in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exit_:  # argparse: a missing --guides
+        main(["stylize", "--method", "rigid", "--exemplar", str(inputs / "ex"), "--out", str(inputs / "out")])
+    assert exit_.value.code == 2 and "--cache/--guides" in capsys.readouterr().err
+    assert not list((inputs / "out").glob("frame_*.png"))
+
+
+def test_native_cli_names_where_rigid_runs(cli_path, inputs):
+    """The native CLI alone (no Python package in front) cannot run the
+    method: it says where it runs, with exit 2, before reading options."""
+    import subprocess
+
+    result = subprocess.run([str(cli_path), "stylize", "--method", "rigid", "--guides", str(inputs / "cache"),
+                             "--k", "2"], capture_output=True, text=True)
+    assert result.returncode == 2 and "python -m tempera stylize --method rigid" in result.stderr

@@ -96,6 +96,34 @@ def test_cancel_writes_nothing_of_the_step_and_resume_equals_uninterrupted(examp
                                       tempera.read_image(str(whole.output_path(f))))
 
 
+def test_strokes_are_resynthesized_cancellable_and_part_of_the_settings(examples, cache, tmp_path):
+    """With a stroke exemplar the layers take its look; Esc while the strokes
+    are re-made writes nothing of the step; plain and stroked runs are
+    different settings (each redoes the other's files)."""
+    from tempera import rigid_strokes
+
+    out = tmp_path / "out"
+    plain = RigidJob(cache, examples, out, [6, 7], objects=["Near"])
+    assert _run(plain) == ["stylized", "composited"]
+    stroked = RigidJob(cache, examples, out, [6, 7], objects=["Near"], strokes="generated")
+    calls = []
+
+    def esc_in_the_strokes(fraction):  # the first two calls are the two frames' drawing
+        calls.append(fraction)
+        return len(calls) <= 2
+
+    with pytest.raises(tempera.Cancelled):
+        stroked.run_step(0, esc_in_the_strokes)
+    assert len(calls) == 3
+    assert not (out / "layers" / "Near").exists() or not list((out / "layers" / "Near").iterdir())
+    assert _run(RigidJob(cache, examples, out, [6, 7], objects=["Near"], strokes="generated")) == [
+        "stylized", "composited"]
+    layer = tempera.read_image(str(stroked.layer_path("Near", 6)))
+    ink = layer[:, :, 3] > 0.5
+    assert ink.sum() > 20 and np.abs(layer[ink, :3].mean(0) - rigid_strokes.STROKE_COLOUR).max() < 0.05
+    assert _run(RigidJob(cache, examples, out, [6, 7], objects=["Near"])) == ["stylized", "composited"]
+
+
 def test_bad_input_is_named(examples, cache, tmp_path):
     with pytest.raises(FileNotFoundError, match="examples folder"):
         exemplar_folders(tmp_path / "nowhere")

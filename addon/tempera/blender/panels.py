@@ -173,12 +173,21 @@ def draw_noise(box, settings):
 
 
 def draw_rigid(box, settings):
-    """The rigid-body method: the drawn examples, the targets, the result."""
+    """The rigid-body method: the drawn examples, the targets, the result,
+    the method's options (from its option table) and the strokes."""
     col = box.column()
     col.prop(settings, "rigid_examples")
     col.prop(settings, "rigid_collection")
     col.prop(settings, "rigid_shape")
     col.prop(settings, "rigid_output")
+    col.prop(settings, "rigid_k")
+    col.prop(settings, "rigid_augment")
+    col.prop(settings, "rigid_damp")
+    col.prop(settings, "rigid_strokes")
+    if settings.rigid_strokes == "IMAGE":
+        col.prop(settings, "rigid_stroke_image")
+    if settings.rigid_strokes != "NONE":
+        wide_prop(col, settings, "rigid_stroke_weight")
 
 
 def draw_media_exemplar(box, settings):

@@ -360,6 +360,12 @@ class CoherentRun(StylizeRun):
 RIGID_DIR = "rigid"  # the rigid-body method's folder in the Output Folder
 
 
+def rigid_options(settings):
+    """The panel's RigidOptions keywords (names of the method's option table)."""
+    return {"k": int(settings.rigid_k), "augment": bool(settings.rigid_augment), "damp": bool(settings.rigid_damp),
+            "stroke_weight": float(settings.rigid_stroke_weight)}
+
+
 class RigidRun(StylizeRun):
     """Guides of every frame, then the rigid-body method (RigidJob), a step
     per object and chunk of frames, then its composites."""
@@ -386,6 +392,17 @@ class RigidRun(StylizeRun):
         self.guides = GuideJob.from_settings(scene, self.frames)
         self.config = {"out": os.path.join(self.out, RIGID_DIR, FRAMES_DIR), "format": "png", "quality": "final"}
         self.shape, self.paper = settings.rigid_shape, settings.rigid_output == "PAPER"
+        self.options = rigid_options(settings)
+        self.strokes = None
+        if settings.rigid_strokes == "GENERATED":
+            from ..rigid_strokes import GENERATED
+
+            self.strokes = GENERATED
+        elif settings.rigid_strokes == "IMAGE":
+            from ..rigid_strokes import load_stroke_exemplar
+
+            self.strokes = resolve_path(settings.rigid_stroke_image, "rigid-body Stroke Image")
+            load_stroke_exemplar(self.strokes)  # a named error now, not after the guides
         self.noise = None
         self.job = None  # the RigidJob, made once the guides (and tracks.json) exist
         self.index = 0
@@ -399,7 +416,8 @@ class RigidRun(StylizeRun):
 
         if self.job is None:
             self.job = RigidJob(self.guides.folder, self.examples, os.path.join(self.out, RIGID_DIR), self.frames,
-                                objects=self.objects, shape=self.shape, paper=self.paper)
+                                objects=self.objects, shape=self.shape, paper=self.paper, strokes=self.strokes,
+                                **self.options)
         return self.job
 
     @property

@@ -86,6 +86,10 @@ struct RigidOptions {
   float fold_min_det = 0.05f; // least det J the fold guard allows
   int contact_fade = 3;       // frames over which the contact fix fades out
   bool overlap_blend = true;  // ramp across sub-sequence overlaps; false: a hard cut at their middle
+  // Stroke re-synthesis (§6 (iv), tempera.rigid_strokes, when a stroke
+  // exemplar is given): the stroke-position guide G = 1 - distance / d_max.
+  float stroke_d_max = 4;     // px
+  float stroke_weight = 4;    // the guide's weight in the engine's patch distance
 };
 
 inline const auto& rigid_option_table() {
@@ -108,7 +112,11 @@ inline const auto& rigid_option_table() {
       field(&R::contact_fade, "contact_fade", "contact-fade",
             "frames over which the contact fix fades out around an event (3)", 0, 100),
       field(&R::overlap_blend, "overlap_blend", "overlap-blend",
-            "blend overlapping sub-sequences with a linear ramp (off: a hard cut at the overlap's middle)"));
+            "blend overlapping sub-sequences with a linear ramp (off: a hard cut at the overlap's middle)"),
+      field(&R::stroke_d_max, "stroke_d_max", "stroke-d-max",
+            "stroke re-synthesis: reach in px of the stroke-position guide 1 - distance / d_max (4)", 0.5, 64),
+      field(&R::stroke_weight, "stroke_weight", "stroke-weight",
+            "stroke re-synthesis: weight of the stroke-position guide; 0 = unguided texture (4)", 0, 1e3));
   return table;
 }
 
