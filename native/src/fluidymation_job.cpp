@@ -18,7 +18,9 @@ namespace fs = std::filesystem;
 namespace tempera {
 namespace {
 
-constexpr const char* kRecordFormat = "tempera-fluidymation-frame 1";
+// 2: frames made since flows from masks keep a symmetric window at the shot's ends and
+// fractional exemplar times vote blended (earlier records are recomputed once).
+constexpr const char* kRecordFormat = "tempera-fluidymation-frame 2";
 
 bool is_image_file(const fs::path& p) {
   std::string ext = p.extension().string();
