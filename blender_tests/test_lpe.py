@@ -571,3 +571,27 @@ def test_light_units():
             assert (exported["size_u"], exported["size_v"]) == (2.0, 1.0)
             np.testing.assert_allclose(exported["radiance"], [50 / (normalisation * 2.0)] * 3, rtol=1e-6)
             np.testing.assert_allclose(exported["normal"], [0, 0, -1])  # Blender's area lights face -Z
+
+
+def test_soft_lights_follow_this_cycles():
+    """A point or spot light with a radius is the disk facing the shaded point
+    in Cycles 3.x and in 4.x with Soft Falloff on, a sphere in 4.x with it
+    off; only 3.x weights spots by the cosine to their axis."""
+    from tempera.blender.scene_export import _light
+
+    cycles4 = bpy.app.version >= (4, 0, 0)  # an oracle independent of compat's feature test
+    light = bpy.data.lights.new("LPE soft spot", "SPOT")
+    light.shadow_soft_size = 0.5
+    obj = bpy.data.objects.new("LPE soft spot", light)
+    try:
+        shapes = []
+        for soft in (True, False):
+            if cycles4:
+                light.use_soft_falloff = soft
+            exported = _light(obj, np.eye(4), [])
+            shapes.append(exported["soft_shape"])
+            assert exported["spot_axis_cosine"] == (not cycles4)
+    finally:
+        bpy.data.objects.remove(obj)
+        bpy.data.lights.remove(light)
+    assert shapes == (["disk", "sphere"] if cycles4 else ["disk", "disk"])
