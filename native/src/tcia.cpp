@@ -8,6 +8,7 @@
 #include "tempera/motion.hpp"
 #include "tempera/rng.hpp"
 #include "tempera/solver.hpp"
+#include "tempera/tcia_ribbons.hpp"
 
 namespace tempera {
 
@@ -70,6 +71,9 @@ void validate(const Shot& shot, const TciaOptions& o) {
       if (v->channels != 2) throw ValueError(concat("frame ", t, ": velocities must have 2 channels"));
     for (const ImageView* v : {&f.occlusion_backward, &f.occlusion_forward})
       if (v->channels != 1) throw ValueError(concat("frame ", t, ": occlusions must have 1 channel"));
+    if (f.orientation.empty() != shot.style_orientation.empty())
+      throw ValueError(concat("frame ", t, shot.style_orientation.empty() ? " has an orientation but the style has none"
+                                                                         : " has no orientation but the style has one"));
   }
   int last = -1;
   for (const ShotKey& k : shot.keys) {
@@ -93,7 +97,9 @@ struct FrameState {
 
 class Sweeper {
  public:
-  Sweeper(const Shot& shot, const TciaOptions& o) : shot_(shot), o_(o) {}
+  Sweeper(const Shot& shot, const TciaOptions& o) : shot_(shot), o_(o) {
+    if (o.ribbons && !shot.keys.empty()) ribbons_ = trace_ribbons(shot);
+  }
 
   std::vector<Image> run(const SweepCallback& progress) {
     const int frames = int(shot_.frames.size());
@@ -128,6 +134,8 @@ class Sweeper {
     placeholder_ = Image(sized.width, sized.height, shot_.style.channels);
     SynthesisInput in;
     in.style = shot_.style;
+    in.source_orientation = shot_.style_orientation;
+    in.target_orientation = f.orientation;
     for (std::size_t g = 0; g < shot_.style_guides.size(); ++g)
       in.guides.add(shot_.guide_names[g], shot_.style_guides[g], f.guides[g], shot_.guide_weights[g]);
     if (in.guides.empty()) {
@@ -144,14 +152,16 @@ class Sweeper {
     // padded by the patch margin (edge pixels repeated, not copyable), so
     // that its border pixels can be patch centres: in-betweens can then copy
     // a key right up to the frame's edge.
-    const int m = o_.synthesis.patch_size / 2;
+    const int m = key_padding();
     keys_.clear();
     keys_.reserve(shot_.keys.size());
     for (std::size_t k = 0; k < shot_.keys.size(); ++k) {
       const ShotKey& key = shot_.keys[k];
       PaddedKey& pk = keys_.emplace_back();
       pk.painting = pad(key.painting, m);
-      for (const ImageView& g : shot_.frames[std::size_t(key.frame)].guides) pk.guides.push_back(pad(g, m));
+      const ShotFrame& kf = shot_.frames[std::size_t(key.frame)];
+      for (const ImageView& g : kf.guides) pk.guides.push_back(pad(g, m));
+      if (!kf.orientation.empty()) pk.orientation = pad(kf.orientation, m);
       pk.mask = Image(pk.painting.width(), pk.painting.height(), 1);
       for (int y = 0; y < key.painting.height; ++y)
         for (int x = 0; x < key.painting.width; ++x)
@@ -161,6 +171,7 @@ class Sweeper {
       for (const Image& g : pk.guides) e.guides.push_back(g.view());
       if (temporal && o_.temporal_weight > 0) e.guides.push_back(pk.painting.view());
       e.mask = pk.mask.view();
+      if (!pk.orientation.empty()) e.orientation = pk.orientation.view();
       in.exemplars.push_back(e);
       if (key.frame == t) {
         key_mask_ = key.mask.empty() ? Image(key.painting.width, key.painting.height, 1, 1.0f) : Image::copy_of(key.mask);
@@ -177,6 +188,14 @@ class Sweeper {
     SynthesisOptions opt = o_.synthesis;
     opt.seed = mix64(o_.synthesis.seed ^ mix64(std::uint64_t(t) + 0x7C1Aull));
     return std::make_unique<Solver>(in, opt);
+  }
+
+  // The keys' border: the patch radius, or with orientations the radius of a
+  // patch turned 45 degrees (PatchSpace::source_margin), so that every key
+  // pixel can be a patch centre.
+  int key_padding() const {
+    const int r = o_.synthesis.patch_size / 2;
+    return shot_.style_orientation.empty() ? r : int(std::ceil(r * 1.41421356f)) + 1;
   }
 
   // Frame t's V (backward for forward sweeps, minus V+ for backward ones, so
@@ -238,6 +257,11 @@ class Sweeper {
     } else if (own) {
       start.field = &*own;
     }
+    CandidateList ribbons;
+    if (!ribbons_.empty()) {
+      ribbons = ribbon_candidates(ribbons_[std::size_t(t)], *solver, l, key_padding());
+      start.candidates = &ribbons;
+    }
     if (neighbour_in_sweep && o_.temporal_weight > 0)
       start.guide_targets.emplace_back(int(shot_.style_guides.size()), &temporal_target);
     LevelResult r = solver->solve_level(l, start);
@@ -247,10 +271,11 @@ class Sweeper {
 
   const Shot& shot_;
   const TciaOptions& o_;
+  std::vector<FrameRibbons> ribbons_;  // per frame; empty without keys or with ribbons off
   mutable Image placeholder_;  // full-size stand-in target of the temporal guide
   mutable Image key_mask_, key_matches_;  // the fixed pixels of a key frame
   struct PaddedKey {
-    Image painting, mask;
+    Image painting, mask, orientation;
     std::vector<Image> guides;
   };
   mutable std::vector<PaddedKey> keys_;  // the keys as exemplars of the solver being built
