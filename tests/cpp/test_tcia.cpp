@@ -51,7 +51,7 @@ struct TranslatingShot {
     shot.guide_weights = {4.0f};
     for (int t = 0; t < frames; ++t)
       shot.frames.push_back({{guides[t].view()}, v_minus[t].view(), v_plus[t].view(), chi_minus[t].view(),
-                             chi_plus[t].view()});
+                             chi_plus[t].view(), {}});
   }
 
   double mean_flicker(const std::vector<Image>& out) const {

@@ -57,7 +57,7 @@ struct TurningHatching {
     shot.style_guides = {style_guide.view()};
     shot.guide_weights = {1.0f};
     for (int t = 0; t < frames; ++t)
-      shot.frames.push_back({{guides[t].view()}, v_minus[t].view(), v_plus[t].view(), chi[0].view(), chi[0].view()});
+      shot.frames.push_back({{guides[t].view()}, v_minus[t].view(), v_plus[t].view(), chi[0].view(), chi[0].view(), {}});
   }
 
   void orient() {

@@ -72,6 +72,9 @@ struct TciaOptions {
   // Ribbons (§4.1): each pixel's surface point in the previous and next key,
   // followed along the motion, tried as PatchMatch candidates at every visit.
   bool ribbons = true;
+  // w_∂in of eq. 10 (tcia_derivative.hpp), times each guide's weight, with
+  // keys only: the in-betweens change the way the input does.
+  float derivative_weight = 0.0f;
   SynthesisOptions synthesis;      // tcia_defaults()
 };
 
@@ -86,7 +89,10 @@ inline const auto& tcia_option_table() {
             1e6),
       field(&T::sweep_pairs, "sweep_pairs", "sweeps", "forward+backward sweep pairs per level (1)", 1, 100),
       field(&T::ribbons, "ribbons", "ribbons",
-            "try each pixel's surface point in the previous and next key, followed along the motion (on)"));
+            "try each pixel's surface point in the previous and next key, followed along the motion (on)"),
+      field(&T::derivative_weight, "derivative_weight", "derivative",
+            "w_din (eq. 10), with keys: in-betweens change as the input does, times each guide's weight; 1 typical",
+            0, 1e6));
   return table;
 }
 
