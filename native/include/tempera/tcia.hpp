@@ -17,8 +17,9 @@
 // and "warps, not blends": each pixel copies its source pixel (output
 // centre). Painted keys (§4.1) are hard constraints and extra exemplars, and
 // the random merge leans toward the nearer key. Ribbons (tcia_ribbons.hpp) give
-// every visit the pixels of the neighbouring keys that the motion leads to.
-// The time-derivative terms (eq. 10) and layers are still to come (issue 12).
+// every visit the pixels of the neighbouring keys that the motion leads to;
+// eq. 10's input time-derivative term (tcia_derivative.hpp) is an option;
+// orientation fields turn the patches. Layers are still to come (issue 12).
 #include <cstdint>
 #include <functional>
 #include <string>
