@@ -92,7 +92,7 @@ inline const auto& tcia_option_table() {
       field(&T::ribbons, "ribbons", "ribbons",
             "try each pixel's surface point in the previous and next key, followed along the motion (on)"),
       field(&T::derivative_weight, "derivative_weight", "derivative",
-            "w_din (eq. 10), with keys: in-betweens change as the input does, times each guide's weight; 1 typical",
+            "w_din (eq. 10), with keys: in-betweens change as the input does, times each guide's weight; 0 = off (see coherent.md)",
             0, 1e6));
   return table;
 }
