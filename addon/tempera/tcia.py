@@ -24,7 +24,7 @@ TciaOptions = _native.TciaOptions
 
 def options(**values) -> "TciaOptions":
     """TciaOptions from keywords: its own (temporal_weight, coherence_weight,
-    coherence_max, sweep_pairs) and engine options (SynthesisOptions names,
+    coherence_max, sweep_pairs, ribbons, derivative_weight) and engine options (SynthesisOptions names,
     from the method's defaults: 9 x 9 Gaussian window, centre output,
     histogram usage, automatic levels)."""
     return method_options(TciaOptions, _native.tcia_defaults(), values, "coherent-method")
@@ -35,20 +35,25 @@ def _image(a):
     return a[:, :, None] if a.ndim == 2 else a
 
 
-def stylize_shot(style, guides, frames, *, keys=(), progress=None, **values):
+def stylize_shot(style, guides, frames, *, keys=(), progress=None, style_orientation=None, **values):
     """The stylized frames of a shot.
 
     style   the painting Ŝ, (H, W, C)
     guides  [(name, exemplar guide S (H, W, c), weight), ...]
     frames  per frame a dict: guides (the frame's B_g in the same order),
             velocity_backward, velocity_forward ((h, w, 2), pixels, x right,
-            y down), occlusion_backward, occlusion_forward ((h, w) χ−, χ+)
+            y down), occlusion_backward, occlusion_forward ((h, w) χ−, χ+),
+            optionally orientation ((h, w) radians, the edge direction: a
+            structure tensor's angle or the artist's AOV)
+    style_orientation  O(S) (H, W) radians; with the frames' orientations,
+            patches are compared rotated, so hatching follows the frames' field
     keys    painted keyframes [(frame index, painting (h, w, C)[, mask (h, w)]), ...]
             in frame order: each comes out as painted and steers its neighbours
     """
     g, f, k = _frames_and_keys(guides, frames, keys)
     report = None if progress is None else (lambda x: progress(x) is not False)
-    return _native.stylize_shot(_image(style), g, f, k, options(**values), report)
+    o = None if style_orientation is None else _image(style_orientation)
+    return _native.stylize_shot(_image(style), g, f, k, options(**values), report, o)
 
 
 def _frames_and_keys(guides, frames, keys):

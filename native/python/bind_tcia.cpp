@@ -56,7 +56,7 @@ TciaJobConfig job_config(const py::dict& d, const TciaOptions& options) {
 
 // The Shot of tempera.tcia.stylize_shot's arguments; its views point into `keep`.
 Shot shot_from(const FloatArray& style, const py::list& guides, const py::list& frames, const py::list& keys,
-               std::vector<FloatArray>& keep) {
+               const py::object& style_orientation, std::vector<FloatArray>& keep) {
   Shot shot;
   shot.style = py_bridge::view_of(style, "style");
   for (const auto& g : guides) {
@@ -65,6 +65,7 @@ Shot shot_from(const FloatArray& style, const py::list& guides, const py::list& 
     shot.style_guides.push_back(keep_view(t[1], "exemplar guide '" + shot.guide_names.back() + "'", keep));
     shot.guide_weights.push_back(t[2].cast<float>());
   }
+  if (!style_orientation.is_none()) shot.style_orientation = keep_view(style_orientation, "style orientation", keep);
   std::size_t k = 0;
   for (const auto& item : frames) {
     const py::dict d = item.cast<py::dict>();
@@ -77,6 +78,7 @@ Shot shot_from(const FloatArray& style, const py::list& guides, const py::list& 
     f.velocity_forward = keep_view(d["velocity_forward"], what + " velocity_forward", keep);
     f.occlusion_backward = keep_view(d["occlusion_backward"], what + " occlusion_backward", keep);
     f.occlusion_forward = keep_view(d["occlusion_forward"], what + " occlusion_forward", keep);
+    if (d.contains("orientation")) f.orientation = keep_view(d["orientation"], what + " orientation", keep);
     shot.frames.push_back(std::move(f));
   }
   for (const auto& item : keys) {
@@ -147,9 +149,9 @@ void bind_tcia(py::module_& m) {
   m.def(
       "stylize_shot",
       [](const FloatArray& style, const py::list& guides, const py::list& frames, const py::list& keys,
-         const TciaOptions& options, const std::function<bool(double)>& progress) {
+         const TciaOptions& options, const std::function<bool(double)>& progress, const py::object& style_orientation) {
         std::vector<FloatArray> keep;
-        const Shot shot = shot_from(style, guides, frames, keys, keep);
+        const Shot shot = shot_from(style, guides, frames, keys, style_orientation, keep);
         ProgressCallback callback = py_bridge::with_gil([&](double f) { return progress ? progress(f) : true; });
         std::vector<Image> out;
         {
@@ -161,7 +163,7 @@ void bind_tcia(py::module_& m) {
         return result;
       },
       py::arg("style"), py::arg("guides"), py::arg("frames"), py::arg("keys"), py::arg("options"),
-      py::arg("progress") = nullptr,
+      py::arg("progress") = nullptr, py::arg("style_orientation") = py::none(),
       "A whole shot with Bénard et al. 2013's sweeps; use tempera.tcia.stylize_shot.");
   m.def(
       "stylize_shot_layers",
@@ -169,7 +171,7 @@ void bind_tcia(py::module_& m) {
          const py::list& layers, bool extrapolate, const TciaOptions& options,
          const std::function<bool(double)>& progress) {
         std::vector<FloatArray> keep;
-        const Shot shot = shot_from(style, guides, frames, keys, keep);
+        const Shot shot = shot_from(style, guides, frames, keys, py::none(), keep);
         std::vector<ShotLayer> spec;
         for (const auto& item : layers) {
           const auto t = item.cast<py::tuple>();

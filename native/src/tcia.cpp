@@ -8,6 +8,8 @@
 #include "tempera/motion.hpp"
 #include "tempera/rng.hpp"
 #include "tempera/solver.hpp"
+#include "tempera/tcia_derivative.hpp"
+#include "tempera/tcia_ribbons.hpp"
 
 namespace tempera {
 
@@ -70,6 +72,9 @@ void validate(const Shot& shot, const TciaOptions& o) {
       if (v->channels != 2) throw ValueError(concat("frame ", t, ": velocities must have 2 channels"));
     for (const ImageView* v : {&f.occlusion_backward, &f.occlusion_forward})
       if (v->channels != 1) throw ValueError(concat("frame ", t, ": occlusions must have 1 channel"));
+    if (f.orientation.empty() != shot.style_orientation.empty())
+      throw ValueError(concat("frame ", t, shot.style_orientation.empty() ? " has an orientation but the style has none"
+                                                                         : " has no orientation but the style has one"));
   }
   int last = -1;
   for (const ShotKey& k : shot.keys) {
@@ -93,7 +98,9 @@ struct FrameState {
 
 class Sweeper {
  public:
-  Sweeper(const Shot& shot, const TciaOptions& o) : shot_(shot), o_(o) {}
+  Sweeper(const Shot& shot, const TciaOptions& o) : shot_(shot), o_(o) {
+    if (o.ribbons && !shot.keys.empty()) ribbons_ = trace_ribbons(shot);
+  }
 
   std::vector<Image> run(const SweepCallback& progress) {
     const int frames = int(shot_.frames.size());
@@ -129,6 +136,8 @@ class Sweeper {
     SynthesisInput in;
     in.style = shot_.style;
     in.source_mask = shot_.style_mask;
+    in.source_orientation = shot_.style_orientation;
+    in.target_orientation = f.orientation;
     for (std::size_t g = 0; g < shot_.style_guides.size(); ++g)
       in.guides.add(shot_.guide_names[g], shot_.style_guides[g], f.guides[g], shot_.guide_weights[g]);
     if (in.guides.empty()) {
@@ -140,19 +149,32 @@ class Sweeper {
       in.guides.add("temporal", shot_.style, placeholder_.view(), o_.temporal_weight);
       in.target_weight_maps.push_back(direction > 0 ? f.occlusion_backward : f.occlusion_forward);
     }
+    if (temporal && derivative()) {
+      in.target_weight_maps.resize(in.guides.layers().size());
+      derivative_placeholders_.clear();
+      derivative_placeholders_.reserve(shot_.style_guides.size());
+      for (std::size_t g = 0; g < shot_.style_guides.size(); ++g) {
+        const Image& target = derivative_placeholders_.emplace_back(sized.width, sized.height, f.guides[g].channels);
+        in.guides.add("derivative_" + shot_.guide_names[g], shot_.style_guides[g], target.view(),
+                      o_.derivative_weight * shot_.guide_weights[g]);
+        in.target_weight_maps.push_back(direction > 0 ? f.occlusion_backward : f.occlusion_forward);
+      }
+    }
     // Keys: extra exemplars (the painting over its frame's guides) and, at
     // their own frame, the painted pixels fixed to the painting. A key is
     // padded by the patch margin (edge pixels repeated, not copyable), so
     // that its border pixels can be patch centres: in-betweens can then copy
     // a key right up to the frame's edge.
-    const int m = o_.synthesis.patch_size / 2;
+    const int m = key_padding();
     keys_.clear();
     keys_.reserve(shot_.keys.size());
     for (std::size_t k = 0; k < shot_.keys.size(); ++k) {
       const ShotKey& key = shot_.keys[k];
       PaddedKey& pk = keys_.emplace_back();
       pk.painting = pad(key.painting, m);
-      for (const ImageView& g : shot_.frames[std::size_t(key.frame)].guides) pk.guides.push_back(pad(g, m));
+      const ShotFrame& kf = shot_.frames[std::size_t(key.frame)];
+      for (const ImageView& g : kf.guides) pk.guides.push_back(pad(g, m));
+      if (!kf.orientation.empty()) pk.orientation = pad(kf.orientation, m);
       pk.mask = Image(pk.painting.width(), pk.painting.height(), 1);
       for (int y = 0; y < key.painting.height; ++y)
         for (int x = 0; x < key.painting.width; ++x)
@@ -161,7 +183,10 @@ class Sweeper {
       e.style = pk.painting.view();
       for (const Image& g : pk.guides) e.guides.push_back(g.view());
       if (temporal && o_.temporal_weight > 0) e.guides.push_back(pk.painting.view());
+      if (temporal && derivative())
+        for (const Image& g : pk.guides) e.guides.push_back(g.view());
       e.mask = pk.mask.view();
+      if (!pk.orientation.empty()) e.orientation = pk.orientation.view();
       in.exemplars.push_back(e);
       if (key.frame == t) {
         key_mask_ = key.mask.empty() ? Image(key.painting.width, key.painting.height, 1, 1.0f) : Image::copy_of(key.mask);
@@ -178,6 +203,35 @@ class Sweeper {
     SynthesisOptions opt = o_.synthesis;
     opt.seed = mix64(o_.synthesis.seed ^ mix64(std::uint64_t(t) + 0x7C1Aull));
     return std::make_unique<Solver>(in, opt);
+  }
+
+  // The keys' border: the patch radius, or with orientations the radius of a
+  // patch turned 45 degrees (PatchSpace::source_margin), so that every key
+  // pixel can be a patch centre.
+  int key_padding() const {
+    const int r = o_.synthesis.patch_size / 2;
+    return shot_.style_orientation.empty() ? r : int(std::ceil(r * 1.41421356f)) + 1;
+  }
+
+  // Eq. 10 (tcia_derivative.hpp): with keys and a derivative weight.
+  bool derivative() const {
+    return o_.derivative_weight > 0 && !shot_.keys.empty() && !shot_.style_guides.empty();
+  }
+
+  // Eq. 10's target per guide layer for frame t at level l, from the
+  // neighbour frame `from` (solved, with `field`) and the level's V.
+  std::vector<Image> level_derivative_targets(const Solver& solver, int l, int t, int from, const OffsetField& field,
+                                              const Image& v) const {
+    const int w = v.width(), h = v.height();
+    std::vector<Image> out;
+    for (std::size_t g = 0; g < shot_.style_guides.size(); ++g) {
+      std::vector<ImageView> exemplar_guides{shot_.style_guides[g]};
+      for (const PaddedKey& k : keys_) exemplar_guides.push_back(k.guides[g].view());
+      out.push_back(derivative_target(pick_resize(shot_.frames[std::size_t(t)].guides[g], w, h),
+                                      pick_resize(shot_.frames[std::size_t(from)].guides[g], w, h),
+                                      matched_guide(solver, l, field, exemplar_guides), v.view()));
+    }
+    return out;
   }
 
   // Frame t's V (backward for forward sweeps, minus V+ for backward ones, so
@@ -208,8 +262,10 @@ class Sweeper {
     else if (!coarse.empty() && coarse[std::size_t(t)].field) own = solver->resample(*coarse[std::size_t(t)].field, l + 1, l);
     std::optional<OffsetField> advected;
     Image visible, temporal_target;
+    Image v_level;
     if (neighbour_in_sweep) {
-      const Image v = level_velocity(t, direction, w, h);
+      v_level = level_velocity(t, direction, w, h);
+      const Image& v = v_level;
       visible = level_visibility(t, direction, w, h);
       advected = solver->advect(*here[std::size_t(from)].field, l, v.view());
       temporal_target = warp_backward(here[std::size_t(from)].image.view(), v.view());
@@ -239,8 +295,20 @@ class Sweeper {
     } else if (own) {
       start.field = &*own;
     }
+    CandidateList ribbons;
+    if (!ribbons_.empty()) {
+      ribbons = ribbon_candidates(ribbons_[std::size_t(t)], *solver, l, key_padding());
+      start.candidates = &ribbons;
+    }
     if (neighbour_in_sweep && o_.temporal_weight > 0)
       start.guide_targets.emplace_back(int(shot_.style_guides.size()), &temporal_target);
+    std::vector<Image> derivative_targets;
+    if (neighbour_in_sweep && derivative()) {
+      const int first = int(shot_.style_guides.size()) + (o_.temporal_weight > 0 ? 1 : 0);
+      derivative_targets = level_derivative_targets(*solver, l, t, from, *here[std::size_t(from)].field, v_level);
+      for (std::size_t g = 0; g < derivative_targets.size(); ++g)
+        start.guide_targets.emplace_back(first + int(g), &derivative_targets[g]);
+    }
     LevelResult r = solver->solve_level(l, start);
     state.field = std::move(r.field);
     state.image = std::move(r.image);
@@ -248,10 +316,12 @@ class Sweeper {
 
   const Shot& shot_;
   const TciaOptions& o_;
+  std::vector<FrameRibbons> ribbons_;  // per frame; empty without keys or with ribbons off
   mutable Image placeholder_;  // full-size stand-in target of the temporal guide
+  mutable std::vector<Image> derivative_placeholders_;  // and of eq. 10's, per guide layer
   mutable Image key_mask_, key_matches_;  // the fixed pixels of a key frame
   struct PaddedKey {
-    Image painting, mask;
+    Image painting, mask, orientation;
     std::vector<Image> guides;
   };
   mutable std::vector<PaddedKey> keys_;  // the keys as exemplars of the solver being built

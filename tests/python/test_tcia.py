@@ -52,6 +52,18 @@ def test_cancel_and_bad_options():
         tcia.stylize_shot(style, guides, bad)
 
 
+def test_orientation_fields_reach_the_method():
+    style, guides, frames = shot(frames=2)
+    turned = [dict(f, orientation=np.full((32, 48), 0.5, np.float32)) for f in frames]
+    with pytest.raises(ValueError, match="the style has none"):
+        tcia.stylize_shot(style, guides, turned, levels=2, patch_size=7)
+    flat = tcia.stylize_shot(style, guides, frames, levels=2, patch_size=7, threads=2)
+    out = tcia.stylize_shot(style, guides, turned, levels=2, patch_size=7, threads=2,
+                            style_orientation=np.zeros((48, 64), np.float32))
+    assert out[0].shape == (32, 48, 3)
+    assert not np.array_equal(out[0], flat[0])  # patches compared turned by 0.5 rad
+
+
 def test_a_key_comes_out_as_painted():
     style, guides, frames = shot(frames=4)
     painting = np.random.default_rng(5).random((32, 48, 3)).astype(np.float32)

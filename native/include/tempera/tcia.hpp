@@ -16,8 +16,10 @@
 //  - spatial coherence (eq. 5) and the usage histogram (eq. 8);
 // and "warps, not blends": each pixel copies its source pixel (output
 // centre). Painted keys (§4.1) are hard constraints and extra exemplars, and
-// the random merge leans toward the nearer key. Lines (eq. 9), ribbons, the
-// time-derivative terms (eq. 10) and layers are still to come (issue 12).
+// the random merge leans toward the nearer key. Ribbons (tcia_ribbons.hpp) give
+// every visit the pixels of the neighbouring keys that the motion leads to;
+// eq. 10's input time-derivative term (tcia_derivative.hpp) is an option;
+// orientation fields turn the patches. Layers (tcia_layers.hpp) solve each part apart.
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -33,6 +35,11 @@ struct ShotFrame {
   std::vector<ImageView> guides;                   // B_g per guide layer, in the exemplar's order
   ImageView velocity_backward, velocity_forward;   // V-, V+: 2 channels, pixels, x right, y down
   ImageView occlusion_backward, occlusion_forward; // χ-, χ+: 1 channel, 1 = visible in the neighbour frame
+  // O(I_t) (§3.1), optional: 1 channel, radians, the edge direction
+  // (orientation.hpp): the tensor's angle or the artist's AOV. With the
+  // style's orientation too, patches are compared rotated by the smallest
+  // angle between the two, so hatching follows the frame's field.
+  ImageView orientation;
 };
 
 // A painted keyframe (§4.1): the frame's painting, optionally only where
@@ -50,6 +57,7 @@ struct Shot {
   std::vector<std::string> guide_names;
   std::vector<ImageView> style_guides;  // S per guide layer
   std::vector<float> guide_weights;     // w_in per guide layer
+  ImageView style_orientation;          // O(S), optional (see ShotFrame::orientation)
   std::vector<ShotFrame> frames;
   std::vector<ShotKey> keys;            // in frame order
 };
@@ -63,6 +71,12 @@ struct TciaOptions {
   float coherence_weight = 0.05f;  // w_sc per window pixel: "small" (§3.2)
   float coherence_max = 3.0f;      // r_max in pixels (the paper gives none)
   int sweep_pairs = 1;             // forward + backward sweeps per level (the paper: 1)
+  // Ribbons (§4.1): each pixel's surface point in the previous and next key,
+  // followed along the motion, tried as PatchMatch candidates at every visit.
+  bool ribbons = true;
+  // w_∂in of eq. 10 (tcia_derivative.hpp), times each guide's weight, with
+  // keys only: the in-betweens change the way the input does.
+  float derivative_weight = 0.0f;
   SynthesisOptions synthesis;      // tcia_defaults()
 };
 
@@ -75,7 +89,12 @@ inline const auto& tcia_option_table() {
             "w_sc: preference for large coherent pieces of the exemplar; 0.05 typical", 0, 1e6),
       field(&T::coherence_max, "coherence_max", "coherence-max", "r_max of spatial coherence, in pixels (3)", 0,
             1e6),
-      field(&T::sweep_pairs, "sweep_pairs", "sweeps", "forward+backward sweep pairs per level (1)", 1, 100));
+      field(&T::sweep_pairs, "sweep_pairs", "sweeps", "forward+backward sweep pairs per level (1)", 1, 100),
+      field(&T::ribbons, "ribbons", "ribbons",
+            "try each pixel's surface point in the previous and next key, followed along the motion (on)"),
+      field(&T::derivative_weight, "derivative_weight", "derivative",
+            "w_din (eq. 10), with keys: in-betweens change as the input does, times each guide's weight; 0 = off (see coherent.md)",
+            0, 1e6));
   return table;
 }
 
