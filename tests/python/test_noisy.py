@@ -84,18 +84,20 @@ def test_the_medium_is_kept(inputs):
     """Medium kept: the finest-level energy of a noisy frame (its patches'
     distance to the undeformed S) is at most 1.25x that of the same frame
     without noise, R, here a plain synthesis of S (so R is the engine's
-    best fit of S at that size, as a coherent pass makes it). Measured
-    (docs/noisy.md): 1.24 at f = 1.3, 1.22 at 2.2 and 3.1; 4.3 gives 1.29
-    and is not asserted. An unsolved finest level (1 EM x 1 PM) gives 1.46."""
+    best fit of S at that size, as a coherent pass makes it), as a mean over
+    8 frames. Measured (docs/noisy.md): 1.24, 1.22, 1.21, 1.21 at f = 1.3, 2.2, 3.1, 4.3; single
+    frames at f = 4.3 spread from 0.88 to 1.34, so 2 frames were not enough
+    to tell 4.3 from the bound. An unsolved finest level (1 EM x 1 PM) gives
+    1.44."""
     style, _ = inputs
     reference, _ = synthesis.synthesize(style, target_shape=(48, 64), patch_size=7, threads=2, seed=3)
     kept = patch_energy(reference, style)
 
     def ratio(f, **kw):
         return np.mean([patch_energy(noisy.noisy_frame(style, reference, i, noise=f, threads=2, **kw), style)
-                        for i in range(2)]) / kept
+                        for i in range(8)]) / kept
 
-    for f in (1.3, 2.2, 3.1):
+    for f in (1.3, 2.2, 3.1, 4.3):
         assert ratio(f) <= 1.25, f
     assert ratio(2.2, em_iterations=1, pm_iterations=1) > 1.25  # the test notices a finest level left unsolved
 
