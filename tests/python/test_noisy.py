@@ -42,7 +42,22 @@ def energy(frames):
 def test_noise_rises_with_the_width(sweep):
     e = {f: energy(frames) for f, frames in sweep.items()}
     assert e[1.3] < e[2.2] < e[3.1] < e[4.3]
-    assert e[4.3] >= 2 * e[1.3]  # measured 2.16 (docs/noisy.md)
+    assert e[4.3] >= 2 * e[1.3]  # measured 2.19 (docs/noisy.md)
+
+
+def test_noise_rises_over_all_eight_steps():
+    """Every step of the slider boils more: E rises strictly over all eight
+    tested widths, on a 128 x 96 R of a 192 x 192 medium (measured, 32
+    frames: 0.0233 ... 0.0475, E(4.3)/E(1.3) = 2.04 with seed 1; with seed 0
+    also strict, 2.28). At the 64 x 48 of the other tests it is not: the
+    coarse levels of f >= 2.6 hold too few patches (the 96 x 96 exemplar is
+    36 x 36 at the 7th level, for 7 x 7 patches), and E dips at 2.6."""
+    rng = np.random.default_rng(1)
+    style = medium(rng, 192, 192)
+    reference = np.ascontiguousarray(style[10:106, 12:140])
+    e = [energy(run((style, reference), f, frames=16)) for f in noisy.TESTED_NOISE]
+    assert all(a < b for a, b in zip(e, e[1:])), e
+    assert e[-1] >= 2 * e[0], e
 
 
 def test_noise_is_white(sweep):
