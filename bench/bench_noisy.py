@@ -4,7 +4,7 @@ and 1 Mpix, for the calm and the lively end of the slider (f = 2.2, 4.3).
 The paper: about 30 s per Mpix on one core of a 3.5 GHz Xeon (§4).
 
     PYTHONPATH=addon /usr/bin/python3 bench/bench_noisy.py --json docs/bench_noisy.json
-    PYTHONPATH=addon /usr/bin/python3 bench/bench_noisy.py --compare main --json docs/bench_noisy_compare.json
+    PYTHONPATH=addon /usr/bin/python3 bench/bench_noisy.py --compare main --json docs/bench_noisy.json
 
 With --compare REV it builds REV's native module in a temporary worktree
 (bench_synthesis.build_revision) and runs REV and this checkout on the same
