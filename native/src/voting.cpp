@@ -34,24 +34,53 @@ struct Voter {
   }
 };
 
-// Index of the candidate with the most similar neighbours (a kernel mode).
-std::size_t weighted_mode(const std::vector<float>& values, int c, std::size_t n) {
-  std::size_t best = 0;
-  float best_score = -1.0f;
-  const float inv = 1.0f / (kModeBandwidth * kModeBandwidth);
+// Index of the candidate with the most similar neighbours (a kernel mode):
+// score(j) = sum over k of exp(-|v_j - v_k|^2 / h^2), the first best wins.
+// This was the whole cost of a Color Me Noisy frame (93%: 49^2 kernels per
+// pixel), so it is computed without changing the answer:
+//  - equal colours (neighbouring patches of a coherent field copy the same
+//    source pixel) are scored once, with their count as weight;
+//  - each pair's kernel is evaluated once, for both ends;
+//  - a kernel below half a float step of 1 is skipped: every score starts at
+//    its own count (>= 1), so adding it could not change the sum.
+struct ModeScratch {
+  std::vector<float> unique, score;
+  std::vector<std::size_t> first, count;
+};
+
+std::size_t weighted_mode(const std::vector<float>& values, int c, std::size_t n, ModeScratch& m) {
+  m.unique.clear(), m.first.clear(), m.count.clear();
   for (std::size_t j = 0; j < n; ++j) {
-    float score = 0.0f;
-    for (std::size_t k = 0; k < n; ++k) {
+    const float* v = values.data() + j * c;
+    std::size_t u = 0;
+    while (u < m.first.size() && !std::equal(v, v + c, m.unique.data() + u * c)) ++u;
+    if (u == m.first.size()) {
+      m.unique.insert(m.unique.end(), v, v + c);
+      m.first.push_back(j);
+      m.count.push_back(0);
+    }
+    ++m.count[u];
+  }
+  const std::size_t u = m.first.size();
+  const float inv = 1.0f / (kModeBandwidth * kModeBandwidth);
+  constexpr float kNegligible = 17.5f;  // exp(-17.5) < 2^-25
+  m.score.assign(m.count.begin(), m.count.end());
+  for (std::size_t j = 0; j < u; ++j)
+    for (std::size_t k = j + 1; k < u; ++k) {
       float d = 0.0f;
       for (int ch = 0; ch < c; ++ch) {
-        const float e = values[j * c + ch] - values[k * c + ch];
+        const float e = m.unique[j * c + ch] - m.unique[k * c + ch];
         d += e * e;
       }
-      score += std::exp(-d * inv);
+      if (d * inv > kNegligible) continue;
+      const float kernel = std::exp(-d * inv);
+      m.score[j] += float(m.count[k]) * kernel;
+      m.score[k] += float(m.count[j]) * kernel;
     }
-    if (score > best_score) best_score = score, best = j;
-  }
-  return best;
+  std::size_t best = 0;  // in order of first appearance, so ties go to the first candidate
+  for (std::size_t j = 1; j < u; ++j)
+    if (m.score[j] > m.score[best]) best = j;
+  return m.first[best];
 }
 
 }  // namespace
@@ -65,6 +94,7 @@ Image vote(const ImageView& style, const PatchSpace& space, const SearchConstrai
   const Voter voter{style, space, field};
   parallel_for(th, params.threads, [&](int ty) {
     std::vector<float> sum(c), sample(c), candidates;
+    ModeScratch scratch;
     for (int tx = 0; tx < tw; ++tx) {
       const std::size_t i = field.index(tx, ty);
       if (!cons.target_active[i]) continue;
@@ -106,7 +136,7 @@ Image vote(const ImageView& style, const PatchSpace& space, const SearchConstrai
           Rng rng(params.seed, mix64(params.stream * 0x9E37ull + 17) ^ i);
           pick = std::size_t(rng.below(count));
         } else {
-          pick = weighted_mode(candidates, c, std::size_t(count));
+          pick = weighted_mode(candidates, c, std::size_t(count), scratch);
         }
         std::copy_n(candidates.data() + pick * c, c, o);
       }

@@ -126,3 +126,36 @@ def test_noise_errors_name_the_problem(cli_path, caches, inputs):
     assert bad.returncode == 2 and "neither an image file nor a guide" in bad.stderr
     bad = stylize(cli_path, *farm(caches, "--noise", "2.2", "--noise-map", "mask.OB_Nothing"))
     assert bad.returncode == 2 and "mask.OB_Nothing" in bad.stderr
+
+
+def test_the_warp_error_of_a_stylized_moving_shot_rises_with_the_width(cli_path, tmp_path):
+    """The issue's moving-shot test on the whole pipeline, small: a 128 x 96
+    guide cache of a blob moving right 2 px a frame (synthetic, as the renderer
+    writes it), coherent StyLit frames with the temporal guide (R), then the
+    noise pass at f = 1.3, 2.2, 3.1, 4.3 on those same frames. The warp
+    error along the cache's own V- and chi- (the flicker figure) rises
+    strictly with f, and every noisy run is above R's."""
+    from tempera import guide_cache, temporal
+
+    shot, size = (1, 2, 3, 4, 5, 6), (128, 96)
+    make_cache(tmp_path / "cache", frames=shot, start=40.0, size=size)
+    make_exemplar(tmp_path / "exemplar", tmp_path / "paint.png", size=size)
+    motion = [guide_cache.read_frame(str(tmp_path / "cache"), f, ["velocity_backward", "occlusion_backward"])
+              for f in shot]
+
+    def warp_error(folder):
+        images = [tempera.read_image(str(folder / f"frame_{f:04d}.png")) for f in shot]
+        return np.mean([temporal.flicker(a, b, m["velocity_backward"], m["occlusion_backward"])
+                        for a, b, m in zip(images, images[1:], motion[1:])])
+
+    base = ("--guides", tmp_path / "cache", "--exemplar", tmp_path / "paint.png", "--exemplar-guides",
+            tmp_path / "exemplar", "--frames", "1-6", "--out", tmp_path / "out", "--threads", "2", "--no-video",
+            "--temporal", "0.5")
+    errors = []
+    for f in (1.3, 2.2, 3.1, 4.3):
+        done = stylize(cli_path, *base, "--noise", f)
+        assert done.returncode == 0, done.stderr
+        errors.append(warp_error(tmp_path / "out" / "noisy"))
+    coherent = warp_error(tmp_path / "out" / "frames")
+    assert all(a < b for a, b in zip(errors, errors[1:])), (coherent, errors)
+    assert coherent < errors[0], (coherent, errors)
