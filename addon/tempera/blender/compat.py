@@ -216,7 +216,9 @@ def default_surface_is_principled():
     """Whether an empty material slot renders as Blender's default material
     (a Principled BSDF of its defaults: Blender 5.0, where every material
     renders its nodes: Material.use_nodes is deprecated there) rather than
-    Cycles' default surface, a diffuse BSDF of 0.8 grey."""
+    Cycles' default surface, a diffuse BSDF of 0.8 grey. No RNA feature
+    tells this apart, so the version does (measured in the LPE gallery:
+    the diffuse default leaves 5.0's empty slots' LSE 53 % low)."""
     return bpy.app.version >= (5, 0, 0)
 
 
