@@ -16,9 +16,8 @@ test_quick_smoke.py):
 import bpy
 import numpy as np
 import pytest
-from test_fluid_velocity import _bake, _remove_scene, skip_without_mantaflow
-from test_quick_smoke import (EXEMPLAR, FACTORY_CAMERA, FACTORY_LIGHT, INK, SIZE, _frames, _guides, _iou,
-                              _panel_settings, _run_cli, warp_error)
+from test_quick_smoke import (INK, SIZE, _frames, _guides, _iou, _panel_settings, _run_cli, baked_and_stylized,
+                              film_the_domain, warp_error)
 
 SCENE = "Quick Liquid test"
 FRAMES = [8, 9, 10]  # 1/3 s in: the block of water falling (it lands near frame 19)
@@ -37,46 +36,14 @@ def _quick_liquid_scene(cache_dir):
     cube.hide_render = True
     settings = domain.modifiers["Fluid"].domain_settings
     settings.use_mesh = True
-    settings.cache_directory, settings.cache_type = cache_dir, "ALL"
-    settings.cache_frame_start, settings.cache_frame_end = 1, BAKE_END
-    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-    camera.location, camera.rotation_euler = FACTORY_CAMERA
-    scene.collection.objects.link(camera)
-    scene.camera = camera
-    light = bpy.data.objects.new("Light", bpy.data.lights.new("Light", "POINT"))
-    light.data.energy, light.location = 1000.0, FACTORY_LIGHT
-    scene.collection.objects.link(light)
-    scene.render.resolution_x, scene.render.resolution_y = SIZE
-    scene.render.resolution_percentage = 100
-    scene.render.film_transparent = True
-    scene.frame_start, scene.frame_end = 1, BAKE_END
+    film_the_domain(scene, domain, cache_dir, BAKE_END)
     return scene, domain
 
 
 @pytest.fixture(scope="module")
 def liquid(tmp_path_factory):
     """The baked Quick Liquid scene and the LazyFluids panel run on it."""
-    import tempera
-    from tempera import media_exemplars
-
-    skip_without_mantaflow()
-    tmp = tmp_path_factory.mktemp("quick_liquid")
-    shown = bpy.context.window.scene
-    scene, domain = _quick_liquid_scene(str(tmp / "fluid_cache"))
-    try:
-        _bake(scene, domain)
-        still = tmp / "smoke_still.png"
-        tempera.write_image(str(still), media_exemplars.smoke_still(EXEMPLAR, EXEMPLAR, seed=4), [])
-        s = _panel_settings(scene, tmp, "LAZYFLUIDS", FRAMES)
-        s.media_exemplar_kind, s.media_exemplar = "STILL", str(still)
-        assert bpy.ops.tempera.stylize(mode="ANIMATION") == {"FINISHED"}
-        yield {"scene": scene, "tmp": tmp, "still": still}
-    finally:
-        bpy.context.window.scene = shown
-        for suffix in (" Tempera", " Tempera Composite"):
-            if SCENE + suffix in bpy.data.scenes:
-                bpy.data.scenes.remove(bpy.data.scenes[SCENE + suffix])
-        _remove_scene(scene)
+    yield from baked_and_stylized(tmp_path_factory, _quick_liquid_scene, FRAMES)
 
 
 def test_falling_liquid_moves_down_the_screen(liquid):

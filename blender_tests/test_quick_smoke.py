@@ -39,9 +39,17 @@ def _quick_smoke_scene(cache_dir, style="SMOKE", name=SCENE):
     assert bpy.ops.object.quick_smoke(style=style) == {"FINISHED"}
     domain = bpy.context.active_object  # "Smoke Domain", made last
     assert domain.name.startswith("Smoke Domain")
+    film_the_domain(scene, domain, cache_dir, BAKE_END)
+    assert cube.modifiers["Fluid"].flow_settings.flow_behavior == "INFLOW"  # as Quick Smoke made it
+    return scene, domain
+
+
+def film_the_domain(scene, domain, cache_dir, bake_end):
+    """What a user sets besides the Quick effect: the domain's cache, the
+    factory camera and light, and a small transparent render."""
     settings = domain.modifiers["Fluid"].domain_settings
     settings.cache_directory, settings.cache_type = cache_dir, "ALL"
-    settings.cache_frame_start, settings.cache_frame_end = 1, BAKE_END
+    settings.cache_frame_start, settings.cache_frame_end = 1, bake_end
     camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
     camera.location, camera.rotation_euler = FACTORY_CAMERA
     scene.collection.objects.link(camera)
@@ -52,9 +60,7 @@ def _quick_smoke_scene(cache_dir, style="SMOKE", name=SCENE):
     scene.render.resolution_x, scene.render.resolution_y = SIZE
     scene.render.resolution_percentage = 100
     scene.render.film_transparent = True
-    scene.frame_start, scene.frame_end = 1, BAKE_END
-    assert cube.modifiers["Fluid"].flow_settings.flow_behavior == "INFLOW"  # as Quick Smoke made it
-    return scene, domain
+    scene.frame_start, scene.frame_end = 1, bake_end
 
 
 def _run_cli(guides, exemplar, out, *options, frames=FRAMES):
@@ -77,30 +83,38 @@ def _panel_settings(scene, tmp, method, frames=FRAMES):
     return s
 
 
-@pytest.fixture(scope="module")
-def smoke(tmp_path_factory):
-    """The baked Quick Smoke scene and the LazyFluids panel run on it."""
+def baked_and_stylized(tmp_path_factory, build_scene, frames):
+    """A module fixture's body: the scene of `build_scene(cache_dir)` baked,
+    then the LazyFluids panel run on `frames` from the procedural smoke still;
+    yields {"scene", "tmp", "still"} and removes the scenes afterwards."""
     import tempera
     from tempera import media_exemplars
 
     skip_without_mantaflow()
-    tmp = tmp_path_factory.mktemp("quick_smoke")
+    tmp = tmp_path_factory.mktemp("quick_effect")
     shown = bpy.context.window.scene
-    scene, domain = _quick_smoke_scene(str(tmp / "fluid_cache"))
+    scene, domain = build_scene(str(tmp / "fluid_cache"))
+    name = scene.name
     try:
         _bake(scene, domain)
         still = tmp / "smoke_still.png"
         tempera.write_image(str(still), media_exemplars.smoke_still(EXEMPLAR, EXEMPLAR, seed=4), [])
-        s = _panel_settings(scene, tmp, "LAZYFLUIDS")
+        s = _panel_settings(scene, tmp, "LAZYFLUIDS", frames)
         s.media_exemplar_kind, s.media_exemplar = "STILL", str(still)
         assert bpy.ops.tempera.stylize(mode="ANIMATION") == {"FINISHED"}
         yield {"scene": scene, "tmp": tmp, "still": still}
     finally:
         bpy.context.window.scene = shown
         for suffix in (" Tempera", " Tempera Composite"):
-            if SCENE + suffix in bpy.data.scenes:
-                bpy.data.scenes.remove(bpy.data.scenes[SCENE + suffix])
+            if name + suffix in bpy.data.scenes:
+                bpy.data.scenes.remove(bpy.data.scenes[name + suffix])
         _remove_scene(scene)
+
+
+@pytest.fixture(scope="module")
+def smoke(tmp_path_factory):
+    """The baked Quick Smoke scene and the LazyFluids panel run on it."""
+    yield from baked_and_stylized(tmp_path_factory, _quick_smoke_scene, FRAMES)
 
 
 def _guides(tmp, frame):

@@ -1,12 +1,23 @@
 #pragma once
-// Shared by the TCIA tests: a smooth random texture and the measures of the
-// in-betweens against ground truth (SSIM, gradient energy).
+// Shared by the TCIA tests: their small solver settings, a smooth random
+// texture and the measures of the in-betweens against ground truth (SSIM,
+// gradient energy).
 #include <algorithm>
 #include <random>
 
 #include "tempera/image.hpp"
+#include "tempera/tcia.hpp"
 
 namespace tempera::test {
+
+// The method's defaults on 2 threads, few levels and 7 x 7 patches: small shots, fast.
+inline TciaOptions fast_options(int levels = 3) {
+  TciaOptions o = default_tcia_options();
+  o.synthesis.threads = 2;
+  o.synthesis.levels = levels;
+  o.synthesis.patch_size = 7;
+  return o;
+}
 
 // Uniform noise blurred by a 3 x 3 box.
 inline Image smooth_noise(int w, int h, int c, unsigned seed) {

@@ -90,14 +90,6 @@ double patch_statistics(const Image& out, const Image& style, int x0 = 0, int x1
   return sum / count;
 }
 
-TciaOptions fast() {
-  TciaOptions o = default_tcia_options();
-  o.synthesis.threads = 2;
-  o.synthesis.levels = 3;
-  o.synthesis.patch_size = 7;
-  return o;
-}
-
 }  // namespace
 
 TEST(Tcia, SweepsKeepThePaintOnTheMovingSurface) {
@@ -105,11 +97,11 @@ TEST(Tcia, SweepsKeepThePaintOnTheMovingSurface) {
   // warp of the previous frame has an error floor of its own (measured 0.031
   // at 1.5 px per frame against 0.078 for independent frames).
   const TranslatingShot s(8, 56, 40, 2.0f);
-  const TciaOptions coherent = fast();
+  const TciaOptions coherent = fast_options();
   const std::vector<Image> out = stylize_shot(s.shot, coherent);
   ASSERT_EQ(out.size(), 8u);
   // Per-frame synthesis: the same engine, no temporal term, frames alone.
-  TciaOptions alone = fast();
+  TciaOptions alone = fast_options();
   alone.temporal_weight = 0;
   std::vector<Image> independent;
   for (std::size_t t = 0; t < s.shot.frames.size(); ++t) {
@@ -133,8 +125,8 @@ TEST(Tcia, CoherenceKeepsThePatchStatisticsAndDoesNotDrift) {
   // w_tc = 1 the shot's last two frames failed (0.00021 against 0.00011,
   // last-third flicker 0.00085): the default is 3 (tcia.hpp).
   const TranslatingShot s(10, 52, 40, 2.0f, 22.0f);
-  const std::vector<Image> out = stylize_shot(s.shot, fast());
-  TciaOptions alone = fast();
+  const std::vector<Image> out = stylize_shot(s.shot, fast_options());
+  TciaOptions alone = fast_options();
   alone.temporal_weight = 0;
   double alone_stats = 0;
   for (std::size_t t = 0; t < s.shot.frames.size(); ++t) {
@@ -171,7 +163,7 @@ TEST(Tcia, DisoccludedBandsAreFreshPaintOnlyWhereChiSaysSo) {
     if (chi_forced_to_one)
       for (auto* chi : {&s.chi_minus, &s.chi_plus})
         for (Image& c : *chi) std::fill(c.data(), c.data() + c.pixel_count(), 1.0f);
-    const std::vector<Image> out = stylize_shot(s.shot, fast());
+    const std::vector<Image> out = stylize_shot(s.shot, fast_options());
     double band = 0, rest = 0;
     for (std::size_t t = 1; t < out.size(); ++t) {
       band += patch_statistics(out[t], s.style, 0, 9, 1) / double(out.size() - 1);
@@ -208,7 +200,7 @@ TEST(Tcia, InBetweensBeatAdvectAndCrossfade) {
     truth.push_back(std::move(g));
   }
   s.shot.keys = {{0, truth[0].view(), {}}, {frames - 1, truth[frames - 1].view(), {}}};
-  const std::vector<Image> out = stylize_shot(s.shot, fast());
+  const std::vector<Image> out = stylize_shot(s.shot, fast_options());
   double ours = 0, crossfade = 0, energy = 0;
   for (int t = 1; t < frames - 1; ++t) {
     // The keys advected to frame t: key 0 forward, key 10 backward (whole pixels: exact where seen).
@@ -234,7 +226,7 @@ TEST(Tcia, InBetweensBeatAdvectAndCrossfade) {
 
 TEST(Tcia, OutputIsAWarpOfTheExemplar) {
   const TranslatingShot s(3, 40, 32, 1.0f);
-  const std::vector<Image> out = stylize_shot(s.shot, fast());
+  const std::vector<Image> out = stylize_shot(s.shot, fast_options());
   // Centre output: every pixel is an exemplar pixel.
   for (const Image& frame : out)
     for (int y = 0; y < frame.height(); y += 3)
@@ -249,7 +241,7 @@ TEST(Tcia, OutputIsAWarpOfTheExemplar) {
 
 TEST(Tcia, SameSeedSameShotForAnyThreadCount) {
   const TranslatingShot s(3, 40, 32, 1.0f);
-  TciaOptions one = fast(), two = fast();
+  TciaOptions one = fast_options(), two = fast_options();
   one.synthesis.threads = 1;
   const auto a = stylize_shot(s.shot, one), b = stylize_shot(s.shot, two);
   for (std::size_t t = 0; t < a.size(); ++t)
@@ -260,10 +252,10 @@ TEST(Tcia, BadShotsNameTheProblem) {
   const TranslatingShot s(2, 40, 32, 1.0f);
   Shot bad = s.shot;
   bad.frames[1].guides.clear();
-  EXPECT_THROW(stylize_shot(bad, fast()), ValueError);
+  EXPECT_THROW(stylize_shot(bad, fast_options()), ValueError);
   bad = s.shot;
   bad.frames.clear();
-  EXPECT_THROW(stylize_shot(bad, fast()), ValueError);
+  EXPECT_THROW(stylize_shot(bad, fast_options()), ValueError);
 }
 
 TEST(Tcia, KeysComeOutAsPaintedAndTheInBetweensFollowThem) {
@@ -282,7 +274,7 @@ TEST(Tcia, KeysComeOutAsPaintedAndTheInBetweensFollowThem) {
     paintings.push_back(std::move(p));
   }
   s.shot.keys = {{0, paintings[0].view(), {}}, {7, paintings[1].view(), {}}};
-  const std::vector<Image> out = stylize_shot(s.shot, fast());
+  const std::vector<Image> out = stylize_shot(s.shot, fast_options());
   for (int i : {0, 1}) {
     const Image& key = paintings[std::size_t(i)];
     const Image& frame = out[std::size_t(i == 0 ? 0 : 7)];

@@ -132,14 +132,6 @@ struct TurningShot {
   }
 };
 
-TciaOptions fast() {
-  TciaOptions o = default_tcia_options();
-  o.synthesis.threads = 2;
-  o.synthesis.levels = 3;
-  o.synthesis.patch_size = 7;
-  return o;
-}
-
 }  // namespace
 
 // Keys 24 frames apart on a square turning 2 degrees per frame (48 in
@@ -164,7 +156,7 @@ TEST(TciaKeys, RibbonsHoldTheKeysOnATurningSquareOverALongGap) {
   };
   std::string report;
   for (std::uint64_t seed : {1, 2}) {
-    TciaOptions on = fast(), off = fast();
+    TciaOptions on = fast_options(), off = fast_options();
     on.synthesis.seed = off.synthesis.seed = seed;
     off.ribbons = false;
     const std::vector<Image> with = stylize_shot(s.shot, on);

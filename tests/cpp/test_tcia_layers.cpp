@@ -15,6 +15,7 @@
 #include "tempera/motion.hpp"
 #include "tempera/stylit.hpp"
 #include "tempera/tcia_layers.hpp"
+#include "tcia_measures.hpp"
 
 using namespace tempera;
 
@@ -116,14 +117,6 @@ struct SquareOverBackground {
   }
 };
 
-TciaOptions fast() {
-  TciaOptions o = default_tcia_options();
-  o.synthesis.threads = 2;
-  o.synthesis.levels = 3;
-  o.synthesis.patch_size = 7;
-  return o;
-}
-
 struct LayerRun {
   std::vector<Image> square, background;
 };
@@ -132,7 +125,7 @@ LayerRun run_layers(const SquareOverBackground& s, bool extrapolate) {
   LayerRun r;
   for (auto [masks, out] : {std::pair{&s.fg_mask, &r.square}, std::pair{&s.bg_mask, &r.background}}) {
     std::deque<Image> keep;
-    *out = stylize_shot(layer_shot(s.shot, s.layer("layer", *masks), keep, extrapolate), fast());
+    *out = stylize_shot(layer_shot(s.shot, s.layer("layer", *masks), keep, extrapolate), test::fast_options());
   }
   return r;
 }
@@ -163,7 +156,7 @@ TEST(TciaLayers, ExtrapolatedMotionCarriesTheBorderWithItsLayer) {
   const SquareOverBackground s;
   const LayerRun layers = run_layers(s, true);
   const double square = s.band_error(layers.square, s.speed), background = s.band_error(layers.background, 0);
-  const std::vector<Image> one = stylize_shot(s.shot, fast());
+  const std::vector<Image> one = stylize_shot(s.shot, test::fast_options());
   const double one_square = s.band_error(one, s.speed), one_background = s.band_error(one, 0);
   const LayerRun plain = run_layers(s, false);
   const double plain_square = s.band_error(plain.square, s.speed);
@@ -212,7 +205,7 @@ TEST(TciaLayers, MatchesComeOnlyFromTheLayersPartOfTheExemplar) {
   auto outside = [&](const ShotLayer& layer) {
     std::deque<Image> keep;
     int n = 0;
-    for (const Image& f : stylize_shot(layer_shot(s.shot, layer, keep), fast()))
+    for (const Image& f : stylize_shot(layer_shot(s.shot, layer, keep), test::fast_options()))
       for (int y = 0; y < s.H; ++y)
         for (int x = 0; x < s.W; ++x) n += !colours.count({f.at(x, y, 0), f.at(x, y, 1), f.at(x, y, 2)});
     return n;

@@ -8,6 +8,7 @@
 
 #include "tempera/orientation.hpp"
 #include "tempera/tcia.hpp"
+#include "tcia_measures.hpp"
 
 using namespace tempera;
 
@@ -85,14 +86,6 @@ struct TurningHatching {
   }
 };
 
-TciaOptions fast() {
-  TciaOptions o = default_tcia_options();
-  o.synthesis.threads = 2;
-  o.synthesis.levels = 2;
-  o.synthesis.patch_size = 7;
-  return o;
-}
-
 }  // namespace
 
 // The field starts at 60 degrees and turns 4 degrees per frame (to 88):
@@ -101,8 +94,8 @@ TciaOptions fast() {
 TEST(TciaOrientation, HatchingFollowsATurningOrientationField) {
   TurningHatching oriented(8, 4.0f, 60.0f), plain(8, 4.0f, 60.0f);
   oriented.orient();
-  const double with = oriented.median_angle_error(stylize_shot(oriented.shot, fast()));
-  const double without = plain.median_angle_error(stylize_shot(plain.shot, fast()));
+  const double with = oriented.median_angle_error(stylize_shot(oriented.shot, test::fast_options(2)));
+  const double without = plain.median_angle_error(stylize_shot(plain.shot, test::fast_options(2)));
   RecordProperty("median_angle_error", std::to_string(with) + " deg; without orientation " + std::to_string(without));
   std::printf("angle error %f vs without %f\n", with, without);
   EXPECT_LE(with, 10.0);

@@ -169,10 +169,16 @@ class TEMPERA_OT_remove_keyframe(Operator):
         return context.scene is not None and len(context.scene.tempera.keyframes) > 0
 
     def execute(self, context):
-        settings = context.scene.tempera
-        settings.keyframes.remove(min(settings.keyframe_index, len(settings.keyframes) - 1))
-        settings.keyframe_index = max(0, min(settings.keyframe_index, len(settings.keyframes) - 1))
+        remove_selected(context.scene.tempera, "keyframes", "keyframe_index")
         return {"FINISHED"}
+
+
+def remove_selected(settings, items, index):
+    """Removes the selected item of the list `settings.<items>` (selection
+    `settings.<index>`) and keeps the selection within the list."""
+    listed = getattr(settings, items)
+    listed.remove(min(getattr(settings, index), len(listed) - 1))
+    setattr(settings, index, max(0, min(getattr(settings, index), len(listed) - 1)))
 
 
 CLASSES = (TEMPERA_UL_keyframes, TEMPERA_OT_add_keyframe, TEMPERA_OT_import_keyframe, TEMPERA_OT_remove_keyframe)

@@ -8,6 +8,7 @@ import re
 from bpy.types import Operator, UIList
 
 from .. import guide_cache
+from .keyframes import remove_selected
 
 
 def layer_name(collection_name):
@@ -74,9 +75,7 @@ class TEMPERA_OT_remove_tcia_layer(Operator):
         return context.scene is not None and len(context.scene.tempera.tcia_layers) > 0
 
     def execute(self, context):
-        settings = context.scene.tempera
-        settings.tcia_layers.remove(min(settings.tcia_layer_index, len(settings.tcia_layers) - 1))
-        settings.tcia_layer_index = max(0, min(settings.tcia_layer_index, len(settings.tcia_layers) - 1))
+        remove_selected(context.scene.tempera, "tcia_layers", "tcia_layer_index")
         return {"FINISHED"}
 
 

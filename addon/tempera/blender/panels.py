@@ -227,14 +227,21 @@ def draw_panel_options(col, settings, prefix):
 MEDIA_METHODS = {"LAZYFLUIDS": draw_lazyfluids, "FLUIDYMATION": draw_fluidymation}
 
 
+def draw_list(box, settings, items, index, add, remove, rows):
+    """The list `settings.<items>` (drawn by TEMPERA_UL_<items>, selection
+    `settings.<index>`) with its add and remove operators' buttons beside it."""
+    row = box.row()
+    row.template_list(f"TEMPERA_UL_{items}", "", settings, items, settings, index, rows=rows)
+    side = row.column(align=True)
+    side.operator(add.bl_idname, text="", icon="ADD")
+    side.operator(remove.bl_idname, text="", icon="REMOVE")
+
+
 def draw_keyframes(box, settings):
     """The coherent method's painted keyframes: the list and its buttons."""
     box.label(text="Keyframes (painted frames the shot follows)")
-    row = box.row()
-    row.template_list("TEMPERA_UL_keyframes", "", settings, "keyframes", settings, "keyframe_index", rows=3)
-    side = row.column(align=True)
-    side.operator(TEMPERA_OT_add_keyframe.bl_idname, text="", icon="ADD")
-    side.operator(TEMPERA_OT_remove_keyframe.bl_idname, text="", icon="REMOVE")
+    draw_list(box, settings, "keyframes", "keyframe_index", TEMPERA_OT_add_keyframe, TEMPERA_OT_remove_keyframe,
+              rows=3)
     row = box.row(align=True)
     row.operator(TEMPERA_OT_add_keyframe.bl_idname, text="Add Keyframe", icon="KEYFRAME")
     row.operator(TEMPERA_OT_import_keyframe.bl_idname, text="Import Key", icon="IMPORT")
@@ -251,11 +258,8 @@ def draw_keyframes(box, settings):
 def draw_layers(box, settings):
     """The coherent method's layers, picked from collections."""
     box.label(text="Layers (collections painted separately)")
-    row = box.row()
-    row.template_list("TEMPERA_UL_tcia_layers", "", settings, "tcia_layers", settings, "tcia_layer_index", rows=2)
-    side = row.column(align=True)
-    side.operator(TEMPERA_OT_add_tcia_layer.bl_idname, text="", icon="ADD")
-    side.operator(TEMPERA_OT_remove_tcia_layer.bl_idname, text="", icon="REMOVE")
+    draw_list(box, settings, "tcia_layers", "tcia_layer_index", TEMPERA_OT_add_tcia_layer,
+              TEMPERA_OT_remove_tcia_layer, rows=2)
     if 0 <= settings.tcia_layer_index < len(settings.tcia_layers):
         layer = settings.tcia_layers[settings.tcia_layer_index]
         col = box.column(align=True)
