@@ -85,39 +85,6 @@ struct Matcher {
   }
 };
 
-// Random-search offsets (Barnes et al. 2009: one window per scale, halving
-// from the whole exemplar), drawn a few pixels ahead of their use so that
-// their source rows can be prefetched early. They do not depend on the match,
-// so drawing them ahead keeps the random stream, and the result, unchanged.
-struct RandomOffsets {
-  static constexpr int kMax = 2 * 32;
-  int d[kMax];
-  int n = 0;
-  int predicted_x = 0, predicted_y = 0;  // center they were prefetched around
-  bool prefetched = false;
-
-  void draw(Rng& rng, int max_radius, int tries) {
-    n = 0;
-    prefetched = false;
-    for (int r = max_radius; r >= 1 && n < kMax; r /= 2)
-      for (int k = 0; k < tries && n < kMax; ++k, n += 2) {
-        d[n] = rng.between(-r, r);
-        d[n + 1] = rng.between(-r, r);
-      }
-  }
-  void prefetch(const Matcher& m, int cx, int cy) {
-    predicted_x = cx;
-    predicted_y = cy;
-    prefetched = true;
-    for (int k = 0; k < n; k += 2) m.prefetch(cx + d[k], cy + d[k + 1]);
-  }
-};
-
-// How many active pixels ahead the random offsets are drawn and prefetched,
-// around the current match shifted along the scan (where coherent matches
-// land): enough lead to hide a miss behind the pixels in between.
-constexpr int kLookAhead = 2;
-
 }  // namespace
 
 void random_field(const PatchSpace& space, const SearchConstraints& cons, OffsetField& field, std::uint64_t seed,
@@ -186,9 +153,6 @@ void patchmatch(const PatchSpace& space, const SearchConstraints& cons, OffsetFi
     parallel_for(bands, params.threads, [&](int band) {
       const int y0 = band * params.band_rows, y1 = std::min(th, y0 + params.band_rows);
       Rng rng(params.seed, mix64(stream * 1000003ull + iter) ^ std::uint64_t(band));
-      RandomOffsets ahead[kLookAhead + 1];
-      for (int k = 0; k < kLookAhead; ++k) ahead[k].draw(rng, max_radius, params.random_tries_per_scale);
-      int visited = 0;  // active pixels of this band so far
       for (int row = 0; row < y1 - y0; ++row) {
         const int ty = forward ? y0 + row : y1 - 1 - row;
         for (int col = 0; col < tw; ++col) {
@@ -225,19 +189,17 @@ void patchmatch(const PatchSpace& space, const SearchConstraints& cons, OffsetFi
                                 b);
           }
           // Random search in shrinking windows around the match after
-          // propagation (Barnes et al. 2009). Each candidate is a likely
-          // cache miss, and waiting for them one by one dominated the search
-          // time: their rows were prefetched kLookAhead pixels ago around the
-          // predicted match, and again here if the match is elsewhere.
-          const int cx = b.x, cy = b.y;
-          RandomOffsets& mine = ahead[visited % (kLookAhead + 1)];
-          if (!mine.prefetched || mine.predicted_x != cx || mine.predicted_y != cy) mine.prefetch(m, cx, cy);
-          for (int k = 0; k < mine.n; k += 2)
-            m.try_candidate(cx + mine.d[k], cy + mine.d[k + 1], 0.0f, 0.0f, tx, ty, segment, b);
-          RandomOffsets& next = ahead[(visited + kLookAhead) % (kLookAhead + 1)];
-          next.draw(rng, max_radius, params.random_tries_per_scale);
-          next.prefetch(m, b.x + kLookAhead * step, b.y);
-          ++visited;
+          // propagation (Barnes et al. 2009). The candidates are drawn first
+          // and their source rows prefetched: each is a likely cache miss, and
+          // waiting for them one by one dominated the search time.
+          int cand[2 * 32], n = 0;
+          for (int r = max_radius; r >= 1 && n < 64; r /= 2)
+            for (int k = 0; k < params.random_tries_per_scale && n < 64; ++k, n += 2) {
+              cand[n] = b.x + rng.between(-r, r);
+              cand[n + 1] = b.y + rng.between(-r, r);
+              m.prefetch(cand[n], cand[n + 1]);
+            }
+          for (int k = 0; k < n; k += 2) m.try_candidate(cand[k], cand[k + 1], 0.0f, 0.0f, tx, ty, segment, b);
           field.x[i] = b.x;
           field.y[i] = b.y;
           field.rx[i] = b.rx;
