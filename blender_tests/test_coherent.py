@@ -185,3 +185,22 @@ def test_layers_picked_from_collections_give_per_layer_frames_and_their_composit
         assert np.abs(frame[on_cube][:, :3] - cube[on_cube][:, :3]).max() <= 1 / 255
         assert np.abs(frame[on_wall][:, :3] - wall[on_wall][:, :3]).max() <= 1 / 255
         assert np.abs(cube[on_cube][:, :3] - wall[on_cube][:, :3]).mean() > 0.01  # two solves, not one
+
+
+def test_orientation_from_guides_reaches_the_job(coherent, tmp_path):
+    """Orientation from Guides: the cache's tensor turns the patches
+    (`--orientation`), so the frames differ from a run without it."""
+    import tempera
+    from tempera.blender.stylize_operator import StylizeRun
+
+    def run(folder, orientation):
+        coherent.tempera.output_dir = str(tmp_path / folder)
+        coherent.tempera.tcia_orientation = orientation
+        r = StylizeRun.from_settings(coherent, "ANIMATION")
+        while not r.finished:
+            r.step()
+        assert r.orientation is orientation and [s["status"] for s in r.segment_results] == ["stylized"]
+        return [tempera.read_image(str(tmp_path / folder / "frames" / f"frame_{f:04d}.png")) for f in FRAMES]
+
+    plain, oriented = run("plain", False), run("oriented", True)
+    assert max(np.abs(a - b).mean() for a, b in zip(plain, oriented)) > 0.005

@@ -127,7 +127,9 @@ std::string stylize_help() {
   std::string text = kStylizeHelpText;
   text.replace(text.find("@WEIGHTS@"), 9, defaults);
   text.replace(text.find("@TCIA@"), 6, flags_help<TciaOptions>(tcia_option_table()));
-  text.replace(text.find("@LINES@"), 7, flags_help<TciaLineOptions>(tcia_line_option_table()));
+  text.replace(text.find("@LINES@"), 7,
+               flags_help<TciaLineOptions>(tcia_line_option_table()) +
+                   flags_help<TciaOrientationOptions>(tcia_orientation_option_table()));
   return text;
 }
 
@@ -160,6 +162,7 @@ struct Options {
   std::optional<std::pair<int, int>> segment;
   TciaOptions tcia = default_tcia_options();
   TciaLineOptions lines;
+  TciaOrientationOptions orientation;
   std::vector<std::pair<std::string, std::string>> engine_flags;
   std::vector<std::string> tcia_flags;
   bool temporal_given = false;
@@ -182,7 +185,8 @@ bool set_engine_flag(Options& o, const std::string& flag, ArgReader& r) {
     return true;
   }
   if (!set_from_flag(o.tcia, tcia_option_table(), flag.substr(2), value) &&
-      !set_from_flag(o.lines, tcia_line_option_table(), flag.substr(2), value))
+      !set_from_flag(o.lines, tcia_line_option_table(), flag.substr(2), value) &&
+      !set_from_flag(o.orientation, tcia_orientation_option_table(), flag.substr(2), value))
     return false;
   o.tcia_flags.push_back(flag);
   return true;
@@ -489,7 +493,8 @@ int run_stylize(const Args& args) {
     config.stylit = o.stylit;
     config.resume = o.resume;
     if (o.method == "tcia") {
-      TciaJob job({config, o.keys, o.tcia, o.lines, o.layers, o.layer_order.value_or("depth"), o.segment});
+      TciaJob job({config, o.keys, o.tcia, o.lines, o.layers, o.layer_order.value_or("depth"), o.segment,
+                   o.orientation});
       for (const auto& w : job.warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
       if (!run_segments(job, o)) return interrupted_segments();
       if (!o.segment) write_extras(job.frames_job(), o);  // a segment is a farm task: the finish writes them

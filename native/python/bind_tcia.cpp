@@ -51,6 +51,8 @@ TciaJobConfig job_config(const py::dict& d, const TciaOptions& options) {
   if (!d["segment"].is_none()) c.segment = d["segment"].cast<std::pair<int, int>>();
   c.tcia = options;
   py_bridge::set_from_dict(c.lines, tcia_line_option_table(), d["lines"].cast<py::dict>(), "line option");
+  py_bridge::set_from_dict(c.orientation, tcia_orientation_option_table(), d["orientation"].cast<py::dict>(),
+                           "orientation option");
   return c;
 }
 

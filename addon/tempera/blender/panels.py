@@ -252,6 +252,7 @@ def draw_keyframes(box, settings):
         col.prop(key, "mask")
     box.prop(settings, "keyframe_dir")
     box.prop(settings, "line_weight")
+    box.prop(settings, "tcia_orientation")
     draw_layers(box, settings)
 
 

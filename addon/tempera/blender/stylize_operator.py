@@ -301,6 +301,7 @@ class CoherentRun(StylizeRun):
         self.segments = tcia.segments(self.frames, [k[0] for k in self.keys])
         self.segment_results = []
         self.line_weight = float(scene.tempera.line_weight)
+        self.orientation = bool(scene.tempera.tcia_orientation)
         self.layers = layer_list(scene.tempera)
         self.layer_order = scene.tempera.tcia_layer_order
         if self.layers:  # their collections' masks
@@ -319,7 +320,7 @@ class CoherentRun(StylizeRun):
                                exemplar_frame=c.get("exemplar_frame"), keys=self.keys, weights=c["weights"],
                                format=c["format"], seed=c["seed"],
                                lines={"weight": self.line_weight, "d_max": self.guides.params["line_d_max"]},
-                               layers=self.layers, layer_order=self.layer_order)
+                               layers=self.layers, layer_order=self.layer_order, orientation=self.orientation)
             self.warnings = list(self.job.warnings)
         i = self.index - len(self.frames)
         started = time.monotonic()

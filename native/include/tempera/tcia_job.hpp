@@ -60,6 +60,23 @@ inline const auto& tcia_line_option_table() {
   return table;
 }
 
+// Orientation (§3.1) from the guide cache: each frame's and the exemplar's
+// `tensor` guide (the structure tensor of the render, or of the artist's
+// orientation AOV when the cache was rendered with one) gives O(I_t) and
+// O(S), so patches are compared rotated and hatching follows the frame.
+struct TciaOrientationOptions {
+  bool from_cache = false;
+};
+
+inline const auto& tcia_orientation_option_table() {
+  using T = TciaOrientationOptions;
+  static const auto table = std::make_tuple(field(
+      &T::from_cache, "from_cache", "orientation",
+      "patches turn with the guide cache's orientation (its tensor: the render's structure or the artist's "
+      "orientation AOV), so strokes follow the surfaces (off)"));
+  return table;
+}
+
 struct TciaJobConfig {
   StylizeJobConfig frames;  // painting, guide caches, frames (consecutive), output, guide weights
   std::vector<KeyFile> keys;
@@ -75,6 +92,7 @@ struct TciaJobConfig {
   // and bounding keys are read. ValueError listing the shot's segments if
   // A-B is not one.
   std::optional<std::pair<int, int>> segment;
+  TciaOrientationOptions orientation;
 };
 
 // Frames first..last (inclusive) are solved together; the segment writes
