@@ -113,8 +113,9 @@ class ShotJob:
     segment   (first, last): only that segment (a farm task)
     lines     {weight, d_max, ink}: the line term of eq. 9 (tcia_job.hpp TciaLineOptions;
               weight > 0 needs the cache's line_distance)
-    layers    [(name, mask guide, painting path or None), ...]: solved separately
-              (frames RGBA in OUT/layers/NAME/) and composited into the frames
+    layers    [(name, mask guide, painting path or None[, keys]), ...]: solved separately
+              (frames RGBA in OUT/layers/NAME/) and composited into the frames; keys as
+              `keys`, the layer's own, in place of the shot's at their frames (--layer-key)
     layer_order  "depth" (per frame, by the cache's depth) or "given" (first at the back)
     orientation  True: patches turn with the cache's orientation, its `tensor` guide of every
               frame and of the exemplar (tcia_job.hpp TciaOrientationOptions; `--orientation`)
@@ -135,7 +136,9 @@ class ShotJob:
                             for k in keys],
                       segment=None if segment is None else (int(segment[0]), int(segment[1])),
                       lines=dict(lines or {}),
-                      layers=[(str(l[0]), str(l[1]), None if len(l) < 3 or not l[2] else os.fspath(l[2]))
+                      layers=[(str(l[0]), str(l[1]), None if len(l) < 3 or not l[2] else os.fspath(l[2]),
+                               [(int(k[0]), os.fspath(k[1]), None if len(k) < 3 or not k[2] else os.fspath(k[2]))
+                                for k in (l[3] if len(l) > 3 else ())])
                               for l in layers],
                       layer_order=str(layer_order), orientation={"from_cache": bool(orientation)})
         self._job = _native.TciaJob(config, options(**values))

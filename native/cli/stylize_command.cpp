@@ -90,6 +90,9 @@ const char* kStylizeHelpText =
     "                          PAINTING its own painting over the exemplar render (default: the\n"
     "                          shared one); frames RGBA in OUT/frames/layers/NAME/, composited\n"
     "                          into OUT/frames (the back-most layer fills what no mask covers)\n"
+    "  --layer-key NAME:F=PATH[,MASK]  tcia: a key of layer NAME only (repeatable): at frame F it\n"
+    "                          replaces the --key of that frame for the layer, so the layer's pixels\n"
+    "                          of the composite come out as painted; segments split there too\n"
     "  --layer-order O         depth (default: per frame, by the guide cache's depth) | given\n"
     "                          (the --layer order, first at the back)\n"
     "@TCIA@"
@@ -158,6 +161,7 @@ struct Options {
   std::string method = "stylit";
   std::vector<KeyFile> keys;
   std::vector<LayerFile> layers;
+  std::vector<std::pair<std::string, KeyFile>> layer_keys;  // --layer-key, added to their layers
   std::optional<std::string> layer_order;
   std::optional<std::pair<int, int>> segment;
   TciaOptions tcia = default_tcia_options();
@@ -247,6 +251,7 @@ Options parse(const Args& args) {
     else if (flag == "--method") o.method = r.value(flag);
     else if (flag == "--key") o.keys.push_back(parse_key(r.value(flag)));
     else if (flag == "--layer") o.layers.push_back(parse_layer(r.value(flag)));
+    else if (flag == "--layer-key") o.layer_keys.push_back(parse_layer_key(r.value(flag)));
     else if (flag == "--layer-order") o.layer_order = r.value(flag);
     else if (flag == "--segment") o.segment = parse_segment(r.value(flag));
     else if (flag == "--noise-map") o.noise_map = r.value(flag);
@@ -255,6 +260,7 @@ Options parse(const Args& args) {
     else if (!set_engine_flag(o, flag, r))
       throw ValueError(concat("unknown option '", flag, "' (see tempera stylize --help)"));
   }
+  add_layer_keys(o.layers, o.layer_keys);
   check_method(o);
   validate(o.stylit.synthesis);
   validate_fields(o.noisy, noisy_option_table());

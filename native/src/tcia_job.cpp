@@ -31,6 +31,16 @@ std::vector<int> segment_bounds(const std::vector<int>& frames, const std::vecto
   return bounds;
 }
 
+// The shot's keys and the layers' own, sorted by frame (one per frame): the segments' bounds.
+std::vector<KeyFile> all_keys(const TciaJobConfig& c) {
+  std::vector<KeyFile> keys = c.keys;
+  for (const LayerFile& l : c.layers) keys.insert(keys.end(), l.keys.begin(), l.keys.end());
+  std::sort(keys.begin(), keys.end(), [](const KeyFile& a, const KeyFile& b) { return a.frame < b.frame; });
+  keys.erase(std::unique(keys.begin(), keys.end(), [](const KeyFile& a, const KeyFile& b) { return a.frame == b.frame; }),
+             keys.end());
+  return keys;
+}
+
 std::vector<TciaSegment> make_segments(const std::vector<int>& frames, const std::vector<KeyFile>& keys) {
   const std::vector<int> bounds = segment_bounds(frames, keys);
   std::vector<TciaSegment> out;
@@ -163,7 +173,7 @@ KeyFile parse_key(const std::string& text) {
 // Options, keys and segments are checked before the per-frame job reads any file.
 TciaJob::TciaJob(TciaJobConfig config)
     : config_(checked(std::move(config))),
-      segments_(make_segments(config_.frames.frames, config_.keys)),
+      segments_(make_segments(config_.frames.frames, all_keys(config_))),
       selected_(select(segments_, config_.segment)),
       frames_(per_frame(config_)) {
   // Motion: a segment's frames link to their neighbours inside it; its first
@@ -186,13 +196,9 @@ TciaJob::TciaJob(TciaJobConfig config)
   if (config_.orientation.from_cache && !has_guide(inspect_image(frames_.exemplar_path()), "tensor"))
     throw ValueError(concat("--orientation needs the structure tensor 'tensor' in the exemplar's guides '",
                             frames_.exemplar_path(), "'"));
-  for (const KeyFile& k : config_.keys) {
-    paintings_.emplace_back(), masks_.emplace_back();
-    if (!is_read(k.frame)) continue;  // outside the one segment run
-    const ImageFileInfo info = inspect_image(frames_.target_guides_path(k.frame));
-    paintings_.back() = read_key_painting(k, frames_.style().channels(), info.width, info.height);
-    masks_.back() = read_key_mask(k, info.width, info.height);
-  }
+  read_keys(config_.keys, paintings_, masks_);
+  for (const LayerFile& l : config_.layers)
+    read_keys(l.keys, layer_key_paintings_.emplace_back(), layer_key_masks_.emplace_back());
   std::ostringstream s;
   s << kRecordFormat << ";weights=";
   for (const auto& [name, weight] : active_guides(config_.frames.stylit)) s << name << ":" << weight << ",";
@@ -216,7 +222,19 @@ TciaJobConfig TciaJob::checked(TciaJobConfig c) {
   if (c.layer_order != "depth" && c.layer_order != "given")
     throw ValueError(concat("the layer order must be 'depth' or 'given', got '", c.layer_order, "'"));
   c.keys = sorted_keys(std::move(c.keys), c.frames.frames);
+  for (LayerFile& l : c.layers) l.keys = sorted_keys(std::move(l.keys), c.frames.frames);
   return c;
+}
+
+void TciaJob::read_keys(const std::vector<KeyFile>& keys, std::vector<Image>& paintings,
+                        std::vector<Image>& masks) const {
+  for (const KeyFile& k : keys) {
+    paintings.emplace_back(), masks.emplace_back();
+    if (!is_read(k.frame)) continue;  // outside the one segment run
+    const ImageFileInfo info = inspect_image(frames_.target_guides_path(k.frame));
+    paintings.back() = read_key_painting(k, frames_.style().channels(), info.width, info.height);
+    masks.back() = read_key_mask(k, info.width, info.height);
+  }
 }
 
 bool TciaJob::is_read(int frame) const {
