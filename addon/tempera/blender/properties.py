@@ -160,6 +160,9 @@ class TemperaKeyframe(PropertyGroup):
                              description="The painted frame (the frame's size); '//' is relative to the .blend file")
     mask: StringProperty(name="Mask", subtype="FILE_PATH", default="",
                          description="Optional: where the key is painted (white); empty: the whole frame")
+    layer: PointerProperty(name="Layer", type=bpy.types.Collection,
+                           description="Optional: the key of this layer only (a collection of the Layers list); "
+                           "empty: a key of the whole frame")
 
 
 class TemperaLayer(PropertyGroup):

@@ -298,11 +298,12 @@ class CoherentRun(StylizeRun):
         super().__init__(scene, frames, mode)
         require_consecutive(self.frames, "The coherent method")
         self.keys = [k for k in key_list(scene.tempera) if self.frames[0] <= k[0] <= self.frames[-1]]
-        self.segments = tcia.segments(self.frames, [k[0] for k in self.keys])
+        self.layers = layer_list(scene.tempera, (self.frames[0], self.frames[-1]))
+        layer_keys = [k[0] for layer in self.layers for k in layer[3]]
+        self.segments = tcia.segments(self.frames, [k[0] for k in self.keys] + layer_keys)
         self.segment_results = []
         self.line_weight = float(scene.tempera.line_weight)
         self.orientation = bool(scene.tempera.tcia_orientation)
-        self.layers = layer_list(scene.tempera)
         self.layer_order = scene.tempera.tcia_layer_order
         if self.layers:  # their collections' masks
             self.guides.params["masks"] = guide_cache.masks_including(self.guides.params["masks"], "CO")
