@@ -169,7 +169,7 @@ def test_layers_picked_from_collections_give_per_layer_frames_and_their_composit
     bpy.types.TEMPERA_PT_output.draw(type("FakePanel", (), {"layout": _Recorder(calls)})(), bpy.context)
     assert ("template_list", "tcia_layers") in calls and ("prop", "tcia_layer_order") in [c[:2] for c in calls]
     run = StylizeRun.from_settings(scene, "ANIMATION")
-    assert run.layers == [("Movers", "mask.CO_Movers", None), ("Back", "mask.CO_Back", None)]
+    assert run.layers == [("Movers", "mask.CO_Movers", None, []), ("Back", "mask.CO_Back", None, [])]
     assert bpy.ops.tempera.stylize(mode="ANIMATION") == {"FINISHED"}
     out = tmp_path / "out" / "frames"
     for f in FRAMES:
@@ -185,3 +185,60 @@ def test_layers_picked_from_collections_give_per_layer_frames_and_their_composit
         assert np.abs(frame[on_cube][:, :3] - cube[on_cube][:, :3]).max() <= 1 / 255
         assert np.abs(frame[on_wall][:, :3] - wall[on_wall][:, :3]).max() <= 1 / 255
         assert np.abs(cube[on_cube][:, :3] - wall[on_cube][:, :3]).mean() > 0.01  # two solves, not one
+
+
+def test_orientation_from_guides_reaches_the_job(coherent, tmp_path):
+    """Orientation from Guides: the cache's tensor turns the patches
+    (`--orientation`), so the frames differ from a run without it."""
+    import tempera
+    from tempera.blender.stylize_operator import StylizeRun
+
+    def run(folder, orientation):
+        coherent.tempera.output_dir = str(tmp_path / folder)
+        coherent.tempera.tcia_orientation = orientation
+        r = StylizeRun.from_settings(coherent, "ANIMATION")
+        while not r.finished:
+            r.step()
+        assert r.orientation is orientation and [s["status"] for s in r.segment_results] == ["stylized"]
+        return [tempera.read_image(str(tmp_path / folder / "frames" / f"frame_{f:04d}.png")) for f in FRAMES]
+
+    plain, oriented = run("plain", False), run("oriented", True)
+    assert max(np.abs(a - b).mean() for a, b in zip(plain, oriented)) > 0.005
+
+
+def test_a_keyframe_of_one_layer(coherent, tmp_path):
+    """A keyframe whose Layer is the cube's collection: at its frame the
+    composite is the painting where the cube is (in front), the wall is
+    solved without a key, and the shot splits there."""
+    import tempera
+    from tempera import guide_cache
+    from tempera.blender.stylize_operator import StylizeRun
+
+    scene, settings = coherent, coherent.tempera
+    bpy.context.window.scene = scene
+    assert bpy.ops.tempera.add_tcia_layer() == {"FINISHED"}  # Movers: the cube
+    back = bpy.data.collections.new("Back")
+    scene.collection.children.link(back)
+    backdrop = bpy.data.objects["Backdrop"]
+    back.objects.link(backdrop)
+    scene.collection.objects.unlink(backdrop)
+    assert bpy.ops.tempera.add_tcia_layer() == {"FINISHED"}
+    painting = tmp_path / "cube_key.png"
+    rng = np.random.default_rng(5)
+    tempera.write_image(str(painting), rng.uniform(0, 1, (SIZE[1], SIZE[0], 3)).astype(np.float32))
+    assert bpy.ops.tempera.import_keyframe(filepath=str(painting), frame=FRAMES[1]) == {"FINISHED"}
+    settings.keyframes[0].layer = bpy.data.collections["Movers"]
+    run = StylizeRun.from_settings(scene, "ANIMATION")
+    assert run.keys == [] and run.layers[0][3] == [(FRAMES[1], str(painting), None)]
+    assert run.segments == [(FRAMES[0], FRAMES[1]), (FRAMES[1], FRAMES[-1])]
+    while not run.finished:
+        run.step()
+    out = tempera.read_image(str(tmp_path / "out" / "frames" / f"frame_{FRAMES[1]:04d}.png"))[:, :, :3]
+    cube = guide_cache.read_frame(str(tmp_path / "guides"), FRAMES[1], ["mask.CO_Movers"])["mask.CO_Movers"] == 1
+    key = tempera.read_image(str(painting))[:, :, :3]
+    assert cube.sum() > 50
+    assert np.abs(out[cube] - key[cube]).max() <= 1 / 255 + 1e-6
+    assert np.abs(out[~cube] - key[~cube]).mean() > 0.1  # the wall is not the key
+    settings.keyframes[0].layer = bpy.data.collections.new("Elsewhere")
+    with pytest.raises(ValueError, match="Keyframe 3 is of the collection 'Elsewhere', which is not in the Layers"):
+        StylizeRun.from_settings(scene, "ANIMATION")

@@ -5,11 +5,14 @@ The shot pictures come from the demo's output (`make demo`: per-frame StyLit
 in OUT/frames, the coherent method with two painted keys in OUT/coherent and
 OUT/keys); the histogram picture from the procedural panning shot of
 bench/bench_tcia.py, with the usage histogram on and off; the layers picture
-(Fig. 10) from a procedural square moving over a static background.
+(Fig. 10) from a procedural square moving over a static background; the
+user-scene picture from the folders test_coherent_user_scene.py leaves
+(scenes/suzanne_turntable.py: per_frame/, panel/ with the keys, no_keys/).
 
     make demo
     PYTHONPATH=addon /usr/bin/python3 docs/make_coherent_figures.py --demo out/demo
     PYTHONPATH=addon /usr/bin/python3 docs/make_coherent_figures.py --only layers
+    PYTHONPATH=addon /usr/bin/python3 docs/make_coherent_figures.py --only user --user-scene PYTEST_TMP
 """
 import argparse
 import sys
@@ -141,11 +144,31 @@ def layers_figure():
     return bands
 
 
+USER_SHOWN = (1, 4, 8, 13, 16)  # frames of the user-scene rows; keys at 4 and 13
+
+
+def user_scene_figure(folder):
+    """Rows: per-frame StyLit, the coherent method without keys, with the two
+    painted keys (frames 4 and 13), then the keys themselves."""
+    rows = [[rgb(folder / run / "frames" / f"frame_{f:04d}.png") for f in USER_SHOWN]
+            for run in ("per_frame", "no_keys", "panel")]
+    keys = [rgb(folder / "keys" / f"key_{f:04d}.png") for f in (4, 13)]
+    blank = np.ones_like(keys[0])
+    cells = rows[0] + rows[1] + rows[2] + [blank, keys[0], blank, keys[1], blank]
+    tempera.write_image(str(OUT / "coherent_user_scene.png"), sheet(cells, len(USER_SHOWN)))
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--demo", default=str(ROOT / "out" / "demo"), help="the demo's output folder")
-    parser.add_argument("--only", choices=("shot", "histogram", "layers"), help="make only this picture")
+    parser.add_argument("--only", choices=("shot", "histogram", "layers", "user"), help="make only this picture")
+    parser.add_argument("--user-scene", help="the tmp folder of blender_tests/test_coherent_user_scene.py")
     args = parser.parse_args()
+    if args.only == "user" or (args.only is None and args.user_scene):
+        user_scene_figure(Path(args.user_scene))
+    if args.only == "user":
+        print(f"pictures in {OUT}")
+        return
     if args.only in (None, "shot"):
         shot_figures(Path(args.demo))
     if args.only in (None, "histogram"):

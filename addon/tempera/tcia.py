@@ -113,9 +113,12 @@ class ShotJob:
     segment   (first, last): only that segment (a farm task)
     lines     {weight, d_max, ink}: the line term of eq. 9 (tcia_job.hpp TciaLineOptions;
               weight > 0 needs the cache's line_distance)
-    layers    [(name, mask guide, painting path or None), ...]: solved separately
-              (frames RGBA in OUT/layers/NAME/) and composited into the frames
+    layers    [(name, mask guide, painting path or None[, keys]), ...]: solved separately
+              (frames RGBA in OUT/layers/NAME/) and composited into the frames; keys as
+              `keys`, the layer's own, in place of the shot's at their frames (--layer-key)
     layer_order  "depth" (per frame, by the cache's depth) or "given" (first at the back)
+    orientation  True: patches turn with the cache's orientation, its `tensor` guide of every
+              frame and of the exemplar (tcia_job.hpp TciaOrientationOptions; `--orientation`)
     **values  the method's and engine options (tempera.tcia.options)
 
     Construction checks every file, key and guide (FileNotFoundError,
@@ -123,7 +126,8 @@ class ShotJob:
     """
 
     def __init__(self, style, exemplar_guides, guides, frames, out, *, exemplar_frame=None, keys=(), segment=None,
-                 weights=None, format="png", resume=True, lines=None, layers=(), layer_order="depth", **values):
+                 weights=None, format="png", resume=True, lines=None, layers=(), layer_order="depth", orientation=False,
+                 **values):
         config = dict(style=os.fspath(style), exemplar_guides=os.fspath(exemplar_guides), guides=os.fspath(guides),
                       frames=[int(f) for f in frames], out=os.fspath(out), format=str(format), resume=bool(resume),
                       exemplar_frame=None if exemplar_frame is None else int(exemplar_frame),
@@ -132,9 +136,11 @@ class ShotJob:
                             for k in keys],
                       segment=None if segment is None else (int(segment[0]), int(segment[1])),
                       lines=dict(lines or {}),
-                      layers=[(str(l[0]), str(l[1]), None if len(l) < 3 or not l[2] else os.fspath(l[2]))
+                      layers=[(str(l[0]), str(l[1]), None if len(l) < 3 or not l[2] else os.fspath(l[2]),
+                               [(int(k[0]), os.fspath(k[1]), None if len(k) < 3 or not k[2] else os.fspath(k[2]))
+                                for k in (l[3] if len(l) > 3 else ())])
                               for l in layers],
-                      layer_order=str(layer_order))
+                      layer_order=str(layer_order), orientation={"from_cache": bool(orientation)})
         self._job = _native.TciaJob(config, options(**values))
 
     @property

@@ -90,6 +90,9 @@ const char* kStylizeHelpText =
     "                          PAINTING its own painting over the exemplar render (default: the\n"
     "                          shared one); frames RGBA in OUT/frames/layers/NAME/, composited\n"
     "                          into OUT/frames (the back-most layer fills what no mask covers)\n"
+    "  --layer-key NAME:F=PATH[,MASK]  tcia: a key of layer NAME only (repeatable): at frame F it\n"
+    "                          replaces the --key of that frame for the layer, so the layer's pixels\n"
+    "                          of the composite come out as painted; segments split there too\n"
     "  --layer-order O         depth (default: per frame, by the guide cache's depth) | given\n"
     "                          (the --layer order, first at the back)\n"
     "@TCIA@"
@@ -127,7 +130,9 @@ std::string stylize_help() {
   std::string text = kStylizeHelpText;
   text.replace(text.find("@WEIGHTS@"), 9, defaults);
   text.replace(text.find("@TCIA@"), 6, flags_help<TciaOptions>(tcia_option_table()));
-  text.replace(text.find("@LINES@"), 7, flags_help<TciaLineOptions>(tcia_line_option_table()));
+  text.replace(text.find("@LINES@"), 7,
+               flags_help<TciaLineOptions>(tcia_line_option_table()) +
+                   flags_help<TciaOrientationOptions>(tcia_orientation_option_table()));
   return text;
 }
 
@@ -156,10 +161,12 @@ struct Options {
   std::string method = "stylit";
   std::vector<KeyFile> keys;
   std::vector<LayerFile> layers;
+  std::vector<std::pair<std::string, KeyFile>> layer_keys;  // --layer-key, added to their layers
   std::optional<std::string> layer_order;
   std::optional<std::pair<int, int>> segment;
   TciaOptions tcia = default_tcia_options();
   TciaLineOptions lines;
+  TciaOrientationOptions orientation;
   std::vector<std::pair<std::string, std::string>> engine_flags;
   std::vector<std::string> tcia_flags;
   bool temporal_given = false;
@@ -182,7 +189,8 @@ bool set_engine_flag(Options& o, const std::string& flag, ArgReader& r) {
     return true;
   }
   if (!set_from_flag(o.tcia, tcia_option_table(), flag.substr(2), value) &&
-      !set_from_flag(o.lines, tcia_line_option_table(), flag.substr(2), value))
+      !set_from_flag(o.lines, tcia_line_option_table(), flag.substr(2), value) &&
+      !set_from_flag(o.orientation, tcia_orientation_option_table(), flag.substr(2), value))
     return false;
   o.tcia_flags.push_back(flag);
   return true;
@@ -243,6 +251,7 @@ Options parse(const Args& args) {
     else if (flag == "--method") o.method = r.value(flag);
     else if (flag == "--key") o.keys.push_back(parse_key(r.value(flag)));
     else if (flag == "--layer") o.layers.push_back(parse_layer(r.value(flag)));
+    else if (flag == "--layer-key") o.layer_keys.push_back(parse_layer_key(r.value(flag)));
     else if (flag == "--layer-order") o.layer_order = r.value(flag);
     else if (flag == "--segment") o.segment = parse_segment(r.value(flag));
     else if (flag == "--noise-map") o.noise_map = r.value(flag);
@@ -251,6 +260,7 @@ Options parse(const Args& args) {
     else if (!set_engine_flag(o, flag, r))
       throw ValueError(concat("unknown option '", flag, "' (see tempera stylize --help)"));
   }
+  add_layer_keys(o.layers, o.layer_keys);
   check_method(o);
   validate(o.stylit.synthesis);
   validate_fields(o.noisy, noisy_option_table());
@@ -489,7 +499,8 @@ int run_stylize(const Args& args) {
     config.stylit = o.stylit;
     config.resume = o.resume;
     if (o.method == "tcia") {
-      TciaJob job({config, o.keys, o.tcia, o.lines, o.layers, o.layer_order.value_or("depth"), o.segment});
+      TciaJob job({config, o.keys, o.tcia, o.lines, o.layers, o.layer_order.value_or("depth"), o.segment,
+                   o.orientation});
       for (const auto& w : job.warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
       if (!run_segments(job, o)) return interrupted_segments();
       if (!o.segment) write_extras(job.frames_job(), o);  // a segment is a farm task: the finish writes them

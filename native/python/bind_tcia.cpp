@@ -45,12 +45,20 @@ TciaJobConfig job_config(const py::dict& d, const TciaOptions& options) {
   }
   for (const auto& layer : d["layers"].cast<py::list>()) {
     const auto t = layer.cast<py::tuple>();
-    c.layers.push_back({t[0].cast<std::string>(), t[1].cast<std::string>(), t[2].is_none() ? "" : t[2].cast<std::string>()});
+    c.layers.push_back({t[0].cast<std::string>(), t[1].cast<std::string>(), t[2].is_none() ? "" : t[2].cast<std::string>(), {}});
+    if (t.size() > 3)  // the layer's own keys
+      for (const auto& key : t[3].cast<py::list>()) {
+        const auto k = key.cast<py::tuple>();
+        c.layers.back().keys.push_back(
+            {k[0].cast<int>(), k[1].cast<std::string>(), k[2].is_none() ? "" : k[2].cast<std::string>()});
+      }
   }
   c.layer_order = d["layer_order"].cast<std::string>();
   if (!d["segment"].is_none()) c.segment = d["segment"].cast<std::pair<int, int>>();
   c.tcia = options;
   py_bridge::set_from_dict(c.lines, tcia_line_option_table(), d["lines"].cast<py::dict>(), "line option");
+  py_bridge::set_from_dict(c.orientation, tcia_orientation_option_table(), d["orientation"].cast<py::dict>(),
+                           "orientation option");
   return c;
 }
 

@@ -11,6 +11,7 @@
 #include "tempera/file_keys.hpp"
 #include "tempera/image_io.hpp"
 #include "tempera/option_table.hpp"
+#include "tempera/orientation.hpp"
 #include "tempera/paths.hpp"
 #include "tempera/text_file.hpp"
 
@@ -28,6 +29,16 @@ std::vector<int> segment_bounds(const std::vector<int>& frames, const std::vecto
     if (k.frame > frames.front() && k.frame < frames.back()) bounds.push_back(k.frame);
   if (frames.back() != frames.front()) bounds.push_back(frames.back());
   return bounds;
+}
+
+// The shot's keys and the layers' own, sorted by frame (one per frame): the segments' bounds.
+std::vector<KeyFile> all_keys(const TciaJobConfig& c) {
+  std::vector<KeyFile> keys = c.keys;
+  for (const LayerFile& l : c.layers) keys.insert(keys.end(), l.keys.begin(), l.keys.end());
+  std::sort(keys.begin(), keys.end(), [](const KeyFile& a, const KeyFile& b) { return a.frame < b.frame; });
+  keys.erase(std::unique(keys.begin(), keys.end(), [](const KeyFile& a, const KeyFile& b) { return a.frame == b.frame; }),
+             keys.end());
+  return keys;
 }
 
 std::vector<TciaSegment> make_segments(const std::vector<int>& frames, const std::vector<KeyFile>& keys) {
@@ -108,6 +119,16 @@ Image read_key_mask(const KeyFile& k, int width, int height) {
   return out;
 }
 
+bool has_guide(const ImageFileInfo& info, const std::string& guide) {
+  return std::any_of(info.channel_names.begin(), info.channel_names.end(),
+                     [&](const std::string& c) { return c.rfind(guide + ".", 0) == 0; });
+}
+
+// O(I) of a guide frame: the angle of its structure tensor (orientation.hpp).
+Image tensor_angle(const GuideFrame& g) {
+  return extract_channels(orientation_from_tensor(g.get("tensor").view()).view(), 0, 1);
+}
+
 // D(S): the bounded distance to the painting's ink (eq. 9).
 Image ink_distance(const ImageView& style, const TciaLineOptions& o) {
   Image ink(style.width, style.height, 1);
@@ -152,7 +173,7 @@ KeyFile parse_key(const std::string& text) {
 // Options, keys and segments are checked before the per-frame job reads any file.
 TciaJob::TciaJob(TciaJobConfig config)
     : config_(checked(std::move(config))),
-      segments_(make_segments(config_.frames.frames, config_.keys)),
+      segments_(make_segments(config_.frames.frames, all_keys(config_))),
       selected_(select(segments_, config_.segment)),
       frames_(per_frame(config_)) {
   // Motion: a segment's frames link to their neighbours inside it; its first
@@ -162,33 +183,29 @@ TciaJob::TciaJob(TciaJobConfig config)
     for (int f = s.first; f <= s.last; ++f) {
       const std::string path = frames_.target_guides_path(f);
       const ImageFileInfo info = inspect_image(path);
-      if (config_.lines.weight > 0 &&
-          std::none_of(info.channel_names.begin(), info.channel_names.end(),
-                       [](const std::string& c) { return c.rfind("line_distance.", 0) == 0; }))
+      if (config_.lines.weight > 0 && !has_guide(info, "line_distance"))
         throw ValueError(concat("the line term (--lines) needs 'line_distance' in '", path, "'"));
-      for (int m = f == s.first ? 2 : 0; m < (f == s.last ? 2 : 4); ++m) {
-        const std::string guide = kMotion[m];
-        const bool has = std::any_of(info.channel_names.begin(), info.channel_names.end(),
-                                     [&](const std::string& c) { return c.rfind(guide + ".", 0) == 0; });
-        if (!has)
-          throw ValueError(concat("the coherent method needs '", guide, "' in '", path,
+      if (config_.orientation.from_cache && !has_guide(info, "tensor"))
+        throw ValueError(concat("--orientation needs the structure tensor 'tensor' in '", path, "'"));
+      for (int m = f == s.first ? 2 : 0; m < (f == s.last ? 2 : 4); ++m)
+        if (!has_guide(info, kMotion[m]))
+          throw ValueError(concat("the coherent method needs '", kMotion[m], "' in '", path,
                                   "' (render the guides with motion)"));
-      }
     }
   }
-  for (const KeyFile& k : config_.keys) {
-    paintings_.emplace_back(), masks_.emplace_back();
-    if (!is_read(k.frame)) continue;  // outside the one segment run
-    const ImageFileInfo info = inspect_image(frames_.target_guides_path(k.frame));
-    paintings_.back() = read_key_painting(k, frames_.style().channels(), info.width, info.height);
-    masks_.back() = read_key_mask(k, info.width, info.height);
-  }
+  if (config_.orientation.from_cache && !has_guide(inspect_image(frames_.exemplar_path()), "tensor"))
+    throw ValueError(concat("--orientation needs the structure tensor 'tensor' in the exemplar's guides '",
+                            frames_.exemplar_path(), "'"));
+  read_keys(config_.keys, paintings_, masks_);
+  for (const LayerFile& l : config_.layers)
+    read_keys(l.keys, layer_key_paintings_.emplace_back(), layer_key_masks_.emplace_back());
   std::ostringstream s;
   s << kRecordFormat << ";weights=";
   for (const auto& [name, weight] : active_guides(config_.frames.stylit)) s << name << ":" << weight << ",";
   s << ";" << settings_text(config_.tcia, tcia_option_table())
     << settings_text(config_.tcia.synthesis, synthesis_option_table())
-    << settings_text(config_.lines, tcia_line_option_table()) << "format=" << config_.frames.format << ";"
+    << settings_text(config_.lines, tcia_line_option_table())
+    << settings_text(config_.orientation, tcia_orientation_option_table()) << "format=" << config_.frames.format << ";"
     << file_stamp(config_.frames.style) << ";" << file_stamp(frames_.exemplar_path());
   settings_ = s.str();
   check_layers();
@@ -200,11 +217,24 @@ TciaJobConfig TciaJob::checked(TciaJobConfig c) {
   check_frames(c.frames.frames);
   validate_fields(c.tcia, tcia_option_table());
   validate_fields(c.lines, tcia_line_option_table());
+  validate_fields(c.orientation, tcia_orientation_option_table());
   validate(c.tcia.synthesis);
   if (c.layer_order != "depth" && c.layer_order != "given")
     throw ValueError(concat("the layer order must be 'depth' or 'given', got '", c.layer_order, "'"));
   c.keys = sorted_keys(std::move(c.keys), c.frames.frames);
+  for (LayerFile& l : c.layers) l.keys = sorted_keys(std::move(l.keys), c.frames.frames);
   return c;
+}
+
+void TciaJob::read_keys(const std::vector<KeyFile>& keys, std::vector<Image>& paintings,
+                        std::vector<Image>& masks) const {
+  for (const KeyFile& k : keys) {
+    paintings.emplace_back(), masks.emplace_back();
+    if (!is_read(k.frame)) continue;  // outside the one segment run
+    const ImageFileInfo info = inspect_image(frames_.target_guides_path(k.frame));
+    paintings.back() = read_key_painting(k, frames_.style().channels(), info.width, info.height);
+    masks.back() = read_key_mask(k, info.width, info.height);
+  }
 }
 
 bool TciaJob::is_read(int frame) const {
@@ -282,15 +312,20 @@ Shot TciaJob::load_shot(const TciaSegment& segment, std::deque<Image>& keep) con
     shot.style_guides.push_back(keep.emplace_back(ink_distance(frames_.style().view(), config_.lines)).view());
     shot.guide_weights.push_back(config_.lines.weight);
   }
+  const bool oriented = config_.orientation.from_cache;
+  if (oriented)
+    shot.style_orientation = keep.emplace_back(tensor_angle(GuideFrame::read(frames_.exemplar_path(), {"tensor"}))).view();
   for (int f = segment.first; f <= segment.last; ++f) {
     std::vector<std::string> wanted = names;
     if (lines) wanted.push_back("line_distance");
+    if (oriented) wanted.push_back("tensor");
     const int from = f == segment.first ? 2 : 0, to = f == segment.last ? 2 : 4;
     for (int m = from; m < to; ++m) wanted.push_back(kMotion[m]);
     const GuideFrame g = GuideFrame::read(frames_.target_guides_path(f), wanted);
     ShotFrame frame;
     for (const auto& name : names) frame.guides.push_back(keep.emplace_back(tonemap_guide(g.get(name).view())).view());
     if (lines) frame.guides.push_back(keep.emplace_back(Image::copy_of(g.get("line_distance").view())).view());
+    if (oriented) frame.orientation = keep.emplace_back(tensor_angle(g)).view();
     const Image& first = g.get(names.front());
     ImageView* motion[] = {&frame.velocity_backward, &frame.occlusion_backward, &frame.velocity_forward,
                            &frame.occlusion_forward};

@@ -65,6 +65,22 @@ LayerFile parse_layer(const std::string& text) {
   return l;
 }
 
+std::pair<std::string, KeyFile> parse_layer_key(const std::string& text) {
+  const std::size_t colon = text.find(':');
+  if (colon == std::string::npos || colon == 0)
+    throw ValueError(concat("--layer-key expects NAME:FRAME=PAINTING[,MASK], got '", text, "'"));
+  return {text.substr(0, colon), parse_key(text.substr(colon + 1))};
+}
+
+void add_layer_keys(std::vector<LayerFile>& layers, const std::vector<std::pair<std::string, KeyFile>>& keys) {
+  for (const auto& [name, key] : keys) {
+    auto layer = std::find_if(layers.begin(), layers.end(), [&](const LayerFile& l) { return l.name == name; });
+    if (layer == layers.end())
+      throw ValueError(concat("--layer-key names layer '", name, "', which no --layer gives"));
+    layer->keys.push_back(key);
+  }
+}
+
 std::string TciaJob::layer_path(std::size_t layer, int frame) const {
   return (fs::path(config_.frames.out) / "layers" / config_.layers.at(layer).name /
           fs::path(frames_.output_path(frame)).filename())
@@ -78,11 +94,32 @@ std::string TciaJob::layer_record_path(std::size_t index, std::size_t layer) con
       .string();
 }
 
-// What one layer's frames depend on: the segment's inputs, its mask guide and its painting.
+// What one layer's frames depend on: the segment's inputs, its mask guide,
+// its painting and its own keys at the segment's bounds.
 std::string TciaJob::layer_key(const TciaSegment& segment, std::size_t layer) const {
   const LayerFile& l = config_.layers[layer];
-  return hash_hex(concat(segment_key(segment), "\nlayer ", l.name, " ", l.mask, " ",
-                         l.painting.empty() ? "shared" : file_stamp(l.painting)));
+  std::string text = concat(segment_key(segment), "\nlayer ", l.name, " ", l.mask, " ",
+                            l.painting.empty() ? "shared" : file_stamp(l.painting));
+  for (const KeyFile& k : l.keys)
+    if (k.frame == segment.first || k.frame == segment.last)
+      text += concat("\nkey ", k.frame, " ", file_stamp(k.painting), " ", k.mask.empty() ? "" : file_stamp(k.mask));
+  return hash_hex(text);
+}
+
+// The segment's shot with the layer's own keys in place of the shot's at their frames.
+Shot TciaJob::with_layer_keys(const Shot& shot, const TciaSegment& segment, std::size_t layer) const {
+  const LayerFile& l = config_.layers[layer];
+  Shot out = shot;
+  for (std::size_t k = 0; k < l.keys.size(); ++k) {
+    const int f = l.keys[k].frame;
+    if (f != segment.first && f != segment.last) continue;
+    const int t = f - segment.first;
+    out.keys.erase(std::remove_if(out.keys.begin(), out.keys.end(), [&](const ShotKey& s) { return s.frame == t; }),
+                   out.keys.end());
+    out.keys.push_back(ShotKey{t, layer_key_paintings_[layer][k].view(), layer_key_masks_[layer][k].view()});
+  }
+  std::sort(out.keys.begin(), out.keys.end(), [](const ShotKey& a, const ShotKey& b) { return a.frame < b.frame; });
+  return out;
 }
 
 // The layer's part of the exemplar render: its mask guide in the exemplar's
@@ -158,7 +195,8 @@ std::vector<Image> TciaJob::run_layers(std::size_t index, const Shot& shot, cons
         here.fraction = (double(l) + p.fraction) / double(n);
         return sweeps(here);
       };
-    const std::vector<Image> images = stylize_shot_sweeps(layer_shot(shot, layer, keep), config_.tcia, progress);
+    const Shot own = with_layer_keys(shot, segment, l);
+    const std::vector<Image> images = stylize_shot_sweeps(layer_shot(own, layer, keep), config_.tcia, progress);
     std::error_code ec;
     fs::create_directories(fs::path(files.front()).parent_path(), ec);
     for (std::size_t i = 0; i < files.size(); ++i) {

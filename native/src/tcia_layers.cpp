@@ -67,6 +67,7 @@ Shot layer_shot(const Shot& shot, const ShotLayer& layer, std::deque<Image>& kee
     ShotFrame& f = out.frames[t];
     for (ImageView* v : {&f.velocity_backward, &f.velocity_forward}) *v = keep.emplace_back(pick_nearest(*v, nearest)).view();
     for (ImageView& g : f.guides) g = keep.emplace_back(pick_nearest(g, nearest)).view();
+    if (!f.orientation.empty()) f.orientation = keep.emplace_back(pick_nearest(f.orientation, nearest)).view();
   }
   // χ of the layer alone, from its own (extrapolated) motion; the shot's
   // ends keep theirs (no neighbour there).

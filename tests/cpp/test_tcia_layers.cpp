@@ -172,6 +172,34 @@ TEST(TciaLayers, ExtrapolatedMotionCarriesTheBorderWithItsLayer) {
   EXPECT_GT(plain_square, 4 * square);
 }
 
+TEST(TciaLayers, OrientationIsExtendedPastTheOutlineLikeTheGuides) {
+  // The square's field is 1 rad, the background's 0: in the square's layer
+  // every pixel takes the nearest square pixel's 1; the background's layer
+  // keeps 0 where the square is not.
+  SquareOverBackground s(2);
+  std::vector<Image> angle;
+  for (int t = 0; t < s.frames; ++t) {
+    Image a(s.W, s.H, 1, 0.0f);
+    for (int y = 0; y < s.H; ++y)
+      for (int x = 0; x < s.W; ++x)
+        if (s.inside(x, y, t)) a.at(x, y, 0) = 1.0f;
+    angle.push_back(std::move(a));
+  }
+  for (int t = 0; t < s.frames; ++t) s.shot.frames[std::size_t(t)].orientation = angle[std::size_t(t)].view();
+  std::deque<Image> keep;
+  const Shot square = layer_shot(s.shot, s.layer("square", s.fg_mask), keep);
+  const Shot background = layer_shot(s.shot, s.layer("background", s.bg_mask), keep);
+  for (int t = 0; t < s.frames; ++t) {
+    const ImageView& a = square.frames[std::size_t(t)].orientation;
+    const ImageView& b = background.frames[std::size_t(t)].orientation;
+    for (int y = 0; y < s.H; ++y)
+      for (int x = 0; x < s.W; ++x) {
+        EXPECT_EQ(a.pixel(x, y)[0], 1.0f) << x << "," << y;
+        EXPECT_EQ(b.pixel(x, y)[0], 0.0f) << x << "," << y;
+      }
+  }
+}
+
 TEST(TciaLayers, CompositeIsEachLayerWhereMasksAreExclusive) {
   const SquareOverBackground s(3);
   const LayerRun r = run_layers(s, true);

@@ -118,3 +118,57 @@ def test_bad_layers_name_the_problem(cli_path, shot, extra, message):
     result = stylize(cli_path, *args(shot, "bad", *extra))
     assert result.returncode == 2 and message in result.stderr, result.stderr
     assert not (shot / "bad" / "frames" / "layers").exists()
+
+
+def _key_painting(p):
+    """A key for frame 3 that differs from anything the sweeps make alone: the
+    blob's painting rolled and flipped, at the frames' size."""
+    path = p / "key3.png"
+    if not path.is_file():
+        paint = tempera.read_image(str(p / "paint.png"))
+        tempera.write_image(str(path), np.roll(paint, 9, axis=1)[::-1].copy())
+    return path
+
+
+def test_a_shot_key_survives_the_layer_composite(cli_path, shot):
+    """Overpaint kept: with layers, the key frame's composite is the painting
+    (within 1/255) on every painted pixel, and the frame after it still
+    differs from it (the key is not copied forward)."""
+    key = _key_painting(shot)
+    result = stylize(cli_path, *args(shot, "layered_key", *layers(shot), "--key", f"3={key}"))
+    assert result.returncode == 0, result.stderr
+    assert "2 segment(s) stylized" in result.stdout, result.stdout
+    painting = tempera.read_image(str(key))[:, :, :3]
+    out = tempera.read_image(str(shot / "layered_key" / "frames" / "frame_0003.png"))[:, :, :3]
+    assert np.abs(out - painting).max() <= 1 / 255 + 1e-6
+    after = tempera.read_image(str(shot / "layered_key" / "frames" / "frame_0004.png"))[:, :, :3]
+    assert np.abs(after - painting).mean() > 0.02
+
+
+def test_a_layer_key_paints_only_its_layer(cli_path, shot):
+    """--layer-key blob:3=...: the blob's own key. At frame 3 the composite is
+    the painting on the blob's pixels (within 1/255: the blob is in front),
+    the rest keeps its own solve (no key there), and the shot splits at 3."""
+    key = _key_painting(shot)
+    result = stylize(cli_path, *args(shot, "layer_key", *layers(shot), "--layer-key", f"blob:3={key}"))
+    assert result.returncode == 0, result.stderr
+    assert "2 segment(s) stylized" in result.stdout, result.stdout
+    painting = tempera.read_image(str(key))[:, :, :3]
+    out = tempera.read_image(str(shot / "layer_key" / "frames" / "frame_0003.png"))[:, :, :3]
+    blob = layer_masks(START + SPEED * 2)["mask.CO_Blob"] == 1
+    assert blob.sum() > 50
+    assert np.abs(out[blob] - painting[blob]).max() <= 1 / 255 + 1e-6
+    assert np.abs(out[~blob] - painting[~blob]).mean() > 0.02  # not a shot-wide key
+    run_layered(cli_path, shot)  # the same layers without the layer key: the blob is not the painting
+    plain = tempera.read_image(str(shot / "layered" / "frames" / "frame_0003.png"))[:, :, :3]
+    assert np.abs(plain[blob] - painting[blob]).mean() > 0.02
+
+
+@pytest.mark.parametrize("value, message", [
+    ("blob3=k.png", "--layer-key expects NAME:FRAME=PAINTING[,MASK]"),
+    ("nobody:3=KEY", "--layer-key names layer 'nobody', which no --layer gives"),
+])
+def test_bad_layer_keys_name_the_problem(cli_path, shot, value, message):
+    result = stylize(cli_path, *args(shot, "bad_layer_key", *layers(shot), "--layer-key",
+                                     value.replace("KEY", str(_key_painting(shot)))))
+    assert result.returncode == 2 and message in result.stderr, result.stderr

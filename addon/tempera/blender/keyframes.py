@@ -62,13 +62,16 @@ def add_key(settings, frame, painting, mask=""):
     return settings.keyframe_index
 
 
-def key_list(settings):
+def key_list(settings, layer=None):
     """[(frame, painting path, mask path or None), ...] in frame order, for
-    tempera.tcia.ShotJob. Keys painted in Blender are saved first."""
+    tempera.tcia.ShotJob: the keys of the whole frame, or those of the
+    layer `layer` (a collection). Keys painted in Blender are saved first."""
     from .stylize_operator import resolve_path
 
     keys = []
     for key in settings.keyframes:
+        if key.layer != layer:
+            continue
         painting = resolve_path(key.painting, f"painting of keyframe {key.frame}")
         for image in bpy.data.images:
             if image.is_dirty and image.filepath and os.path.normpath(bpy.path.abspath(image.filepath)) == painting:
@@ -77,7 +80,8 @@ def key_list(settings):
         keys.append((key.frame, painting, mask))
     frames = [k[0] for k in keys]
     if len(set(frames)) != len(frames):
-        raise ValueError("Two keyframes are of the same frame: remove one from the Keyframes list.")
+        whose = "" if layer is None else f" of layer '{layer.name}'"
+        raise ValueError(f"Two keyframes{whose} are of the same frame: remove one from the Keyframes list.")
     return sorted(keys)
 
 

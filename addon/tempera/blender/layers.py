@@ -16,10 +16,18 @@ def layer_name(collection_name):
     return re.sub(r"[^A-Za-z0-9_.-]", "_", collection_name).strip(".") or "layer"
 
 
-def layer_list(settings):
-    """[(name, mask guide, painting path or None), ...] for tempera.tcia.ShotJob,
-    in list order (the first at the back when the order is 'given')."""
+def layer_list(settings, frames=None):
+    """[(name, mask guide, painting path or None, its own keys), ...] for
+    tempera.tcia.ShotJob, in list order (the first at the back when the
+    order is 'given'); keys only of `frames` (first, last) when given."""
+    from .keyframes import key_list
     from .stylize_operator import resolve_path
+
+    listed = {layer.collection for layer in settings.tcia_layers}
+    for key in settings.keyframes:
+        if key.layer is not None and key.layer not in listed:
+            raise ValueError(f"Keyframe {key.frame} is of the collection '{key.layer.name}', which is not in the "
+                             "Layers list: add it there or clear the key's Layer.")
 
     out, names = [], set()
     for i, layer in enumerate(settings.tcia_layers):
@@ -32,7 +40,8 @@ def layer_list(settings):
                              "cannot have): remove or rename one.")
         names.add(name)
         painting = resolve_path(layer.painting, f"painting of layer '{name}'") if layer.painting.strip() else None
-        out.append((name, guide_cache.mask_guide("CO", layer.collection.name), painting))
+        keys = [k for k in key_list(settings, layer.collection) if frames is None or frames[0] <= k[0] <= frames[1]]
+        out.append((name, guide_cache.mask_guide("CO", layer.collection.name), painting, keys))
     return out
 
 

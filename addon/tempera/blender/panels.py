@@ -250,8 +250,11 @@ def draw_keyframes(box, settings):
         col = box.column(align=True)
         col.prop(key, "painting")
         col.prop(key, "mask")
+        if len(settings.tcia_layers):
+            col.prop(key, "layer")
     box.prop(settings, "keyframe_dir")
     box.prop(settings, "line_weight")
+    box.prop(settings, "tcia_orientation")
     draw_layers(box, settings)
 
 

@@ -160,6 +160,9 @@ class TemperaKeyframe(PropertyGroup):
                              description="The painted frame (the frame's size); '//' is relative to the .blend file")
     mask: StringProperty(name="Mask", subtype="FILE_PATH", default="",
                          description="Optional: where the key is painted (white); empty: the whole frame")
+    layer: PointerProperty(name="Layer", type=bpy.types.Collection,
+                           description="Optional: the key of this layer only (a collection of the Layers list); "
+                           "empty: a key of the whole frame")
 
 
 class TemperaLayer(PropertyGroup):
@@ -365,6 +368,11 @@ class TemperaSettings(PropertyGroup):
         description="For line paintings (ink on paper): pulls the painting's ink onto the scene's lines (the "
         "guide cache's line distance, Bénard 2013 eq. 9); 0 = off, 4 typical",
         default=0.0, min=0.0, soft_max=10.0)
+    tcia_orientation: BoolProperty(
+        name="Orientation from Guides",
+        description="Patches turn with the guide cache's orientation (the render's structure, or your "
+        "Orientation AOV), so strokes follow the surfaces (Bénard 2013 §3.1); needs the exemplar's too",
+        default=False)
     tcia_layers: CollectionProperty(type=TemperaLayer, name="Layers")
     tcia_layer_index: IntProperty(name="Active Layer", default=0, min=0)
     tcia_layer_order: EnumProperty(name="Layer Order", items=LAYER_ORDERS, default="depth",

@@ -298,10 +298,12 @@ class CoherentRun(StylizeRun):
         super().__init__(scene, frames, mode)
         require_consecutive(self.frames, "The coherent method")
         self.keys = [k for k in key_list(scene.tempera) if self.frames[0] <= k[0] <= self.frames[-1]]
-        self.segments = tcia.segments(self.frames, [k[0] for k in self.keys])
+        self.layers = layer_list(scene.tempera, (self.frames[0], self.frames[-1]))
+        layer_keys = [k[0] for layer in self.layers for k in layer[3]]
+        self.segments = tcia.segments(self.frames, [k[0] for k in self.keys] + layer_keys)
         self.segment_results = []
         self.line_weight = float(scene.tempera.line_weight)
-        self.layers = layer_list(scene.tempera)
+        self.orientation = bool(scene.tempera.tcia_orientation)
         self.layer_order = scene.tempera.tcia_layer_order
         if self.layers:  # their collections' masks
             self.guides.params["masks"] = guide_cache.masks_including(self.guides.params["masks"], "CO")
@@ -319,7 +321,7 @@ class CoherentRun(StylizeRun):
                                exemplar_frame=c.get("exemplar_frame"), keys=self.keys, weights=c["weights"],
                                format=c["format"], seed=c["seed"],
                                lines={"weight": self.line_weight, "d_max": self.guides.params["line_d_max"]},
-                               layers=self.layers, layer_order=self.layer_order)
+                               layers=self.layers, layer_order=self.layer_order, orientation=self.orientation)
             self.warnings = list(self.job.warnings)
         i = self.index - len(self.frames)
         started = time.monotonic()

@@ -33,12 +33,23 @@ KeyFile parse_key(const std::string& text);
 // own painting over the shared exemplar render (empty = the shared one).
 // When the exemplar's guide cache has the same mask (covering at least a
 // patch's area), the layer's matches come only from there (§4).
+// A layer may have keys of its own (§4: each layer painted apart): at its
+// key frames they replace the shot's keys for that layer, so the layer's
+// pixels of the composite come out as its painting. Segments split at
+// every key, the shot's and the layers'.
 struct LayerFile {
   std::string name, mask, painting;
+  std::vector<KeyFile> keys;
 };
 
 // "suit=mask.CO_Suit" or "suit=mask.CO_Suit,suit.png" (the CLI's --layer); ValueError naming the text.
 LayerFile parse_layer(const std::string& text);
+
+// "suit:12=key.png[,mask.png]" (the CLI's --layer-key): the layer's name and its key; ValueError naming the text.
+std::pair<std::string, KeyFile> parse_layer_key(const std::string& text);
+
+// Adds each (layer name, key) to its layer; ValueError naming a layer that is not given.
+void add_layer_keys(std::vector<LayerFile>& layers, const std::vector<std::pair<std::string, KeyFile>>& keys);
 
 // The distance-transform term for line exemplars (eq. 9): one more guide
 // pair, D(S) of the painting's ink against the guide cache's line_distance
@@ -60,6 +71,23 @@ inline const auto& tcia_line_option_table() {
   return table;
 }
 
+// Orientation (§3.1) from the guide cache: each frame's and the exemplar's
+// `tensor` guide (the structure tensor of the render, or of the artist's
+// orientation AOV when the cache was rendered with one) gives O(I_t) and
+// O(S), so patches are compared rotated and hatching follows the frame.
+struct TciaOrientationOptions {
+  bool from_cache = false;
+};
+
+inline const auto& tcia_orientation_option_table() {
+  using T = TciaOrientationOptions;
+  static const auto table = std::make_tuple(field(
+      &T::from_cache, "from_cache", "orientation",
+      "patches turn with the guide cache's orientation (its tensor: the render's structure or the artist's "
+      "orientation AOV), so strokes follow the surfaces (off)"));
+  return table;
+}
+
 struct TciaJobConfig {
   StylizeJobConfig frames;  // painting, guide caches, frames (consecutive), output, guide weights
   std::vector<KeyFile> keys;
@@ -75,6 +103,7 @@ struct TciaJobConfig {
   // and bounding keys are read. ValueError listing the shot's segments if
   // A-B is not one.
   std::optional<std::pair<int, int>> segment;
+  TciaOrientationOptions orientation;
 };
 
 // Frames first..last (inclusive) are solved together; the segment writes
@@ -131,6 +160,8 @@ class TciaJob {
 
   static TciaJobConfig checked(TciaJobConfig config);  // frames consecutive, keys sorted and in the shot
   bool is_read(int frame) const;                       // in the frames this job reads
+  // Each key's painting and mask (empty outside the frames read, and for a whole key).
+  void read_keys(const std::vector<KeyFile>& keys, std::vector<Image>& paintings, std::vector<Image>& masks) const;
 
   TciaJobConfig config_;
   std::vector<TciaSegment> segments_;
@@ -139,6 +170,8 @@ class TciaJob {
   std::vector<Image> paintings_, masks_;  // per key (masks_ empty for a whole key)
   std::vector<Image> layer_paintings_;    // per layer (empty: the shared painting)
   std::vector<Image> layer_style_masks_;  // per layer: its part of the exemplar (empty: all of it)
+  std::vector<std::vector<Image>> layer_key_paintings_, layer_key_masks_;  // per layer, per own key
+  Shot with_layer_keys(const Shot& shot, const TciaSegment& segment, std::size_t layer) const;
   std::string settings_;
 };
 

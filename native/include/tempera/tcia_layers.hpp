@@ -9,9 +9,9 @@
 //    border, and paint beyond it, then moves with the layer instead of with
 //    whatever is behind it. χ± are recomputed from the extrapolated fields,
 //    so a layer's background is not disoccluded by the other layers. The
-//    frame's guides are extended the same way: the layer's background looks
-//    like the layer's border (as if it were rendered alone), so guides and
-//    motion agree there.
+//    frame's guides (and its orientation field) are extended the same way:
+//    the layer's background looks like the layer's border (as if it were
+//    rendered alone), so guides and motion agree there.
 //  - The layers' frames are composited back to front, each over the ones
 //    behind with its mask as alpha, the back-most layer opaque (it fills
 //    what no mask covers). The order is the given one, or per frame by the
