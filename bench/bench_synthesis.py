@@ -265,8 +265,10 @@ def main():
                      "guide_variance": args.guide_variance, "threads": args.threads, "seed": args.seed,
                      "feature_precision": args.feature_precision or "default"},
         "guide_channels_matched": stats["guide_channels"],
-        "levels": [{k: l[k] for k in ("width", "height", "search_seconds", "usage_seconds", "vote_seconds",
-                                      "usage_rounds", "reversed_coverage", "energy")} for l in stats["levels"]],
+        # usage_wide_searches: absent in builds before it was counted (--compare).
+        "levels": [{k: getattr(l, k) for k in ("width", "height", "search_seconds", "usage_seconds", "vote_seconds",
+                                               "usage_rounds", "usage_wide_searches", "reversed_coverage", "energy")
+                    if hasattr(l, k)} for l in stats["levels"]],
         "source_coverage": stats["source_coverage"],
         "machine": f"{platform.processor() or platform.machine()}, {__import__('os').cpu_count()} cores",
         "tempera": tempera.__version__,

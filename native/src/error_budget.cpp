@@ -110,6 +110,7 @@ UsageStats retrieve_with_budget(const PatchSpace& space, const SearchConstraints
     if (taken == 0) break;
   }
   stats.covered = double(rr.assigned_count()) / double(std::max<std::size_t>(1, rr.active()));
+  stats.wide_searches = rr.wide_searches();
   return stats;  // targets not covered keep their forward match
 }
 

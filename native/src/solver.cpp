@@ -748,6 +748,7 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
     for (const auto& t : terms_) {
       const UsageStats us = t->reassign(context, field, stream);
       stats.usage_rounds += us.rounds;
+      stats.usage_wide_searches += us.wide_searches;
       if (us.rounds > 0) stats.reversed_coverage = us.covered;
     }
     stats.usage_seconds += seconds_since(t0);

@@ -55,6 +55,7 @@ UsageStats retrieve_uniform(const PatchSpace& space, const SearchConstraints& co
     if (taken == 0) throw ValueError("internal: uniform retrieval stalled with targets left");
   }
   stats.covered = double(rr.assigned_count()) / double(std::max<std::size_t>(1, rr.active()));
+  stats.wide_searches = rr.wide_searches();
   return stats;
 }
 

@@ -183,6 +183,24 @@ TEST(Synthesis, BudgetFillsTheYellowRegionWithYellow) {
   EXPECT_GT(c.blue_in_yellow(uniform.image), 0.3);
 }
 
+// The bench reports how many sources reversed retrieval seeded at random (the
+// whole-frame search, most of a round's cost): at least one per level that
+// ran rounds, at most one per source and round, none without retrieval.
+TEST(Synthesis, ReversedRetrievalCountsItsWideSearches) {
+  BlueYellowCase c;
+  SynthesisInput in;
+  in.style = c.style.view();
+  in.guides.add("g", c.src_guide.view(), c.tgt_guide.view(), 2.0f);
+  const SynthesisResult budget = synthesize(in, fast_options(PatchUsage::Budget));
+  for (const LevelStats& l : budget.levels) {
+    ASSERT_GT(l.usage_rounds, 0);
+    EXPECT_GT(l.usage_wide_searches, 0u) << l.width;
+    EXPECT_LE(l.usage_wide_searches, std::size_t(l.usage_rounds) * std::size_t(l.width) * l.height) << l.width;
+  }
+  for (const LevelStats& l : synthesize(in, fast_options(PatchUsage::None)).levels)
+    EXPECT_EQ(l.usage_wide_searches, 0u);
+}
+
 TEST(Synthesis, RotatedPatchesFollowTheTargetOrientation) {
   // Horizontal stripes (constant along x) in the exemplar, orientation 0.
   Image style(64, 64, 1);

@@ -36,6 +36,7 @@ struct LevelContext {
 struct UsageStats {
   int rounds = 0;
   double covered = 0.0;  // fraction of active targets placed by reversed retrieval
+  std::size_t wide_searches = 0;  // sources seeded at random, searched over the whole frame
 };
 
 // What a term keeps across the EM iterations of one level solve (terms

@@ -60,6 +60,9 @@ class ReversedRetrieval {
   std::size_t assigned_count() const { return assigned_count_; }
   const std::vector<std::int32_t>& candidate() const { return candidate_; }
   const std::vector<float>& candidate_dist() const { return candidate_dist_; }
+  // Sources seeded with a random target so far (each searched over the whole
+  // frame: the costly part of a round).
+  std::size_t wide_searches() const { return wide_searches_; }
 
   // One round of retrieval: fills candidates for eligible sources and returns
   // the collision-free (best source per target) assignments, in target order.
@@ -146,6 +149,7 @@ class ReversedRetrieval {
         wide_search_[p] = 1;
       }
     });
+    wide_searches_ += std::size_t(std::count(wide_search_.begin(), wide_search_.end(), std::uint8_t(1)));
   }
 
   void prefetch_target(int qx, int qy) const {
@@ -260,7 +264,7 @@ class ReversedRetrieval {
   std::vector<std::int32_t> candidate_;
   std::vector<float> candidate_dist_;
   std::vector<std::vector<std::int32_t>> unassigned_;
-  std::size_t active_ = 0, assigned_count_ = 0;
+  std::size_t active_ = 0, assigned_count_ = 0, wide_searches_ = 0;
 };
 
 }  // namespace tempera

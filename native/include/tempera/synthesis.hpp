@@ -61,6 +61,7 @@ struct LevelStats {
   std::vector<double> energy;  // mean patch distance after each search
   double search_seconds = 0, usage_seconds = 0, vote_seconds = 0;
   int usage_rounds = 0;
+  std::size_t usage_wide_searches = 0;  // reversed retrieval's sources seeded at random (whole-frame search)
   double reversed_coverage = 0;  // fraction of targets placed by reversed retrieval (last iteration)
   double source_coverage = 0;    // fraction of valid source patches used at the end
 };
