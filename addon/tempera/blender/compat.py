@@ -184,9 +184,9 @@ def cycles_closure_model():
     """Which microfacet closures this Cycles renders, as the tracer's
     closure_model: Cycles 4.0 rewrote them (height-correlated Smith
     shadowing; rough glass as one closure with the Fresnel of each
-    microfacet). The Sharp distribution left the Glossy BSDF in the same
-    release, so its absence tells them apart."""
-    cycles4 = "SHARP" not in _enum_ids(bpy.types.ShaderNodeBsdfGlossy, "distribution")
+    microfacet). No RNA property of a registered type tells them apart (the
+    node types are not in bpy.types until a node exists), so the version does."""
+    cycles4 = bpy.app.version >= (4, 0, 0)
     return {"height_correlated_shadowing": cycles4, "microfacet_glass_fresnel": cycles4}
 
 
