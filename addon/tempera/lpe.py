@@ -257,6 +257,11 @@ def scene_from_dict(scene: dict):
             s.world_rotation = [float(x) for x in rotation.ravel()]
         w.finish()
     s.camera = _camera(r.required("camera"))
+    if r.has("closure_model"):  # which Cycles' microfacets: {"height_correlated_shadowing": bool, ...}
+        c = _Reader(r.required("closure_model"), "scene closure_model")
+        for key in ("height_correlated_shadowing", "microfacet_glass_fresnel"):
+            setattr(s.closure_model, key, bool(c.get(key, False)))
+        c.finish()
     r.finish()
     return s
 

@@ -214,6 +214,13 @@ void bind_scene_types(py::module_& m) {
       .def_readwrite("clip_start", &Camera::clip_start)
       .def_readwrite("clip_end", &Camera::clip_end);
 
+  py::class_<ClosureModel>(m, "ClosureModel", "Which Cycles' microfacet closures to render (3.x's by default).")
+      .def(py::init<>())
+      .def_readwrite("height_correlated_shadowing", &ClosureModel::height_correlated_shadowing,
+                     "Smith shadowing 1 / (1 + Lambda(i) + Lambda(o)) (Cycles 4.0+) instead of G1(i) G1(o)")
+      .def_readwrite("microfacet_glass_fresnel", &ClosureModel::microfacet_glass_fresnel,
+                     "rough glass weighted by the Fresnel of each microfacet (Cycles 4.0+), not of the normal");
+
   py::class_<Scene> scene(m, "Scene", "The tracer's scene: triangles, materials, lights, world and camera.");
   scene.def(py::init<>())
       .def_property(
@@ -296,6 +303,7 @@ void bind_scene_types(py::module_& m) {
       .def_readwrite("world_rotation", &Scene::world_rotation, "row-major 3x3 turning world directions into the map's")
       .def_readwrite("world_visibility", &Scene::world_visibility, "bits of the rays that see the world")
       .def_readwrite("camera", &Scene::camera)
+      .def_readwrite("closure_model", &Scene::closure_model)
       .def("validate", &validate_scene, "Raise ValueError naming the first problem of the scene.");
   float3_field(scene, "world_radiance", &Scene::world_radiance);
 }

@@ -525,6 +525,63 @@ TEST(Tracer, RoughGlassSphereInAFurnaceLosesLittleEnergy) {
   }
 }
 
+// A white rough sphere in a white world seen whole: what it reflects once (LSE).
+double furnace_glossy(float roughness, bool correlated, bool beckmann) {
+  Scene s;
+  Closure g = closure(Closure::Type::glossy, {1, 1, 1}, roughness);
+  if (beckmann) g.distribution = Closure::Distribution::beckmann;
+  s.materials = {of({g})};
+  add_sphere(s, {0, 0, 0}, 1, 0);
+  s.world_radiance = {1, 1, 1};
+  s.camera = top_camera(5, 1.4f, 16);  // the sphere out to sin = 0.7: grazing views included
+  s.closure_model.height_correlated_shadowing = correlated;
+  TraceOptions o = options(256);
+  o.max_bounces = 1;
+  return mean(trace_lpe(s, {"LSE"}, o).images[0]);
+}
+
+TEST(Tracer, HeightCorrelatedShadowingLosesLessEnergy) {
+  // Cycles 4.0's Smith shadowing 1 / (1 + Lambda(i) + Lambda(o)) is never below
+  // 3.x's G1(i) G1(o) (they differ by Lambda(i) Lambda(o), second order in
+  // alpha): at roughness 0.9 GGX's single-scattering albedo rises by about 2 %
+  // (Beckmann's Lambda is 0 beyond a = 1.6, so it gains less), yet stays at most 1.
+  for (const bool beckmann : {false, true}) {
+    const double separable = furnace_glossy(0.9f, false, beckmann);
+    const double correlated = furnace_glossy(0.9f, true, beckmann);
+    EXPECT_GT(correlated, separable * (beckmann ? 1.0 : 1.01)) << beckmann;
+    EXPECT_LT(correlated, 1.01) << beckmann;
+  }
+  // Nearly smooth, nothing is shadowed in either model.
+  EXPECT_NEAR(furnace_glossy(0.05f, true, false), furnace_glossy(0.05f, false, false), 0.01);
+}
+
+TEST(Tracer, MicrofacetGlassFresnelKeepsEnergyAndReflectsLessAtTheRim) {
+  // Cycles 4.0's rough glass: reflection F(h) and refraction 1 - F(h) of each
+  // microfacet, instead of F and 1 - F of the shading normal. In a white world
+  // the sphere still returns at most what reaches it; its rim, where the
+  // normal's Fresnel is largest, reflects less (h lies between wo and wi).
+  double reflected[2];
+  for (const bool per_microfacet : {false, true}) {
+    Scene s;
+    Closure glass = closure(Closure::Type::glass, {1, 1, 1}, 0.3f);
+    glass.ior = 1.5f;
+    s.materials = {of({glass})};
+    add_sphere(s, {0, 0, 0}, 1, 0);
+    s.world_radiance = {1, 1, 1};
+    s.camera = top_camera(5, 2.0f, 16);
+    s.closure_model.height_correlated_shadowing = per_microfacet;
+    s.closure_model.microfacet_glass_fresnel = per_microfacet;
+    TraceOptions o = options(128);
+    o.max_bounces = 64;
+    const TraceResult r = trace_lpe(s, {"L.*E", "LSE"}, o);
+    // Over the sphere's disk (pi / 4 of the square): all of it, no more.
+    EXPECT_LT(mean(r.images[0]), 1.02) << per_microfacet;
+    EXPECT_GT(mean(r.images[0]), 0.85) << per_microfacet;
+    reflected[per_microfacet] = mean(r.images[1]);
+  }
+  EXPECT_LT(reflected[1], reflected[0] * 0.97);
+}
+
 TEST(Tracer, WorldRayVisibility) {
   // A world invisible to diffuse rays lights nothing diffusely.
   Scene s;

@@ -180,6 +180,16 @@ def cycles_light_model(light):
             "spot_axis_cosine": not cycles4, "area_emits_power": cycles4}
 
 
+def cycles_closure_model():
+    """Which microfacet closures this Cycles renders, as the tracer's
+    closure_model: Cycles 4.0 rewrote them (height-correlated Smith
+    shadowing; rough glass as one closure with the Fresnel of each
+    microfacet). No RNA property of a registered type tells them apart (the
+    node types are not in bpy.types until a node exists), so the version does."""
+    cycles4 = bpy.app.version >= (4, 0, 0)
+    return {"height_correlated_shadowing": cycles4, "microfacet_glass_fresnel": cycles4}
+
+
 def set_sharp_distribution(node):
     """Makes a Glass, Refraction or Glossy BSDF node perfectly sharp: the SHARP
     distribution where it exists (3.x), else GGX of roughness 0, which Cycles

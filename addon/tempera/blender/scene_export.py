@@ -110,6 +110,7 @@ def export_scene(scene, depsgraph, size):
         "world": world,
         "textures": textures,
         "camera": export_camera(scene, depsgraph, size),
+        "closure_model": compat.cycles_closure_model(),  # Cycles 3.x's microfacets or 4.0's
     }
     if (visibility != 31).any():
         out["triangle_visibility"] = visibility

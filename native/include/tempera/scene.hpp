@@ -166,6 +166,17 @@ struct Camera {
   float clip_start = 0.1f, clip_end = 1000.0f;
 };
 
+// Which Cycles' microfacet closures the tracer renders (the exporter knows the
+// Blender version; the tracer does not). Cycles 3.x: separable Smith shadowing
+// G1(i) G1(o), and rough glass as two closures whose reflection is weighted by
+// the Fresnel of the shading normal. Cycles 4.0+: height-correlated Smith
+// shadowing 1 / (1 + Lambda(i) + Lambda(o)) (Heitz 2014), and rough glass as one
+// closure with the Fresnel of each microfacet normal.
+struct ClosureModel {
+  bool height_correlated_shadowing = false;
+  bool microfacet_glass_fresnel = false;
+};
+
 struct Scene {
   std::vector<Float3> vertices;
   std::vector<std::array<std::uint32_t, 3>> triangles;
@@ -188,6 +199,7 @@ struct Scene {
   // Optional per-triangle ray visibility (bits of Visibility); empty: all visible.
   std::vector<std::uint8_t> triangle_visibility;
   Camera camera;
+  ClosureModel closure_model;  // Cycles 3.x's by default
 };
 
 // Throws ValueError naming the first problem: non-finite numbers, indices out

@@ -36,6 +36,33 @@ float beckmann_g1(float cos_v, float alpha2) {  // Walter et al. 2007's rational
   return (3.535f * a + 2.181f * a * a) / (1 + 2.276f * a + 2.577f * a * a);
 }
 
+// Smith's Lambda (Heitz 2014): G1 = 1 / (1 + Lambda). GGX's is exact; Beckmann's
+// is Walter et al. 2007's rational fit, the one beckmann_g1 uses.
+float ggx_lambda(float cos_v, float alpha2) {
+  const float c2 = cos_v * cos_v;
+  return 0.5f * (std::sqrt(1 + alpha2 * (1 - c2) / c2) - 1);
+}
+float beckmann_lambda(float cos_v, float alpha2) {
+  const float sin_v = std::sqrt(std::fmax(0.0f, 1 - cos_v * cos_v));
+  if (sin_v <= 0) return 0;
+  const float a = cos_v / (std::sqrt(alpha2) * sin_v);
+  if (a >= 1.6f) return 0;
+  return (1 - 1.259f * a + 0.396f * a * a) / (3.535f * a + 2.181f * a * a);
+}
+
+// Masking-shadowing of a microfacet lobe for |cos| to wi and wo: separable
+// G1(i) G1(o) (Cycles 3.x) or height-correlated 1 / (1 + Lambda(i) + Lambda(o))
+// (Cycles 4.0+), which is larger: less energy lost at grazing angles.
+float smith_g(const Lobe& l, float cos_i, float cos_o) {
+  if (l.correlated) {
+    const float li = l.beckmann ? beckmann_lambda(cos_i, l.alpha2) : ggx_lambda(cos_i, l.alpha2);
+    const float lo = l.beckmann ? beckmann_lambda(cos_o, l.alpha2) : ggx_lambda(cos_o, l.alpha2);
+    return 1 / (1 + li + lo);
+  }
+  return l.beckmann ? beckmann_g1(cos_i, l.alpha2) * beckmann_g1(cos_o, l.alpha2)
+                    : ggx_g1(cos_i, l.alpha2) * ggx_g1(cos_o, l.alpha2);
+}
+
 // Cycles' Fresnel and Layer Weight nodes at the shading point.
 float factor_value(const Scene& scene, const Factor& f, const SurfaceInput& at) {
   float x = 1;
@@ -185,11 +212,20 @@ void add_closure(const Scene& scene, ShadingPoint& s, const Closure& c, const Su
         // Rough glass as Cycles 3.x builds it: a microfacet reflection weighted
         // by the Fresnel of the shading normal, and a microfacet refraction by
         // the rest (Refraction BSDF: the refraction alone, unweighted).
+        // Cycles 4.0+ (microfacet_glass_fresnel): one closure whose parts take
+        // the Fresnel of each microfacet normal, F(h) and 1 - F(h).
         const float eta = s.front ? c.ior : 1 / c.ior;
-        const float fresnel = c.type == Closure::Type::glass ? fresnel_dielectric(dot(at.n, at.wo), eta) : 0.0f;
+        const bool is_glass = c.type == Closure::Type::glass;
+        const bool per_microfacet = is_glass && scene.closure_model.microfacet_glass_fresnel;
+        const float fresnel = is_glass && !per_microfacet ? fresnel_dielectric(dot(at.n, at.wo), eta) : 0.0f;
         const bool beckmann = c.distribution == Closure::Distribution::beckmann;
-        if (fresnel > 0) add_lobe(s, reflection_lobe(weight * color * fresnel, r, beckmann, FresnelMode::none, {}));
-        Lobe t = reflection_lobe(weight * color * (1 - fresnel), r, beckmann, FresnelMode::none, {});
+        const FresnelMode mode = per_microfacet ? FresnelMode::dielectric : FresnelMode::none;
+        if (per_microfacet || fresnel > 0) {
+          Lobe reflection = reflection_lobe(weight * color * (per_microfacet ? 1.0f : fresnel), r, beckmann, mode, {});
+          reflection.eta = eta;
+          add_lobe(s, reflection);
+        }
+        Lobe t = reflection_lobe(weight * color * (1 - fresnel), r, beckmann, mode, {});
         t.kind = LobeKind::microfacet_transmission;
         t.eta = eta;
         add_lobe(s, t);
@@ -210,6 +246,10 @@ void add_closure(const Scene& scene, ShadingPoint& s, const Closure& c, const Su
 }
 
 float lobe_energy(const ShadingPoint& s, const Lobe& l) {
+  if (l.fresnel == FresnelMode::dielectric && !l.singular()) {  // microfacet glass: F and 1 - F at the normal
+    const float f = fresnel_dielectric(dot(s.n, s.wo), l.eta);
+    return luminance(l.weight) * (l.kind == LobeKind::microfacet_transmission ? 1 - f : f);
+  }
   if (l.fresnel == FresnelMode::schlick) return luminance(l.weight * schlick(l.f0, dot(s.n, s.wo)));
   if (l.fresnel == FresnelMode::principled) return luminance(l.weight * principled_fresnel(l, dot(s.n, s.wo)));
   return luminance(l.weight);
@@ -251,6 +291,7 @@ ShadingPoint shade(const Scene& scene, const Material& m, const SurfaceInput& at
   } else {
     for (const Closure& c : m.closures) add_closure(scene, s, c, at);
   }
+  for (int i = 0; i < s.count; ++i) s.lobes[i].correlated = scene.closure_model.height_correlated_shadowing;
   set_picks(s);
   return s;
 }
@@ -349,18 +390,13 @@ LobeValue evaluate_lobe(const ShadingPoint& s, const Lobe& l, Float3 wi) {
     const float cos_ho = dot(h, s.wo), cos_hi = dot(h, wi);
     if (cos_ho <= 0 || cos_hi >= 0) return {};
     const float cos_h = dot(s.n, h);
-    float d, g;
-    if (l.beckmann) {
-      d = beckmann_d(cos_h, l.alpha2);
-      g = beckmann_g1(-cos_i, l.alpha2) * beckmann_g1(cos_o, l.alpha2);
-    } else {
-      d = ggx_d(cos_h, l.alpha2);
-      g = ggx_g1(-cos_i, l.alpha2) * ggx_g1(cos_o, l.alpha2);
-    }
+    const float d = l.beckmann ? beckmann_d(cos_h, l.alpha2) : ggx_d(cos_h, l.alpha2);
+    const float g = smith_g(l, -cos_i, cos_o);
     const float denom = cos_ho + l.eta * cos_hi;
     const float jacobian = l.eta * l.eta * -cos_hi / (denom * denom);  // d(omega_h) / d(omega_i)
     // Radiance is not rescaled by eta^2 (as in Cycles).
-    return {l.weight * (d * g * cos_ho * jacobian / cos_o), d * cos_h * jacobian};
+    const float transmitted = l.fresnel == FresnelMode::dielectric ? 1 - fresnel_dielectric(cos_ho, l.eta) : 1.0f;
+    return {l.weight * (d * g * cos_ho * jacobian * transmitted / cos_o), d * cos_h * jacobian};
   }
   if (cos_i <= 0 || dot(s.ng, wi) <= 0) return {};
   if (l.kind == LobeKind::lambert) return {l.weight * (cos_i / kPi), cos_i / kPi};
@@ -390,14 +426,8 @@ LobeValue evaluate_lobe(const ShadingPoint& s, const Lobe& l, Float3 wi) {
   const Float3 h = normalize(wi + s.wo);
   const float cos_h = dot(s.n, h);
   if (cos_h <= 0) return {};
-  float d, g;
-  if (l.beckmann) {
-    d = beckmann_d(cos_h, l.alpha2);
-    g = beckmann_g1(cos_i, l.alpha2) * beckmann_g1(cos_o, l.alpha2);
-  } else {
-    d = ggx_d(cos_h, l.alpha2);
-    g = ggx_g1(cos_i, l.alpha2) * ggx_g1(cos_o, l.alpha2);
-  }
+  const float d = l.beckmann ? beckmann_d(cos_h, l.alpha2) : ggx_d(cos_h, l.alpha2);
+  const float g = smith_g(l, cos_i, cos_o);
   Float3 f = l.weight * (d * g / (4 * cos_o));
   if (l.fresnel == FresnelMode::schlick) f *= schlick(l.f0, dot(wi, h));
   else if (l.fresnel == FresnelMode::principled) f *= principled_fresnel(l, dot(wi, h));

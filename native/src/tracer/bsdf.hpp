@@ -31,7 +31,8 @@ struct Lobe {
   float alpha2 = 0;         // microfacet: alpha^2
   float a = 0, b = 0;       // oren_nayar: A, B; principled_diffuse: a = roughness
   bool beckmann = false;    // microfacet: Beckmann instead of GGX
-  FresnelMode fresnel = FresnelMode::none;
+  bool correlated = false;  // microfacet: height-correlated Smith shadowing (ClosureModel)
+  FresnelMode fresnel = FresnelMode::none;  // microfacet_transmission, dielectric: 1 - F(microfacet)
   Float3 f0;                // schlick
   float eta = 1;            // dielectric: n behind / n in front; microfacet with dielectric Fresnel
   bool reflect = true, refract = true;  // dielectric: which parts exist (refraction-only closures, caustic filter)
