@@ -7,7 +7,8 @@
 // start (a field from another level or frame, a starting image, injected
 // candidates) and returns the field, the image and the statistics; it keeps
 // no state between calls, so a method may solve levels in any order, as often
-// as it likes (per frame, per sweep).
+// as it likes (per frame, per sweep); only a `last_use` solve changes the
+// solver: it frees that level (below).
 //
 //   Solver solver(input, options);
 //   LevelResult r = solver.solve_level(solver.coarsest(), {});
