@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <tuple>
 
 #include "tempera/color.hpp"
 #include "tempera/error.hpp"
@@ -258,6 +259,10 @@ struct Solver::Plan {
   double kept_variance = 1.0;
   std::vector<SourceLayout> layout;   // per level
   std::vector<Image> source, target;  // source: style + guides (atlas); target: guides
+  // Per level: the sizes of `source` and `target`, which outlive them once a
+  // level's last solve has freed them (LevelStart::last_use).
+  std::vector<std::pair<int, int>> source_size, target_size;
+  std::vector<std::uint8_t> released;
   std::vector<Image> source_mask, target_mask, source_angle, target_angle, source_label, target_label;
   std::vector<std::vector<Image>> weight_maps;  // per guide (may be empty)
   std::vector<Image> reference, fixed_mask, fixed_values;
@@ -355,6 +360,11 @@ Solver::Solver(const SynthesisInput& in, const SynthesisOptions& opt) : plan_(ne
   } else {
     for (const auto& [w, h] : level_sizes(tw, th, p.levels, p.ratio)) p.target.emplace_back(w, h, 1);
   }
+  for (int l = 0; l < p.levels; ++l) {
+    p.source_size.emplace_back(p.source[l].width(), p.source[l].height());
+    p.target_size.emplace_back(p.target[l].width(), p.target[l].height());
+  }
+  p.released.assign(std::size_t(p.levels), 0);
   for (std::size_t e = 0; e < ex.size(); ++e) {
     const auto [cw, ch] = sizes[e].back();
     if (cw >= opt.patch_size + 2 && ch >= opt.patch_size + 2) continue;
@@ -412,8 +422,8 @@ Solver::Solver(const SynthesisInput& in, const SynthesisOptions& opt) : plan_(ne
 Solver::~Solver() = default;
 
 int Solver::levels() const { return plan_->levels; }
-int Solver::target_width(int l) const { return plan_->target.at(std::size_t(l)).width(); }
-int Solver::target_height(int l) const { return plan_->target.at(std::size_t(l)).height(); }
+int Solver::target_width(int l) const { return plan_->target_size.at(std::size_t(l)).first; }
+int Solver::target_height(int l) const { return plan_->target_size.at(std::size_t(l)).second; }
 const SourceLayout& Solver::layout(int l) const { return plan_->layout.at(std::size_t(l)); }
 int Solver::guide_channels() const {
   int n = 0;
@@ -445,10 +455,8 @@ double mean_energy(const OffsetField& field, const SearchConstraints& cons) {
 
 PatchSpace Solver::geometry(int l, FeatureImage& source, FeatureImage& target) const {
   const Plan& p = *plan_;
-  source.width = p.source[std::size_t(l)].width();
-  source.height = p.source[std::size_t(l)].height();
-  target.width = p.target[std::size_t(l)].width();
-  target.height = p.target[std::size_t(l)].height();
+  std::tie(source.width, source.height) = p.source_size[std::size_t(l)];
+  std::tie(target.width, target.height) = p.target_size[std::size_t(l)];
   PatchSpace space;
   space.source = &source;
   space.target = &target;
@@ -462,19 +470,26 @@ PatchSpace Solver::geometry(int l, FeatureImage& source, FeatureImage& target) c
 
 void Solver::build_level(int l, Level& level, const LevelStart* start) const {
   const Image* fixed_mask = start ? start->fixed_mask : nullptr;
-  const Plan& p = *plan_;
-  const Image& src = p.source[std::size_t(l)];
-  const int total = src.channels();
+  Plan& p = *plan_;
+  if (p.released[std::size_t(l)])
+    throw ValueError(concat("level ", l, " was solved with last_use; its pyramids are freed"));
+  // The level's last use frees each float pyramid level as soon as its
+  // features are built, so that the plan's copy and the features are not
+  // both held through the solve (peak memory ~ pixels, not pixels x levels).
+  const bool release = start && start->last_use;
+  const int total = p.source[std::size_t(l)].channels();
   level.space = geometry(l, level.source, level.target);
-  level.source = FeatureImage(src.width(), src.height(), total);
-  level.target = FeatureImage(p.target[l].width(), p.target[l].height(), total);
+  level.source = FeatureImage(p.source_size[l].first, p.source_size[l].second, total);
+  level.target = FeatureImage(p.target_size[l].first, p.target_size[l].second, total);
   level.space.source = &level.source;
   level.space.target = &level.target;
-  level.style = extract_channels(src.view(), 0, p.style_channels);
+  level.style = extract_channels(p.source[l].view(), 0, p.style_channels);
   // All channels as they are (the guides are weighted already), then the
   // style's as matched: no full-size copy of the guides.
-  level.source.set_channels(0, src.view(), 1.0f);
+  level.source.set_channels(0, p.source[l].view(), 1.0f);
+  if (release) p.source[l] = Image();
   if (total > p.style_channels) level.target.set_channels(p.style_channels, p.target[l].view(), 1.0f);
+  if (release) p.target[l] = Image(), p.released[std::size_t(l)] = 1;
   if (start) replace_guide_targets(l, *start, level.target);
   if (options_.color_space == ColorSpace::Lab)
     level.source.set_channels(0, srgb_to_lab(level.style.view()).view(), p.style_scales);
@@ -685,11 +700,15 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
   auto t0 = Clock::now();
   OffsetField& field = out.field;
   Image& bprime = out.image;
-  if (start.field) {
-    if (start.field->width != stats.width || start.field->height != stats.height)
-      throw ValueError(concat("start field is ", start.field->width, "x", start.field->height, " but level ", l,
-                              " is ", stats.width, "x", stats.height));
-    field = *start.field;
+  const OffsetField* given = start.take_field ? start.take_field : start.field;
+  if (given) {
+    if (given->width != stats.width || given->height != stats.height)
+      throw ValueError(concat("start field is ", given->width, "x", given->height, " but level ", l, " is ",
+                              stats.width, "x", stats.height));
+    if (start.take_field)
+      field = std::move(*start.take_field);
+    else
+      field = *given;
     legalize_field(level.space, level.constraints, field);
   } else {
     field = cold_start(l, level, bprime);
@@ -704,7 +723,7 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
   if (start.image && !start.image_mask) bprime = *start.image;
   fix_pixels(l, level, start.fixed_values, field, bprime);
   stats.search_seconds += seconds_since(t0);
-  const bool have_image = (start.image && !start.image_mask) || (!start.field && !p.reference.empty());
+  const bool have_image = (start.image && !start.image_mask) || (!given && !p.reference.empty());
   if (!have_image) {  // vote it from the field
     t0 = Clock::now();
     bprime = vote(level.style.view(), level.space, level.constraints, field, bprime.view(), vote_params);

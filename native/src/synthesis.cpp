@@ -23,12 +23,17 @@ SynthesisResult synthesize(const SynthesisInput& in, const SynthesisOptions& opt
     auto report = [&](double fraction) {
       return !progress || progress(std::min(1.0, (done_work + fraction * work) / total_work));
     };
-    if (l == solver.coarsest()) {
-      level = solver.solve_level(l, {}, report);
-    } else {
-      const OffsetField start = solver.resample(level.field, l + 1, l);
-      level = solver.solve_level(l, {&start}, report);
+    // Each level is solved once: its plan is freed as it starts, the coarser
+    // result before it, and the start field is handed over, not copied.
+    LevelStart start;
+    start.last_use = true;
+    OffsetField up;
+    if (l != solver.coarsest()) {
+      up = solver.resample(level.field, l + 1, l);
+      level = LevelResult();
+      start.take_field = &up;
     }
+    level = solver.solve_level(l, start, report);
     done_work += work;
     result.levels.push_back(level.stats);
   }

@@ -96,6 +96,36 @@ TEST(Solver, SynthesizeEqualsDrivingTheSolverLevelByLevel) {
   for (std::size_t i = 0; i < r.image.pixel_count() * 3; ++i) ASSERT_EQ(r.image.data()[i], whole.image.data()[i]);
 }
 
+// synthesize()'s memory saving: a level's last solve frees its pyramids (a
+// second solve or energy() of it is refused, sizes and resampling still
+// work), and a handed-over start field is moved, not copied, with the same
+// output as the copied one.
+TEST(Solver, LastUseFreesTheLevelAndTakeFieldMovesTheStart) {
+  const Image style = smooth_noise(64, 48, 3, 3), sg = coordinate_guide(64, 48), tg = coordinate_guide(56, 40);
+  SynthesisInput in;
+  in.style = style.view();
+  in.guides.add("coords", sg.view(), tg.view(), 2.0f);
+  const SynthesisOptions opt = options(PatchUsage::Budget);
+  const Solver kept(in, opt), freed(in, opt);
+  const int c = kept.coarsest();
+  const LevelResult coarse = kept.solve_level(c, {});
+  OffsetField up = kept.resample(coarse.field, c, c - 1);
+  const LevelResult copied = kept.solve_level(c - 1, {&up});
+  LevelStart start;
+  start.take_field = &up;
+  start.last_use = true;
+  const LevelResult moved = freed.solve_level(c - 1, start);
+  EXPECT_TRUE(up.x.empty());
+  ASSERT_EQ(moved.image.pixel_count(), copied.image.pixel_count());
+  for (std::size_t i = 0; i < moved.image.pixel_count() * 3; ++i) ASSERT_EQ(moved.image.data()[i], copied.image.data()[i]);
+  EXPECT_THROW(freed.solve_level(c - 1, {}), ValueError);
+  EXPECT_THROW(freed.energy(c - 1, moved.field, moved.image), ValueError);
+  EXPECT_EQ(freed.target_width(c - 1), kept.target_width(c - 1));
+  const OffsetField down = freed.resample(moved.field, c - 1, c);
+  EXPECT_EQ(down.width, freed.target_width(c));
+  EXPECT_NO_THROW(kept.solve_level(c - 1, {&copied.field}));  // without last_use: any order, again
+}
+
 TEST(Solver, WarmStartFromItsOwnFieldIsNoWorseInHalfTheTime) {
   const Image style = smooth_noise(96, 72, 3, 2), sg = coordinate_guide(96, 72), tg = coordinate_guide(88, 64);
   SynthesisInput in;

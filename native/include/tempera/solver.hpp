@@ -7,7 +7,8 @@
 // start (a field from another level or frame, a starting image, injected
 // candidates) and returns the field, the image and the statistics; it keeps
 // no state between calls, so a method may solve levels in any order, as often
-// as it likes (per frame, per sweep).
+// as it likes (per frame, per sweep); only a `last_use` solve changes the
+// solver: it frees that level (below).
 //
 //   Solver solver(input, options);
 //   LevelResult r = solver.solve_level(solver.coarsest(), {});
@@ -15,6 +16,10 @@
 //     OffsetField up = solver.resample(r.field, l + 1, l);
 //     r = solver.solve_level(l, {&up});
 //   }
+//
+// A method that solves each level once (synthesize()) marks the solve
+// `last_use` and hands the start field over (`take_field`), so the plan's
+// level and the carried field are freed while the level runs.
 #include <memory>
 #include <vector>
 
@@ -39,6 +44,14 @@ struct LevelStart {
   // method recomputes per level and sweep, such as Bénard's temporal term on
   // the previous frame's result. Needs uncompressed guides (guide_variance 1).
   std::vector<std::pair<int, const Image*>> guide_targets;
+  // Instead of `field`: a start field the solver moves from (one full-size
+  // field less while the level runs). Left empty.
+  OffsetField* take_field = nullptr;
+  // No later call solves (or measures) this level: the solver frees the
+  // level's float pyramids of the plan as soon as its features are built
+  // (the coarse-to-fine schedule, so that the peak grows with the pixels and
+  // not with pixels x levels). Sizes, layouts and resample() stay usable.
+  bool last_use = false;
 };
 
 struct LevelResult {
