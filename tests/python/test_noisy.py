@@ -284,3 +284,9 @@ def test_a_guided_sequence_reads_both_caches_and_keys_the_setting(tmp_path):
     assert noisy.NoisySequence(**dict(args, noise_guides=0.0)).run_frame(1)["status"] == "made"
     with pytest.raises(ValueError, match="exemplar's guide cache"):
         noisy.NoisySequence(**dict(args, exemplar_guides=None))
+
+
+def test_guided_noise_off_ignores_the_guides_bit_for_bit():
+    style, reference, guides = thin_strokes()
+    plain = noisy.noisy_frame(style, reference, 2, noise=2.2, threads=2)
+    np.testing.assert_array_equal(noisy.noisy_frame(style, reference, 2, noise=2.2, threads=2, guides=guides), plain)
