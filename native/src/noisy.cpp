@@ -13,6 +13,11 @@ namespace {
 
 constexpr double kRatio = 0.85;  // the paper's sampling-rate ratio between levels
 
+// An exemplar layer under the frame's MLS map (no map: the layer as it is).
+Image warped(const ImageView& layer, const Image& deformation) {
+  return deformation.empty() ? Image::copy_of(layer) : warp_by_map(layer, deformation.view());
+}
+
 }  // namespace
 
 SynthesisOptions noisy_defaults() {
@@ -50,8 +55,7 @@ Image exemplar_deformation(int width, int height, const NoisyOptions& o, int fra
 }
 
 Image deform_exemplar(const ImageView& style, const NoisyOptions& o, int frame) {
-  const Image map = exemplar_deformation(style.width, style.height, o, frame);
-  return map.empty() ? Image::copy_of(style) : warp_by_map(style, map.view());
+  return warped(style, exemplar_deformation(style.width, style.height, o, frame));
 }
 
 Image dihedral_copy(const ImageView& image, int k) {
@@ -180,7 +184,7 @@ void add_light_path_guides(SynthesisInput& in, const std::vector<NoisyGuide>& gu
   keep.reserve(guides.size());
   for (const NoisyGuide& g : guides) {
     if (!(g.weight > 0)) continue;
-    keep.push_back(deformation.empty() ? Image::copy_of(g.source) : warp_by_map(g.source, deformation.view()));
+    keep.push_back(warped(g.source, deformation));
     in.guides.add(g.name, keep.back().view(), g.target, g.weight * o.noise_guides);
   }
 }
@@ -197,7 +201,7 @@ Image noisy_frame(const ImageView& style, const ImageView& reference, int frame,
   const float f = noise_map.empty() ? o.noise : o.noise * std::max(0.0f, *std::max_element(noise_map.data, noise_map.data + noise_map.size()));
   if (!(f > 1.0f)) return Image::copy_of(reference);  // no noise anywhere: R itself
   const Image deformation = exemplar_deformation(style.width, style.height, o, frame);
-  const Image exemplar = deformation.empty() ? Image::copy_of(style) : warp_by_map(style, deformation.view());
+  const Image exemplar = warped(style, deformation);
   SynthesisInput in;
   in.style = exemplar.view();
   in.target_width = reference.width;

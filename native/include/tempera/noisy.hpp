@@ -70,7 +70,7 @@ inline const auto& noisy_option_table() {
             "also copy patches from the exemplar's mirror image (and its turns, with rotations)"),
       field(&N::noise_guides, "noise_guides", "noise-guides",
             "guided noise: keep StyLit's light-path guides at every level, their weights times this "
-            "(0 = off; 0.5 kept thin strokes best in docs/noisy.md); needs the exemplar's guides", 0, 1e6));
+            "(0 = off; the panel uses 0.5, docs/noisy.md); needs both guide caches", 0, 1e6));
   return table;
 }
 
