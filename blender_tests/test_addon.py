@@ -212,7 +212,7 @@ def test_output_panel_draws_settings_with_the_frames_by_the_buttons():
     finally:
         settings.guide_lpe = ""
     assert [name for kind, name in calls if kind == "prop"][-2:] == ["guide_lpe", "guide_lpe_samples"]
-    # Temporal Noise on: its width, the map picker and the chosen map's field.
+    # Temporal Noise on: its width, Guided Noise, the map picker and the chosen map's field.
     settings.noise_level, settings.noise_map_source = 4, "OBJECT"
     try:
         calls.clear()
@@ -220,7 +220,7 @@ def test_output_panel_draws_settings_with_the_frames_by_the_buttons():
     finally:
         settings.noise_level, settings.noise_map_source = 0, "NONE"
     props = [name for kind, name in calls if kind == "prop"]
-    assert props[props.index("noise_level") + 1:][:2] == ["noise_map_source", "noise_map_object"]
+    assert props[props.index("noise_level") + 1:][:3] == ["noise_guided", "noise_map_source", "noise_map_object"]
     assert any(kind == "label" and text.startswith("f = 2.2 px") for kind, text in calls)
 
 

@@ -236,3 +236,9 @@ def test_temporal_noise_boils_the_coherent_frames_where_the_map_says(scene, tmp_
     while not rerun.finished:
         rerun.step()
     assert [r["status"] for r in rerun.noise_results] == ["skipped"] * len(FRAMES)
+    # Guided Noise: a new setting (in the key), so every frame is boiled again.
+    settings.noise_guided = True
+    guided = StylizeRun.from_settings(scene)
+    while not guided.finished:
+        guided.step()
+    assert [r["status"] for r in guided.noise_results] == ["made"] * len(FRAMES)

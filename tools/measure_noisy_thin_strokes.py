@@ -6,8 +6,8 @@ R is a folder of coherent frames, e.g. the OUT/frames of
 blender_tests/test_noisy_user_scene.py or of `make demo`; S is the kit's
 painting (make kit).
 
-With --guides (R's guide cache) the last rows are a probe of guided noise,
-not its implementation: StyLit's light-path guides (tonemapped, scaled by
+With --guides (R's guide cache) the last rows are guided noise itself
+(noise_guides 0.5 and 1), after a probe of it: StyLit's light-path guides (tonemapped, scaled by
 sqrt(weight) and by the probe's scale) appended to S's and R's colour as
 further channels, so the search, the MLS warp and the low-frequency term
 see them. They are voted like colour and dropped afterwards.
@@ -29,6 +29,7 @@ ROOT = Path(__file__).resolve().parent.parent
 PAINTING = ROOT / "build" / "kit" / "sphere_on_table" / "style.png"
 KIT_GUIDES = ROOT / "build" / "kit" / "sphere_on_table" / "guides"
 PROBE_SCALES = (0.5, 1.0)
+GUIDED_NOISE = (0.5, 1.0)  # noise_guides rows
 VARIANTS = [("default (f = 2.2)", {}), ("f = 1.01 (finest level only)", dict(noise=1.01)),
             ("f = 4.3", dict(noise=4.3)), ("no MLS", dict(deform=False)), ("consistency 0", dict(consistency=0.0)),
             ("consistency 8", dict(consistency=8.0)), ("patch 5", dict(patch_size=5)),
@@ -52,6 +53,13 @@ def light_path_stack(folder, frame):
     g = guide_cache.read_frame(str(folder), frame, names)
     return np.concatenate([tonemap(g[n]).reshape(g[n].shape[0], g[n].shape[1], -1)[:, :, :3]
                            * np.sqrt(DEFAULT_GUIDE_WEIGHTS[n]) for n in names], 2)
+
+
+def light_path_guides(folder, frame):
+    """{name: tonemapped guide} of StyLit's default guides, for guided noise."""
+    names = [n for n, w in DEFAULT_GUIDE_WEIGHTS.items() if w > 0]
+    g = guide_cache.read_frame(str(folder), frame, names)
+    return {n: np.ascontiguousarray(tonemap(g[n]).reshape(g[n].shape[0], g[n].shape[1], -1)[:, :, :3]) for n in names}
 
 
 def with_guides(image, guides, scale):
@@ -87,6 +95,15 @@ def main():
                 t = noisy.noisy_frame(with_guides(style, style_guides, scale), r, f, noise=2.2, threads=2)
                 kept += int(red(t[:, :, :3]).sum())
             print(f"{'probe: guides x ' + str(scale):30s} red kept {kept / strokes:.2f}")
+        source = light_path_guides(args.exemplar_guides, exemplar_frame)
+        for weight in GUIDED_NOISE:  # the implementation: noise_guides
+            kept = 0
+            for f in frames:
+                target = light_path_guides(args.guides, f)
+                guides = {n: (source[n], target[n], DEFAULT_GUIDE_WEIGHTS[n]) for n in source}
+                t = noisy.noisy_frame(style, references[f], f, noise=2.2, threads=2, noise_guides=weight, guides=guides)
+                kept += int(red(t).sum())
+            print(f"{'guided noise ' + str(weight):30s} red kept {kept / strokes:.2f}")
 
 
 if __name__ == "__main__":

@@ -34,17 +34,21 @@ def _image(a, what):
     return a
 
 
-def noisy_frame(style, reference, frame: int, *, noise_map=None, progress=None, **values):
+def noisy_frame(style, reference, frame: int, *, noise_map=None, progress=None, guides=None, **values):
     """One noisy frame: ``reference`` (R_i) with its fine texture synthesized
     again from the freshly deformed exemplar ``style`` above the width
     ``noise`` (f, px). ``frame`` seeds the frame's randomness (the same frame
     and seed give the same result). ``noise_map`` (R's size) scales f per
-    pixel: 0 keeps R, 1 the full amount."""
+    pixel: 0 keeps R, 1 the full amount. ``guides``: for guided noise
+    (``noise_guides`` > 0), {name: (exemplar guide, frame guide, weight)},
+    tone-mapped, the exemplar's undeformed at S's size."""
     opts = options(**values)
     nm = None if noise_map is None else _image(noise_map, "noise map")
     report = None if progress is None else (lambda f: progress(f) is not False)
+    pairs = [(str(name), _image(src, f"exemplar guide {name}"), _image(tgt, f"frame guide {name}"), float(w))
+             for name, (src, tgt, w) in (guides or {}).items()]
     return _native.noisy_frame(_image(style, "exemplar"), _image(reference, "reference frame"), int(frame), opts,
-                               nm, report)
+                               nm, report, pairs)
 
 
 def noise_width(level: int) -> float:
@@ -65,13 +69,18 @@ class NoisySequence:
     noise_map  optional: an image file of R's size, or the name of a guide of
                ``guides`` ("alpha", "mask.OB_Cube", an AOV), read per frame;
                f_p = noise * map (0 keeps R, 1 the full amount)
+    exemplar_guides, exemplar_frame, guide_weights
+               for guided noise (``noise_guides`` > 0): the exemplar render's
+               guide cache, its frame (default: the only one) and StyLit's
+               light-path guide weights {name: weight} (default: StyLit's);
+               ``guides`` is then the frames' guide cache
     **values   Color Me Noisy and engine options (see ``options``)
 
     Construction checks every file up front (FileNotFoundError, ValueError).
     ``run_frame(i)`` makes frames[i] or skips it when current (resume)."""
 
     def __init__(self, exemplar, reference, frames, out, *, noise_map=None, guides=None, prefix="frame_",
-                 resume=True, **values):
+                 resume=True, exemplar_guides=None, exemplar_frame=None, guide_weights=None, **values):
         import os
 
         config = dict(exemplar=os.fspath(exemplar), reference=os.fspath(reference), frames=[int(f) for f in frames],
@@ -80,6 +89,12 @@ class NoisySequence:
             config["noise_map"] = os.fspath(noise_map)
         if guides:
             config["guides"] = os.fspath(guides)
+        if exemplar_guides:
+            config["exemplar_guides"] = os.fspath(exemplar_guides)
+        if exemplar_frame is not None:
+            config["exemplar_frame"] = int(exemplar_frame)
+        if guide_weights is not None:
+            config["guide_weights"] = [(str(k), float(v)) for k, v in dict(guide_weights).items()]
         self._sequence = _native.NoisySequence(config, options(**values))
 
     @property

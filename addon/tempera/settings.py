@@ -36,6 +36,9 @@ DEFAULT_GUIDE_WEIGHTS = {g["name"]: g["weight"] for g in LIGHT_PATH_GUIDES}
 # with the stroke detail kept (docs/user_guide.md).
 DEFAULT_TEMPORAL_WEIGHT = _native.stylit_defaults()["temporal_weight"]
 PANEL_TEMPORAL_WEIGHT = 0.5
+# The panel's Guided Noise checkbox sets noise_guides to this (docs/noisy.md:
+# 0.5 and 1 keep the same share of thin strokes; 0.5 was the probe's best).
+PANEL_NOISE_GUIDES = 0.5
 DEFAULT_QUALITY = _native.stylit_defaults()["quality"]
 QUALITY_PRESETS = ("preview", "final")
 OUTPUT_FORMATS = ("png", "exr")

@@ -24,7 +24,10 @@ std::string noisy_help() {
          "  --out DIR               output folder: OUT/<prefix>0001.png ...\n"
          "  --noise-map FILE|GUIDE  where the noise goes: an image of R's size, or a guide of --guides\n"
          "                          (alpha, mask.OB_Name, an AOV); 0 = R as it is, 1 = --noise\n"
-         "  --guides DIR            the guide cache holding a GUIDE noise map\n"
+         "  --guides DIR            the frames' guide cache: for a GUIDE noise map and --noise-guides\n"
+         "  --exemplar-guides DIR   guide cache of the exemplar render (for --noise-guides)\n"
+         "  --exemplar-frame N      its frame (default: the only frame in --exemplar-guides)\n"
+         "  --weights NAME=W,...    light-path guide weights for --noise-guides (as tempera stylize)\n"
          "  --prefix P              frame file prefix (default frame_)\n"
          "  --no-resume             redo every frame\n"
          "\n"
@@ -54,6 +57,9 @@ int run_noisy(const Args& args) {
     else if (flag == "--out") c.out = value();
     else if (flag == "--noise-map") c.noise_map = value();
     else if (flag == "--guides") c.guides = value();
+    else if (flag == "--exemplar-guides") c.exemplar_guides = value();
+    else if (flag == "--exemplar-frame") c.exemplar_frame = r.number<int>(flag);
+    else if (flag == "--weights") parse_guide_weights(value(), c.guide_weights);
     else if (flag == "--prefix") c.prefix = value();
     else if (flag == "--no-resume") c.resume = false;
     else if (!set_from_flag(c.options, noisy_option_table(), flag.substr(2), value) &&

@@ -267,6 +267,8 @@ Options parse(const Args& args) {
   const bool noise = o.noisy.noise > 0;
   if (!noise && !(o.noise_map.empty() && o.noise_reference.empty()))
     throw ValueError("--noise-map and --noise-reference need --noise F (the amount of temporal noise)");
+  if (!noise && o.noisy.noise_guides > 0)
+    throw ValueError("--noise-guides needs --noise F (guided noise is a setting of the noise pass)");
   if (noise && o.segment)
     throw ValueError("--noise with --segment: run the noise pass once all segments are done "
                      "(tempera stylize --noise F --noise-reference OUT/frames ...)");
@@ -387,6 +389,9 @@ bool run_noise_pass(const Options& o) {
   c.out = (fs::path(o.out) / "noisy").string();
   c.noise_map = o.noise_map;
   c.guides = o.guides;
+  c.exemplar_guides = o.exemplar_guides;  // for guided noise
+  c.exemplar_frame = o.exemplar_frame;
+  c.guide_weights = o.stylit.weights;
   c.options = o.noisy;
   c.options.synthesis.seed = o.stylit.synthesis.seed;
   c.options.synthesis.threads = o.stylit.synthesis.threads;
@@ -478,15 +483,15 @@ int run_stylize(const Args& args) {
   std::vector<FrameResult> results;
   try {
     const bool guide_map = !o.noise_map.empty() && !fs::is_regular_file(o.noise_map);
-    if (!o.scene.empty() && (o.noise_reference.empty() || guide_map)) render_guides(o, o.scene, o.frames_text, o.guides);
-    if (!o.noise_reference.empty()) {  // boil the given coherent frames
-      if (!run_noise_pass(o)) return interrupted(results);
-      return 0;
-    }
-    if (!o.exemplar_scene.empty()) {
+    if (!o.scene.empty() && (o.noise_reference.empty() || guide_map || o.noisy.noise_guides > 0)) render_guides(o, o.scene, o.frames_text, o.guides);
+    if (!o.exemplar_scene.empty() && (o.noise_reference.empty() || o.noisy.noise_guides > 0)) {
       o.exemplar_guides = (fs::path(o.out) / "exemplar_guides").string();
       o.exemplar_frame = o.exemplar_frame.value_or(1);
       render_guides(o, o.exemplar_scene, std::to_string(*o.exemplar_frame), o.exemplar_guides);
+    }
+    if (!o.noise_reference.empty()) {  // boil the given coherent frames
+      if (!run_noise_pass(o)) return interrupted(results);
+      return 0;
     }
     StylizeJobConfig config;
     config.style = o.exemplar;

@@ -2,6 +2,8 @@
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
+#include <tuple>
+
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
 #include "tempera/noisy_sequence.hpp"
@@ -23,6 +25,9 @@ NoisySequenceConfig sequence_config(const py::dict& d, const NoisyOptions& optio
   if (d.contains("noise_map")) c.noise_map = d["noise_map"].cast<std::string>();
   if (d.contains("guides")) c.guides = d["guides"].cast<std::string>();
   if (d.contains("resume")) c.resume = d["resume"].cast<bool>();
+  if (d.contains("exemplar_guides")) c.exemplar_guides = d["exemplar_guides"].cast<std::string>();
+  if (d.contains("exemplar_frame")) c.exemplar_frame = d["exemplar_frame"].cast<int>();
+  if (d.contains("guide_weights")) c.guide_weights = d["guide_weights"].cast<std::vector<std::pair<std::string, float>>>();
   c.options = options;
   return c;
 }
@@ -69,19 +74,25 @@ void bind_noisy(py::module_& m) {
   m.def(
       "noisy_frame",
       [](const FloatArray& style, const FloatArray& reference, int frame, const NoisyOptions& options,
-         std::optional<FloatArray> noise_map, const std::function<bool(double)>& progress) {
+         std::optional<FloatArray> noise_map, const std::function<bool(double)>& progress,
+         const std::vector<std::tuple<std::string, FloatArray, FloatArray, float>>& guide_pairs) {
         const ImageView s = py_bridge::view_of(style, "exemplar"), r = py_bridge::view_of(reference, "reference frame");
         const ImageView map = noise_map ? py_bridge::view_of(*noise_map, "noise map") : ImageView{};
+        std::vector<NoisyGuide> guides;  // (name, exemplar side, frame side, weight)
+        for (const auto& [name, source, target, weight] : guide_pairs)
+          guides.push_back({name, py_bridge::view_of(source, "exemplar guide " + name),
+                            py_bridge::view_of(target, "frame guide " + name), weight});
         ProgressCallback callback = py_bridge::with_gil([&](double f) { return progress ? progress(f) : true; });
         Image out;
         {
           py::gil_scoped_release release;
-          out = noisy_frame(s, r, frame, options, map, callback);
+          out = noisy_frame(s, r, frame, options, map, callback, guides);
         }
         return py_bridge::to_numpy(std::move(out));
       },
       py::arg("style"), py::arg("reference"), py::arg("frame"), py::arg("options"), py::arg("noise_map") = py::none(),
-      py::arg("progress") = nullptr, "One Color Me Noisy frame; use tempera.noisy.noisy_frame.");
+      py::arg("progress") = nullptr, py::arg("guides") = std::vector<std::tuple<std::string, FloatArray, FloatArray, float>>{},
+      "One Color Me Noisy frame; use tempera.noisy.noisy_frame.");
   m.def(
       "deform_exemplar",
       [](const FloatArray& style, const NoisyOptions& options, int frame) {

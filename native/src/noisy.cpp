@@ -13,6 +13,11 @@ namespace {
 
 constexpr double kRatio = 0.85;  // the paper's sampling-rate ratio between levels
 
+// An exemplar layer under the frame's MLS map (no map: the layer as it is).
+Image warped(const ImageView& layer, const Image& deformation) {
+  return deformation.empty() ? Image::copy_of(layer) : warp_by_map(layer, deformation.view());
+}
+
 }  // namespace
 
 SynthesisOptions noisy_defaults() {
@@ -41,12 +46,16 @@ std::vector<float> noisy_box_widths(float noise) {
 
 std::uint64_t noisy_frame_seed(std::uint64_t seed, int frame) { return mix64(seed ^ mix64(std::uint64_t(std::int64_t(frame)) + 0x6E6F697379ull)); }
 
-Image deform_exemplar(const ImageView& style, const NoisyOptions& o, int frame) {
-  if (!o.deform) return Image::copy_of(style);
-  const float scale = float(std::sqrt(double(style.pixel_count()) / 1e6));
-  const MlsLattice lattice = random_lattice(style.width, style.height, o.lattice_spacing * scale, o.shift_min * scale,
+Image exemplar_deformation(int width, int height, const NoisyOptions& o, int frame) {
+  if (!o.deform) return {};
+  const float scale = float(std::sqrt(double(width) * height / 1e6));
+  const MlsLattice lattice = random_lattice(width, height, o.lattice_spacing * scale, o.shift_min * scale,
                                             o.shift_max * scale, noisy_frame_seed(o.synthesis.seed, frame));
-  return warp_by_map(style, mls_backward_map(lattice, style.width, style.height).view());
+  return mls_backward_map(lattice, width, height);
+}
+
+Image deform_exemplar(const ImageView& style, const NoisyOptions& o, int frame) {
+  return warped(style, exemplar_deformation(style.width, style.height, o, frame));
 }
 
 Image dihedral_copy(const ImageView& image, int k) {
@@ -102,6 +111,19 @@ int join_level(const std::vector<float>& widths, float fp) {
   return l;
 }
 
+void validate_guides(const ImageView& style, const ImageView& reference, const std::vector<NoisyGuide>& guides) {
+  if (guides.empty())
+    throw ValueError("guided noise (noise_guides > 0) needs the light-path guides of the exemplar and of the frame");
+  for (const NoisyGuide& g : guides) {
+    require_same_size(g.source, concat("exemplar guide '", g.name, "'"), style, "exemplar");
+    require_same_size(g.target, concat("frame guide '", g.name, "'"), reference, "reference frame");
+    if (g.source.channels != g.target.channels)
+      throw ValueError(concat("guide '", g.name, "' has ", g.source.channels, " channels for the exemplar but ",
+                              g.target.channels, " for the frame"));
+    if (!std::isfinite(g.weight) || g.weight < 0) throw ValueError(concat("guide '", g.name, "' has a bad weight"));
+  }
+}
+
 void validate(const ImageView& style, const ImageView& reference, const NoisyOptions& o, const ImageView& map) {
   require_nonempty(style, "exemplar");
   require_nonempty(reference, "reference frame");
@@ -110,6 +132,8 @@ void validate(const ImageView& style, const ImageView& reference, const NoisyOpt
                             style.channels));
   if (!std::isfinite(o.noise) || o.noise < 0 || o.noise > 64)
     throw ValueError(concat("noise (the low-pass width f) must be in [0, 64] pixels, got ", o.noise));
+  if (!std::isfinite(o.noise_guides) || o.noise_guides < 0)
+    throw ValueError(concat("noise_guides (the guided-noise weight) must be >= 0, got ", o.noise_guides));
   if (!map.empty()) {
     if (map.channels != 1) throw ValueError("the noise map must have 1 channel");
     require_same_size(map, "noise map", reference, "reference frame");
@@ -151,16 +175,33 @@ void add_low_frequency_guides(SynthesisInput& in, const ImageView& exemplar, con
   }
 }
 
+// Guided noise: each light-path guide pair, the exemplar's side warped by
+// the frame's MLS map like S (so a deformed patch keeps its light), weight
+// StyLit's times noise_guides. The solver low-passes and resamples the guides
+// per level as it does S and R.
+void add_light_path_guides(SynthesisInput& in, const std::vector<NoisyGuide>& guides, const Image& deformation,
+                           const NoisyOptions& o, std::vector<Image>& keep) {
+  keep.reserve(guides.size());
+  for (const NoisyGuide& g : guides) {
+    if (!(g.weight > 0)) continue;
+    keep.push_back(warped(g.source, deformation));
+    in.guides.add(g.name, keep.back().view(), g.target, g.weight * o.noise_guides);
+  }
+}
+
 }  // namespace
 
 Image noisy_frame(const ImageView& style, const ImageView& reference, int frame, const NoisyOptions& o,
-                  const ImageView& noise_map, const ProgressCallback& progress) {
+                  const ImageView& noise_map, const ProgressCallback& progress, const std::vector<NoisyGuide>& guides) {
   validate(style, reference, o, noise_map);
+  const bool guided = o.noise_guides > 0;
+  if (guided) validate_guides(style, reference, guides);
   // With a map, f_p = f * map(p): the map says where the noise goes (1 =
   // the slider's amount, 0 = R as it is).
   const float f = noise_map.empty() ? o.noise : o.noise * std::max(0.0f, *std::max_element(noise_map.data, noise_map.data + noise_map.size()));
   if (!(f > 1.0f)) return Image::copy_of(reference);  // no noise anywhere: R itself
-  const Image exemplar = deform_exemplar(style, o, frame);
+  const Image deformation = exemplar_deformation(style.width, style.height, o, frame);
+  const Image exemplar = warped(style, deformation);
   SynthesisInput in;
   in.style = exemplar.view();
   in.target_width = reference.width;
@@ -168,6 +209,8 @@ Image noisy_frame(const ImageView& style, const ImageView& reference, int frame,
   in.reference = reference;
   std::vector<Image> low_frequency_images;  // kept alive for the guides' views
   if (o.consistency > 0) add_low_frequency_guides(in, exemplar.view(), reference, o, f, noise_map, low_frequency_images);
+  std::vector<Image> guide_images;  // the warped exemplar guides, kept alive likewise
+  if (guided) add_light_path_guides(in, guides, deformation, o, guide_images);
   std::vector<Image> dihedral_images;  // kept alive for the exemplars' views
   add_dihedral_exemplars(in, o, dihedral_images);
   SynthesisOptions opt = o.synthesis;

@@ -9,6 +9,7 @@
 #include "tempera/file_keys.hpp"
 #include "tempera/image_io.hpp"
 #include "tempera/stylit.hpp"
+#include "tempera/stylize_job.hpp"
 #include "tempera/text_file.hpp"
 
 namespace fs = std::filesystem;
@@ -47,6 +48,7 @@ NoisySequence::NoisySequence(NoisySequenceConfig config) : config_(std::move(con
   medium_ = read_image(c.exemplar);
   settings_ = settings_text(c.options, noisy_option_table()) + settings_text(c.options.synthesis, synthesis_option_table()) +
               file_stamp(c.exemplar);
+  if (guided()) read_exemplar_guides();
   if (!c.noise_map.empty()) {
     map_file_ = fs::is_regular_file(c.noise_map);
     if (map_file_) {
@@ -60,6 +62,45 @@ NoisySequence::NoisySequence(NoisySequenceConfig config) : config_(std::move(con
       noise_map(c.frames.front());  // names a missing guide now, not after hours
     }
   }
+}
+
+// Guided noise: the active light-path guides and the exemplar's side, read
+// once; the frame's side is read per frame (and its file is in the key).
+void NoisySequence::read_exemplar_guides() {
+  const NoisySequenceConfig& c = config_;
+  if (c.guides.empty()) throw ValueError("guided noise (noise_guides > 0) needs the frames' guide cache (--guides)");
+  if (c.exemplar_guides.empty())
+    throw ValueError("guided noise (noise_guides > 0) needs the exemplar's guide cache (--exemplar-guides)");
+  if (!fs::is_directory(c.exemplar_guides))
+    throw FileNotFoundError(concat("the exemplar guide folder '", c.exemplar_guides, "' does not exist"));
+  StylitOptions weights;
+  weights.weights = c.guide_weights;
+  light_path_ = active_guides(weights);
+  std::vector<std::string> names;
+  for (const auto& [name, weight] : light_path_) names.push_back(name);
+  const std::string path =
+      (fs::path(c.exemplar_guides) / frame_file("frame_", exemplar_guide_frame(c.exemplar_guides, c.exemplar_frame), "exr"))
+          .string();
+  const GuideFrame exemplar = GuideFrame::read(path, names);
+  for (const auto& [name, weight] : light_path_) {
+    const Image& g = exemplar.get(name);
+    if (g.width() != medium_.width() || g.height() != medium_.height())
+      throw ValueError(concat("the exemplar guide '", name, "' of '", path, "' is ", g.width(), "x", g.height(),
+                              " but the exemplar '", c.exemplar, "' is ", medium_.width(), "x", medium_.height()));
+    exemplar_guides_.push_back(tonemap_guide(g.view()));
+    settings_ += concat("|guide ", name, "=", weight);
+  }
+  settings_ += "|exemplar guides " + file_stamp(path);
+  frame_guides(c.frames.front());  // names a missing guide frame now, not after hours
+}
+
+std::vector<Image> NoisySequence::frame_guides(int frame) const {
+  std::vector<std::string> names;
+  for (const auto& [name, weight] : light_path_) names.push_back(name);
+  const GuideFrame g = GuideFrame::read(guide_path(frame), names);
+  std::vector<Image> out;
+  for (const std::string& name : names) out.push_back(tonemap_guide(g.get(name).view()));
+  return out;
 }
 
 std::string NoisySequence::reference_path(int frame) const {
@@ -83,7 +124,7 @@ Image NoisySequence::noise_map(int frame) const {
 
 std::string NoisySequence::key(int frame) const {
   std::string text = concat(settings_, "|", frame, "|", file_stamp(reference_path(frame)));
-  if (map_is_guide()) text += "|" + file_stamp(guide_path(frame));
+  if (map_is_guide() || guided()) text += "|" + file_stamp(guide_path(frame));
   return hash_hex(text);
 }
 
@@ -99,8 +140,15 @@ NoisyFrameResult NoisySequence::run_frame(std::size_t index, const ProgressCallb
   const auto t0 = std::chrono::steady_clock::now();
   const Image r = read_image(reference_path(frame));
   const Image map = noise_map(frame);
+  std::vector<Image> targets;
+  std::vector<NoisyGuide> guides;
+  if (guided()) {
+    targets = frame_guides(frame);
+    for (std::size_t i = 0; i < targets.size(); ++i)
+      guides.push_back({light_path_[i].first, exemplar_guides_[i].view(), targets[i].view(), light_path_[i].second});
+  }
   const Image out = noisy_frame(medium_.view(), r.view(), frame, config_.options, map.empty() ? ImageView{} : map.view(),
-                                progress);
+                                progress, guides);
   fs::create_directories(key_file.parent_path());
   write_image(result.path, out.view());  // atomic
   write_text_atomically(key_file.string(), k, "the resume key");

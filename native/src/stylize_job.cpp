@@ -255,19 +255,7 @@ void validate_config(const StylizeJobConfig& c) {
   active_guides(c.stylit);
 }
 
-int resolve_exemplar_frame(const StylizeJobConfig& c) {
-  if (c.exemplar_frame) return *c.exemplar_frame;
-  const std::vector<int> found = cached_frames(c.exemplar_guides);
-  if (found.empty())
-    throw FileNotFoundError(concat("no frame_####.exr in the exemplar guide folder '", c.exemplar_guides, "'"));
-  if (found.size() > 1) {
-    std::string list;
-    for (int f : found) list += concat(list.empty() ? "" : ", ", f);
-    throw ValueError(concat("the exemplar guide folder '", c.exemplar_guides, "' holds ", found.size(),
-                            " frames (", list, "); choose one with Exemplar Frame (--exemplar-frame)"));
-  }
-  return found.front();
-}
+int resolve_exemplar_frame(const StylizeJobConfig& c) { return exemplar_guide_frame(c.exemplar_guides, c.exemplar_frame); }
 
 // The painting at the exemplar guides' size: same aspect within 1% is
 // resampled (a photo of the template rarely lands on the exact pixel size).
@@ -285,6 +273,20 @@ Image fit_painting(Image painting, const std::string& path, int width, int heigh
 }
 
 }  // namespace
+
+int exemplar_guide_frame(const std::string& folder, std::optional<int> frame) {
+  if (frame) return *frame;
+  const std::vector<int> found = cached_frames(folder);
+  if (found.empty())
+    throw FileNotFoundError(concat("no frame_####.exr in the exemplar guide folder '", folder, "'"));
+  if (found.size() > 1) {
+    std::string list;
+    for (int f : found) list += concat(list.empty() ? "" : ", ", f);
+    throw ValueError(concat("the exemplar guide folder '", folder, "' holds ", found.size(),
+                            " frames (", list, "); choose one with Exemplar Frame (--exemplar-frame)"));
+  }
+  return found.front();
+}
 
 StylizeJob::StylizeJob(StylizeJobConfig config) : config_(std::move(config)) {
   validate_config(config_);

@@ -159,3 +159,24 @@ def test_the_warp_error_of_a_stylized_moving_shot_rises_with_the_width(cli_path,
     coherent = warp_error(tmp_path / "out" / "frames")
     assert all(a < b for a, b in zip(errors, errors[1:])), (coherent, errors)
     assert coherent < errors[0], (coherent, errors)
+
+
+def test_stylize_guided_noise_is_a_new_setting_and_errors_are_named(cli_path, caches, inputs):
+    plain = stylize(cli_path, *farm(caches, "--noise", "2.2"))
+    assert plain.returncode == 0, plain.stderr
+    before = frames(caches / "out" / "noisy")
+    guided = stylize(cli_path, *farm(caches, "--noise", "2.2", "--noise-guides", "0.5"))
+    assert guided.returncode == 0, guided.stderr
+    assert guided.stdout.count("skipped, already current") == 3  # the coherent frames only: the key holds it
+    after = frames(caches / "out" / "noisy")
+    assert any(np.abs(a - b).mean() > 0 for a, b in zip(after, before))  # the guides changed the search
+    bad = stylize(cli_path, *farm(caches, "--noise-guides", "0.5"))
+    assert bad.returncode == 2 and "needs --noise" in bad.stderr
+    bad = stylize(cli_path, *farm(caches, "--noise", "2.2", "--noise-guides", "-1"))
+    assert bad.returncode == 2 and "noise guides" in bad.stderr
+    lone = ("--exemplar", inputs / "medium.png", "--reference", inputs / "R", "--frames", "1-3", "--out",
+            inputs / "o", "--noise", "2.2", "--noise-guides", "0.5")
+    bad = run(cli_path, *lone)
+    assert bad.returncode == 2 and "--guides" in bad.stderr
+    bad = run(cli_path, *lone, "--guides", caches / "cache")
+    assert bad.returncode == 2 and "--exemplar-guides" in bad.stderr

@@ -205,3 +205,88 @@ def test_a_sequence_is_made_then_current(inputs, tmp_path):
         noisy.NoisySequence(**dict(args, noise=1.6)).run_frame(0, lambda f: False)
     with pytest.raises(ValueError, match="neither an image file nor a guide"):
         noisy.NoisySequence(**args, noise_map="alpha")
+
+
+def thin_strokes():
+    """Guided noise's case (docs/noisy.md): R's thin red strokes lie on dark
+    hatching; S has red strokes only in its lit half, on a lighter ground, so
+    a colour-only search matches R's strokes with S's dark, unlit half."""
+    rng = np.random.default_rng(1)
+    red = np.array([0.9, 0.1, 0.1], np.float32)
+    style = np.zeros((64, 64, 3), np.float32)
+    style[:, :32] = 0.38 + 0.1 * rng.random((64, 32, 1))
+    style[:, 32:] = 0.3 + 0.1 * rng.random((64, 32, 1))
+    style[:, 2:32:6] = red
+    lit = np.where(np.arange(64) < 32, 0.9, 0.1).astype(np.float32)
+    style_guide = np.broadcast_to(lit[None, :, None], (64, 64, 1)).copy()
+    reference = (0.3 + 0.1 * rng.random((40, 48, 1))).repeat(3, 2).astype(np.float32)
+    reference[:, 10:26:6] = red
+    x = np.arange(48)
+    frame_guide = np.broadcast_to(np.where((x >= 8) & (x < 28), 0.9, 0.1)[None, :, None], (40, 48, 1))
+    return style, reference, {"LDE": (style_guide, frame_guide.astype(np.float32).copy(), 1.0)}
+
+
+def red_kept(out, reference):
+    strokes = (reference[..., 0] > 0.7) & (reference[..., 1] < 0.3)
+    return float(((out[..., 0] > 0.6) & (out[..., 1] < 0.4) & strokes).sum() / strokes.sum())
+
+
+@pytest.mark.parametrize("guided", [0.5])
+def test_guided_noise_keeps_the_thin_strokes(guided):
+    style, reference, guides = thin_strokes()
+    kept = {}
+    for g in (0.0, guided):
+        a, b = (noisy.noisy_frame(style, reference, f, noise=2.2, threads=2, noise_guides=g, guides=guides)
+                for f in (1, 2))
+        kept[g] = red_kept(a, reference)
+        if g:
+            assert np.abs(a - b).mean() > 0.01  # it still boils
+            assert temporal.box_consistency_error(a, reference, 2.2) <= 0.05  # the large shapes stay R's
+    assert kept[guided] >= 0.8 and kept[guided] > kept[0.0] + 0.3, kept
+
+
+def test_guided_noise_is_the_same_for_any_thread_count():
+    style, reference, guides = thin_strokes()
+    one, two = (noisy.noisy_frame(style, reference, 3, noise=3.1, threads=t, noise_guides=0.5, guides=guides)
+                for t in (1, 2))
+    np.testing.assert_array_equal(one, two)
+
+
+def test_guided_noise_names_missing_or_bad_guides():
+    style, reference, guides = thin_strokes()
+    with pytest.raises(ValueError, match="light-path guides"):
+        noisy.noisy_frame(style, reference, 1, noise=2.2, noise_guides=0.5)
+    with pytest.raises(ValueError, match="noise_guides"):
+        noisy.noisy_frame(style, reference, 1, noise=2.2, noise_guides=-1, guides=guides)
+    small = {"LDE": (guides["LDE"][0][:32], guides["LDE"][1], 1.0)}
+    with pytest.raises(ValueError, match="exemplar guide 'LDE'"):
+        noisy.noisy_frame(style, reference, 1, noise=2.2, noise_guides=0.5, guides=small)
+
+
+def test_a_guided_sequence_reads_both_caches_and_keys_the_setting(tmp_path):
+    import tempera
+    from tempera import guide_cache
+
+    style, reference, guides = thin_strokes()
+    source, target, _ = guides["LDE"]
+    (tmp_path / "R").mkdir()
+    tempera.write_image(str(tmp_path / "medium.png"), style)
+    guide_cache.write_frame(str(tmp_path / "exemplar_guides"), 1, {"LDE": source.repeat(3, 2)})
+    for f in (1, 2):
+        tempera.write_image(str(tmp_path / "R" / f"frame_{f:04d}.png"), reference)
+        guide_cache.write_frame(str(tmp_path / "guides"), f, {"LDE": target.repeat(3, 2)})
+    args = dict(exemplar=tmp_path / "medium.png", reference=tmp_path / "R", frames=[1, 2], out=tmp_path / "out",
+                noise=2.2, threads=2, guides=tmp_path / "guides", exemplar_guides=tmp_path / "exemplar_guides",
+                guide_weights={"LDE": 1.0}, noise_guides=0.5)
+    assert [noisy.NoisySequence(**args).run_frame(i)["status"] for i in range(2)] == ["made", "made"]
+    assert noisy.NoisySequence(**args).run_frame(0)["status"] == "skipped"
+    assert noisy.NoisySequence(**dict(args, noise_guides=1.0)).run_frame(0)["status"] == "made"  # new setting
+    assert noisy.NoisySequence(**dict(args, noise_guides=0.0)).run_frame(1)["status"] == "made"
+    with pytest.raises(ValueError, match="exemplar's guide cache"):
+        noisy.NoisySequence(**dict(args, exemplar_guides=None))
+
+
+def test_guided_noise_off_ignores_the_guides_bit_for_bit():
+    style, reference, guides = thin_strokes()
+    plain = noisy.noisy_frame(style, reference, 2, noise=2.2, threads=2)
+    np.testing.assert_array_equal(noisy.noisy_frame(style, reference, 2, noise=2.2, threads=2, guides=guides), plain)

@@ -165,6 +165,7 @@ def draw_noise(box, settings):
     if settings.noise_level == 0:
         return
     col.label(text=f"f = {noisy.noise_width(settings.noise_level)} px: frames boil into Output Folder/noisy")
+    col.prop(settings, "noise_guided")
     col.prop(settings, "noise_map_source")
     field = {"IMAGE": "noise_map_image", "OBJECT": "noise_map_object", "COLLECTION": "noise_map_collection",
              "GUIDE": "noise_map_guide"}.get(settings.noise_map_source)

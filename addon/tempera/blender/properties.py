@@ -347,6 +347,12 @@ class TemperaSettings(PropertyGroup):
         "0 = off, the coherent frames as they are)",
         default=0, min=0, max=len(noisy.TESTED_NOISE),
     )
+    noise_guided: BoolProperty(
+        name="Guided Noise",
+        description="Also keep the light-path guides while boiling, so thin strokes stay where the light "
+        "matches the exemplar's (slower; docs/noisy.md)",
+        default=False,
+    )
     noise_map_source: EnumProperty(name="Noise Map", items=noisy.NOISE_MAP_SOURCES, default="NONE",
                                    description="Where the temporal noise goes")
     noise_map_image: StringProperty(name="Map Image", subtype="FILE_PATH",

@@ -111,9 +111,13 @@ def noise_config(settings, out, config):
         settings.noise_map_source, resolve_path(image, "noise map image") if image else "",
         settings.noise_map_object.name if settings.noise_map_object else "",
         settings.noise_map_collection.name if settings.noise_map_collection else "", settings.noise_map_guide.strip())
-    return dict(exemplar=config["style"], reference=config["out"], frames=config["frames"],
+    args = dict(exemplar=config["style"], reference=config["out"], frames=config["frames"],
                 out=os.path.join(out, NOISY_DIR), noise_map=noise_map, guides=config["guides"],
                 noise=noisy.noise_width(settings.noise_level), seed=config["seed"])
+    if settings.noise_guided:  # guided noise: the exemplar's guides and StyLit's weights
+        args.update(exemplar_guides=config["exemplar_guides"], exemplar_frame=config.get("exemplar_frame"),
+                    guide_weights=config["weights"], noise_guides=limits.PANEL_NOISE_GUIDES)
+    return args
 
 
 def output_dir(settings):

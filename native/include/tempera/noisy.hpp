@@ -22,8 +22,14 @@
 //  - optional rotations and reflections of P (eq. 1): the exemplar's dihedral
 //    copies join the source set as further exemplars;
 //  - a local noise map f_p (§3.3): pixel p joins the synthesis at the first
-//    level whose f_bar <= f_p and copies R before; f_p < 1 copies R outright.
+//    level whose f_bar <= f_p and copies R before; f_p < 1 copies R outright;
+//  - optional guided noise (the thesis's future work): StyLit's light-path
+//    guides of the exemplar render (warped by the same MLS map as S) against
+//    those of the frame join as guide pairs at every level, so the search
+//    takes its patches where the light matches (docs/noisy.md).
 #include <cstdint>
+#include <string>
+#include <vector>
 
 #include "tempera/image.hpp"
 #include "tempera/mls.hpp"
@@ -40,6 +46,7 @@ struct NoisyOptions {
   float consistency = 2.75f;    // weight of the low-frequency term (eq. 2) as a guide pair
   bool rotations = false;      // the exemplar's quarter turns join the source set (eq. 1: P "rotated")
   bool reflections = false;    // its mirror images too (with rotations: all 8 dihedral copies)
+  float noise_guides = 0;      // guided noise: scale of StyLit's light-path guide weights; 0 = off
   SynthesisOptions synthesis;  // patch 7, mode voting, 4 EM x 2 PM per level, usage none (noisy_defaults())
 };
 
@@ -60,7 +67,10 @@ inline const auto& noisy_option_table() {
       field(&N::rotations, "rotations", "rotations",
             "also copy patches from the exemplar turned by 90, 180 and 270 degrees (for media without a direction)"),
       field(&N::reflections, "reflections", "reflections",
-            "also copy patches from the exemplar's mirror image (and its turns, with rotations)"));
+            "also copy patches from the exemplar's mirror image (and its turns, with rotations)"),
+      field(&N::noise_guides, "noise_guides", "noise-guides",
+            "guided noise: keep StyLit's light-path guides at every level, their weights times this "
+            "(0 = off; the panel uses 0.5, docs/noisy.md); needs both guide caches", 0, 1e6));
   return table;
 }
 
@@ -78,16 +88,32 @@ std::vector<float> noisy_box_widths(float noise);
 // The per-frame seed: mix(seed, frame).
 std::uint64_t noisy_frame_seed(std::uint64_t seed, int frame);
 
+// The MLS pre-deformation of frame `frame` as a backward map (x, y per
+// pixel) over a width x height exemplar; empty when options.deform is off.
+Image exemplar_deformation(int width, int height, const NoisyOptions& options, int frame);
+
 // The exemplar `style` deformed for frame `frame` (the MLS pre-deformation).
 Image deform_exemplar(const ImageView& style, const NoisyOptions& options, int frame);
+
+// One light-path guide pair for guided noise: the exemplar render's guide
+// (the exemplar's size, undeformed: noisy_frame warps it like S), the
+// frame's (R's size), both tone-mapped, and StyLit's weight, which
+// options.noise_guides scales.
+struct NoisyGuide {
+  std::string name;
+  ImageView source, target;
+  float weight = 1;
+};
 
 // The dihedral copy `k` of an image: bit 0 mirrors x, bits 1-2 count the
 // quarter turns clockwise after it (k = 0: the image itself).
 Image dihedral_copy(const ImageView& image, int k);
 
 // One noisy frame. `reference` is R_i (any size; the exemplar's channels);
-// `noise_map` (optional, R's size, 1 channel) holds f_p per pixel.
+// `noise_map` (optional, R's size, 1 channel) holds f_p per pixel. `guides`
+// are used when options.noise_guides > 0 (and then required).
 Image noisy_frame(const ImageView& style, const ImageView& reference, int frame, const NoisyOptions& options,
-                  const ImageView& noise_map = {}, const ProgressCallback& progress = {});
+                  const ImageView& noise_map = {}, const ProgressCallback& progress = {},
+                  const std::vector<NoisyGuide>& guides = {});
 
 }  // namespace tempera

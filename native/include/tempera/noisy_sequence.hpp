@@ -6,11 +6,14 @@
 // independent, so a farm may split the range anywhere; each output is
 // written atomically with a key beside it (OUT/.tempera_noisy/0001.key), and
 // a rerun skips frames whose key still matches.
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tempera/image.hpp"
 #include "tempera/noisy.hpp"
+#include "tempera/stylit.hpp"
 
 namespace tempera {
 
@@ -24,7 +27,12 @@ struct NoisySequenceConfig {
   // size), or the name of a guide in the guide cache `guides` ("alpha",
   // "mask.OB_Cube", an AOV), read per frame. 0 keeps R, 1 is the full amount.
   std::string noise_map;
-  std::string guides;             // guide cache folder, for a guide noise map
+  std::string guides;             // guide cache folder, for a guide noise map and guided noise
+  // Guided noise (options.noise_guides > 0): the exemplar render's guide
+  // cache (its frame as in StylizeJobConfig) and StyLit's guide weights.
+  std::string exemplar_guides;
+  std::optional<int> exemplar_frame;
+  std::vector<std::pair<std::string, float>> guide_weights = default_guide_weights();
   NoisyOptions options = default_noisy_options();
   bool resume = true;
 };
@@ -52,6 +60,9 @@ class NoisySequence {
   std::string guide_path(int frame) const;
   bool map_is_guide() const { return !config_.noise_map.empty() && !map_file_; }
   Image noise_map(int frame) const;
+  bool guided() const { return config_.options.noise_guides > 0; }
+  void read_exemplar_guides();
+  std::vector<Image> frame_guides(int frame) const;  // tone-mapped, in light_path_ order
   std::string key(int frame) const;
 
   NoisySequenceConfig config_;
@@ -59,6 +70,8 @@ class NoisySequence {
   bool map_file_ = false;
   Image file_map_;
   std::string settings_;
+  std::vector<std::pair<std::string, float>> light_path_;  // guided noise: the active guides
+  std::vector<Image> exemplar_guides_;                      // their exemplar side, tone-mapped
 };
 
 }  // namespace tempera

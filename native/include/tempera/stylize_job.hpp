@@ -27,6 +27,10 @@ struct StylizeJobConfig {
   bool resume = true;
 };
 
+// The exemplar's guide cache frame: `frame` if given, else the folder's only
+// frame_*.exr (FileNotFoundError if none, ValueError if several).
+int exemplar_guide_frame(const std::string& folder, std::optional<int> frame);
+
 struct FrameResult {
   int frame = 0;
   std::string path;
