@@ -15,6 +15,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 import pytest
+from guide_scene import remove_scene
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "scenes"))
 import noisy_turning_suzanne  # noqa: E402
@@ -43,9 +44,7 @@ def user_scene(tmp_path):
     settings.load_result = "NONE"
     yield scene
     bpy.context.window.scene = shown
-    for o in list(scene.objects):
-        bpy.data.objects.remove(o)
-    bpy.data.scenes.remove(scene)
+    remove_scene(scene)
 
 
 def _frames(folder):

@@ -8,6 +8,7 @@ import math
 import bpy
 import numpy as np
 import pytest
+from guide_scene import remove_scene
 from fake_ui import esc_within_next_step
 
 SCENE = "Rigid method test"
@@ -67,9 +68,7 @@ def rigid_scene(tmp_path):
     settings.load_result = "IMAGE"
     yield scene
     bpy.context.window.scene = shown
-    for o in list(scene.objects):
-        bpy.data.objects.remove(o)
-    bpy.data.scenes.remove(scene)
+    remove_scene(scene)
 
 
 def _frames(folder):

@@ -12,6 +12,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 import pytest
+from guide_scene import remove_scene
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "scenes"))
 import rigid_fractured_cube  # noqa: E402
@@ -53,9 +54,7 @@ def fractured_scene(tmp_path):
     settings.load_result = "NONE"
     yield scene, sorted(o.name for o in shards)
     bpy.context.window.scene = shown
-    for o in list(scene.objects):
-        bpy.data.objects.remove(o)
-    bpy.data.scenes.remove(scene)
+    remove_scene(scene)
 
 
 def _lowest_z(scene, name, frame):
