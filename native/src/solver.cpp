@@ -262,7 +262,6 @@ struct Solver::Plan {
   // Per level: the sizes of `source` and `target`, which outlive them once a
   // level's last solve has freed them (LevelStart::last_use).
   std::vector<std::pair<int, int>> source_size, target_size;
-  std::vector<std::uint8_t> released;
   std::vector<Image> source_mask, target_mask, source_angle, target_angle, source_label, target_label;
   std::vector<std::vector<Image>> weight_maps;  // per guide (may be empty)
   std::vector<Image> reference, fixed_mask, fixed_values;
@@ -364,7 +363,6 @@ Solver::Solver(const SynthesisInput& in, const SynthesisOptions& opt) : plan_(ne
     p.source_size.emplace_back(p.source[l].width(), p.source[l].height());
     p.target_size.emplace_back(p.target[l].width(), p.target[l].height());
   }
-  p.released.assign(std::size_t(p.levels), 0);
   for (std::size_t e = 0; e < ex.size(); ++e) {
     const auto [cw, ch] = sizes[e].back();
     if (cw >= opt.patch_size + 2 && ch >= opt.patch_size + 2) continue;
@@ -471,7 +469,7 @@ PatchSpace Solver::geometry(int l, FeatureImage& source, FeatureImage& target) c
 void Solver::build_level(int l, Level& level, const LevelStart* start) const {
   const Image* fixed_mask = start ? start->fixed_mask : nullptr;
   Plan& p = *plan_;
-  if (p.released[std::size_t(l)])
+  if (p.source[std::size_t(l)].empty())
     throw ValueError(concat("level ", l, " was solved with last_use; its pyramids are freed"));
   // The level's last use frees each float pyramid level as soon as its
   // features are built, so that the plan's copy and the features are not
@@ -489,7 +487,7 @@ void Solver::build_level(int l, Level& level, const LevelStart* start) const {
   level.source.set_channels(0, p.source[l].view(), 1.0f);
   if (release) p.source[l] = Image();
   if (total > p.style_channels) level.target.set_channels(p.style_channels, p.target[l].view(), 1.0f);
-  if (release) p.target[l] = Image(), p.released[std::size_t(l)] = 1;
+  if (release) p.target[l] = Image();
   if (start) replace_guide_targets(l, *start, level.target);
   if (options_.color_space == ColorSpace::Lab)
     level.source.set_channels(0, srgb_to_lab(level.style.view()).view(), p.style_scales);

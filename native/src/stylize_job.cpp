@@ -255,8 +255,6 @@ void validate_config(const StylizeJobConfig& c) {
   active_guides(c.stylit);
 }
 
-int resolve_exemplar_frame(const StylizeJobConfig& c) { return exemplar_guide_frame(c.exemplar_guides, c.exemplar_frame); }
-
 // The painting at the exemplar guides' size: same aspect within 1% is
 // resampled (a photo of the template rarely lands on the exact pixel size).
 Image fit_painting(Image painting, const std::string& path, int width, int height,
@@ -296,7 +294,8 @@ StylizeJob::StylizeJob(StylizeJobConfig config) : config_(std::move(config)) {
 
   require_file(config_.style, "painting");
   require_folder(config_.exemplar_guides, "exemplar guide");
-  exemplar_path_ = guide_cache_frame(config_.exemplar_guides, resolve_exemplar_frame(config_));
+  exemplar_path_ =
+      guide_cache_frame(config_.exemplar_guides, exemplar_guide_frame(config_.exemplar_guides, config_.exemplar_frame));
   require_file(exemplar_path_, "exemplar guide frame");
   exemplar_ = GuideFrame::read(exemplar_path_, names);
   const Image& first = exemplar_.get(names.front());
