@@ -66,7 +66,8 @@ struct Factor {
 // reflections S, refraction T; transparent is no event (the path goes on).
 struct Closure {
   enum class Type {
-    principled,   // Principled BSDF (Cycles 3.x v1: Disney diffuse, GGX with its Fresnel, smooth glass, clearcoat)
+    principled,   // Principled BSDF: Cycles 3.x v1 (Disney diffuse, GGX with its Fresnel, smooth glass,
+                  // clearcoat), or Cycles 4 v2's layers with ClosureModel::principled_v2
     diffuse,      // Lambert, or Oren-Nayar with a roughness
     glossy,       // microfacet reflection tinted by color, no Fresnel (Glossy, Anisotropic)
     glass,        // smooth dielectric: Fresnel reflection S + refraction T, both tinted
