@@ -165,3 +165,32 @@ TEST(PrincipledV2, F82TintDarkensOnlyGrazingMetal) {
     for (int x = 14; x < 18; ++x) centre_a += a.at(x, y, 0), centre_b += b.at(x, y, 0);
   EXPECT_NEAR(centre_b / centre_a, 1.0, 0.02);
 }
+
+TEST(PrincipledV2, TransmissionIsGlassWithAnUntintedReflection) {
+  // Transmission 1: clear glass in a white world lets through what reaches it
+  // (rough: one microfacet closure; smooth: singular). Cycles 4 tints only the
+  // refraction, by sqrt(base colour): a red base leaves the reflection white.
+  for (const float roughness : {0.0f, 0.3f}) {
+    Closure glass = principled({1, 0.25f, 0.25f}, roughness);
+    glass.transmission = 1;
+    Scene s = furnace(glass);
+    TraceOptions o;
+    o.samples = 128;
+    o.max_bounces = 64;
+    const TraceResult r = trace_lpe(s, {"LSE", "L.*TE"}, o);
+    double red = 0, green = 0, reflected_red = 0, reflected_green = 0;
+    const Image &t = r.images[1], &reflected = r.images[0];
+    for (int y = 0; y < t.height(); ++y)
+      for (int x = 0; x < t.width(); ++x) {
+        red += t.at(x, y, 0), green += t.at(x, y, 1);
+        reflected_red += reflected.at(x, y, 0), reflected_green += reflected.at(x, y, 1);
+      }
+    EXPECT_GT(reflected_red, 0) << roughness;
+    EXPECT_NEAR(reflected_green / reflected_red, 1.0, 0.02) << roughness;  // white reflection
+    EXPECT_LT(green / red, 0.6) << roughness;  // red refraction: sqrt(0.25) = 0.5 a pass
+    glass.color = {1, 1, 1};
+    const double clear = mean(trace_lpe(furnace(glass), {"L.*E"}, o).images[0]);
+    EXPECT_GT(clear, 0.85) << roughness;  // white glass: at most what reaches it, little lost
+    EXPECT_LT(clear, 1.02) << roughness;
+  }
+}

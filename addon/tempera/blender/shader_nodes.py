@@ -524,7 +524,8 @@ class ShaderInterpreter:
         transmission = self.constant_scalar(get("Transmission Weight", "Transmission"), ctx,
                                             f"Principled '{node.name}' Transmission")
         roughness = self.scalar(get("Roughness"), ctx)
-        if transmission > 0 and (not roughness.constant or float(roughness.const) >= SINGULAR_ROUGHNESS):
+        rough = not roughness.constant or float(roughness.const) >= SINGULAR_ROUGHNESS
+        if transmission > 0 and rough and not v2:  # v2's transmission is the tracer's rough glass
             self.warn(f"Principled '{node.name}': rough transmission is traced as smooth glass.")
         closure = self._closure("principled", color=base, metallic=metallic, specular=specular,
                                 transmission=transmission, ior=ior, roughness=roughness)

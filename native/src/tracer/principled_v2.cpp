@@ -96,6 +96,36 @@ Float3 add_specular(ShadingPoint& s, const Closure& c, Float3 weight, float roug
   return below_layer(weight, albedo);
 }
 
+// Transmission: glass whose reflection (F of each microfacet) is untinted
+// and whose refraction (1 - F) is tinted by sqrt(base colour), as Cycles 4
+// splits them; rough glass is one microfacet closure, smooth glass singular.
+void add_transmission(ShadingPoint& s, const Closure& c, Float3 weight, Float3 base, float roughness) {
+  const float eta = s.front ? std::max(c.ior, 1e-5f) : 1 / std::max(c.ior, 1e-5f);
+  const Float3 b = clamp01(base);
+  const Float3 refracted = weight * Float3{std::sqrt(b.x), std::sqrt(b.y), std::sqrt(b.z)};
+  if (roughness >= kSingularRoughness) {
+    Lobe reflection = reflection_lobe(weight, roughness, false, FresnelMode::dielectric, {});
+    reflection.eta = eta;
+    add_lobe(s, reflection);
+    Lobe t = reflection_lobe(refracted, roughness, false, FresnelMode::dielectric, {});
+    t.kind = LobeKind::microfacet_transmission;
+    t.eta = eta;
+    add_lobe(s, t);
+    return;
+  }
+  Lobe glass;  // two singular parts, each with its own tint and its share F or 1 - F
+  glass.kind = LobeKind::dielectric;
+  glass.eta = eta;
+  glass.fresnel = FresnelMode::dielectric;
+  glass.weight = weight;
+  glass.refract = false;
+  add_lobe(s, glass);
+  glass.weight = refracted;
+  glass.reflect = false;
+  glass.refract = true;
+  add_lobe(s, glass);
+}
+
 }  // namespace
 
 Float3 fresnel_f82(Float3 f0, Float3 b, float cos_theta) {
@@ -121,14 +151,8 @@ void add_principled_v2(ShadingPoint& s, const Closure& c, Float3 weight, Float3 
     weight = weight * (1 - metallic);
   }
   const float transmission = std::clamp(c.transmission, 0.0f, 1.0f);
-  if (transmission > kWeightCutoff) {  // traced as smooth glass; Cycles tints its refraction by sqrt(base)
-    Lobe glass;
-    glass.kind = LobeKind::dielectric;
-    const Float3 b = clamp01(base);
-    glass.weight = weight * Float3{std::sqrt(b.x), std::sqrt(b.y), std::sqrt(b.z)} * transmission;
-    glass.eta = s.front ? c.ior : 1 / c.ior;
-    glass.fresnel = FresnelMode::dielectric;
-    add_lobe(s, glass);
+  if (transmission > kWeightCutoff) {
+    add_transmission(s, c, weight * transmission, base, roughness);
     weight = weight * (1 - transmission);
   }
   weight = add_specular(s, c, weight, roughness, mu);
