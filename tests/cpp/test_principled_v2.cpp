@@ -219,3 +219,41 @@ TEST(PrincipledV2, SameResultForAnyThreadCount) {
     EXPECT_GT(mean(a.images[k]), 0.0) << k;
   }
 }
+
+TEST(PrincipledV2, WithoutReflectiveCausticsTheDiffuseHasNoLayersAbove) {
+  // After a diffuse bounce with reflective caustics off, Cycles builds none of
+  // Principled v2's reflective layers, nor the 1 - albedo they pass down: the
+  // diffuse then has its full weight. Seen through a Lambert floor (LDDE: the
+  // floor, then a white dielectric sphere above it), the sphere's diffuse is
+  // 1 / (1 - its specular albedo) brighter than with caustics on.
+  Scene s;
+  Material floor;
+  Closure lambert;
+  lambert.type = Closure::Type::diffuse;
+  lambert.color = {0.8f, 0.8f, 0.8f};
+  floor.closures = {lambert};
+  Material sphere;
+  Closure white = principled({1, 1, 1}, 0.5f);
+  white.multiscatter = true;
+  sphere.closures = {white};
+  s.materials = {floor, sphere};
+  const float h = 50;
+  const auto base = std::uint32_t(s.vertices.size());
+  s.vertices.insert(s.vertices.end(), {{-h, -h, 0}, {h, -h, 0}, {h, h, 0}, {-h, h, 0}});
+  s.triangles.push_back({base, base + 1, base + 2});
+  s.triangles.push_back({base, base + 2, base + 3});
+  s.triangle_materials.insert(s.triangle_materials.end(), {0, 0});
+  add_sphere(s, {0, 0, 1.2f}, 1, 1);
+  s.world_radiance = {1, 1, 1};
+  s.camera = top_camera(5, 6, 24);
+  s.closure_model.height_correlated_shadowing = true;
+  s.closure_model.principled_v2 = true;
+  TraceOptions o;
+  o.samples = 512;
+  o.max_bounces = 2;
+  const double with_caustics = mean(trace_lpe(s, {"LDDE"}, o).images[0]);
+  o.caustics_reflective = false;
+  const double without = mean(trace_lpe(s, {"LDDE"}, o).images[0]);
+  EXPECT_GT(without, with_caustics * 1.03);
+  EXPECT_LT(without, with_caustics * 1.10);
+}

@@ -113,7 +113,6 @@ float closure_roughness(const Scene& scene, const Closure& c, const SurfaceInput
   return std::clamp(r, 0.0f, 1.0f);
 }
 
-
 // Cycles 3.x's Principled Fresnel: the dielectric Fresnel of `eta`, remapped
 // so that it starts at f0 (the specular colour) at normal incidence.
 Float3 principled_fresnel(const Lobe& l, float cos_theta) {
@@ -121,7 +120,6 @@ Float3 principled_fresnel(const Lobe& l, float cos_theta) {
   const float t = (fresnel_dielectric(cos_theta, l.eta) - normal) / (1 - normal);
   return l.f0 + (Float3{1, 1, 1} - l.f0) * t;
 }
-
 
 void add_principled(ShadingPoint& s, Float3 weight, Float3 base, float metallic, float specular, float roughness,
                     float transmission, float ior) {
@@ -345,6 +343,8 @@ void filter_caustics(ShadingPoint& s, bool reflective, bool refractive) {
     Lobe l = s.lobes[i];
     if (l.kind == LobeKind::microfacet || l.kind == LobeKind::mirror) {
       if (!reflective) continue;
+    } else if (l.layered && !reflective) {
+      l.weight = l.unlayered_weight;
     } else if (l.kind == LobeKind::microfacet_transmission) {
       if (!refractive) continue;
     } else if (l.kind == LobeKind::dielectric) {

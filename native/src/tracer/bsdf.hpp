@@ -39,6 +39,10 @@ struct Lobe {
   float eta = 1;            // dielectric: n behind / n in front; microfacet with dielectric Fresnel
   bool reflect = true, refract = true;  // dielectric: which parts exist (refraction-only closures, caustic filter)
   bool sharp = false;       // mirror: a Sharp distribution (never blurred by Filter Glossy)
+  // lambert under Principled v2's reflective layers: its weight when reflective caustics are
+  // filtered, for Cycles then builds neither those layers nor the layering weight they pass down.
+  bool layered = false;
+  Float3 unlayered_weight;
   float pick = 0;           // selection probability
   bool singular() const { return kind == LobeKind::mirror || kind == LobeKind::dielectric; }
   bool diffuse() const {

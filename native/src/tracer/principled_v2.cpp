@@ -30,8 +30,19 @@ Float3 below_layer(Float3 weight, Float3 albedo) {
   return weight * std::clamp(1 - max_component(albedo), 0.0f, 1.0f);
 }
 
-// Coat: a GGX dielectric layer of its own IOR and roughness; what passes
-// through it is tinted by Beer's law along the refracted view ray, tint^(1/cos_t).
+// What passes through the coat is tinted by Beer's law along the refracted
+// view ray, tint^(1/cos_t), in proportion to the coat's weight.
+Float3 coat_tint(const Closure& c, Float3 weight, float mu) {
+  const float coat = std::max(c.clearcoat, 0.0f);
+  const Float3 tint = max0(c.coat_tint);
+  if (coat <= kWeightCutoff || (tint.x == 1 && tint.y == 1 && tint.z == 1)) return weight;
+  const float ior = std::max(c.coat_ior, 1.0f);
+  const float cos_t = std::sqrt(std::max(1e-6f, 1 - (1 - mu * mu) / (ior * ior)));
+  const Float3 through{std::pow(tint.x, 1 / cos_t), std::pow(tint.y, 1 / cos_t), std::pow(tint.z, 1 / cos_t)};
+  return weight * mix({1, 1, 1}, through, std::min(coat, 1.0f));
+}
+
+// Coat: a GGX dielectric layer of its own IOR and roughness, then its tint.
 Float3 add_coat(ShadingPoint& s, const Closure& c, Float3 weight, float mu) {
   const float coat = std::max(c.clearcoat, 0.0f);
   if (coat <= kWeightCutoff) return weight;
@@ -41,14 +52,7 @@ Float3 add_coat(ShadingPoint& s, const Closure& c, Float3 weight, float mu) {
   l.eta = ior;
   add_lobe(s, l);
   const float albedo = coat * (f0_from_ior(ior) + (1 - f0_from_ior(ior)) * ggx_fresnel_blend(roughness, mu, ior));
-  weight = below_layer(weight, {albedo, albedo, albedo});
-  const Float3 tint = max0(c.coat_tint);
-  if (tint.x != 1 || tint.y != 1 || tint.z != 1) {
-    const float cos_t = std::sqrt(std::max(1e-6f, 1 - (1 - mu * mu) / (ior * ior)));
-    const Float3 through{std::pow(tint.x, 1 / cos_t), std::pow(tint.y, 1 / cos_t), std::pow(tint.z, 1 / cos_t)};
-    weight *= mix({1, 1, 1}, through, std::min(coat, 1.0f));
-  }
-  return weight;
+  return coat_tint(c, below_layer(weight, {albedo, albedo, albedo}), mu);
 }
 
 // Multiscatter GGX's compensation of a lobe whose hemispherical mean Fresnel is f_ss.
@@ -144,21 +148,27 @@ Float3 f82_tint_b(Float3 f0, Float3 tint) {
 void add_principled_v2(ShadingPoint& s, const Closure& c, Float3 weight, Float3 base, float roughness) {
   const float mu = std::clamp(dot(s.n, s.wo), 0.0f, 1.0f);
   base = max0(base);
+  // `unlayered`: the weight without the reflective layers' 1 - albedo (see Lobe::layered).
+  Float3 unlayered = coat_tint(c, weight, mu);
   weight = add_coat(s, c, weight, mu);
   const float metallic = std::clamp(c.metallic, 0.0f, 1.0f);
   if (metallic > kWeightCutoff) {
     add_metal(s, c, weight * metallic, base, roughness, mu);
     weight = weight * (1 - metallic);
+    unlayered = unlayered * (1 - metallic);
   }
   const float transmission = std::clamp(c.transmission, 0.0f, 1.0f);
   if (transmission > kWeightCutoff) {
     add_transmission(s, c, weight * transmission, base, roughness);
     weight = weight * (1 - transmission);
+    unlayered = unlayered * (1 - transmission);
   }
   weight = add_specular(s, c, weight, roughness, mu);
   Lobe diffuse;  // Lambertian; subsurface scattering is traced as this diffuse reflection
   diffuse.kind = LobeKind::lambert;
   diffuse.weight = weight * base;
+  diffuse.layered = true;
+  diffuse.unlayered_weight = unlayered * base;
   add_lobe(s, diffuse);
 }
 
