@@ -28,12 +28,6 @@ SIZE = (96, 72)
 SAMPLES = 64  # Cycles and tracer alike
 MEAN_TOLERANCE = 0.05
 BLOCK_TOLERANCE = 0.15
-# Cycles 4.0's lights are modelled (compat.cycles_light_model); its Principled
-# v2 BSDF only by the v1 model: the metal scene's Principled surfaces give an
-# LDE mean error of 0.079 in 4.5 (0.21 before the 4.0 lights were modelled).
-CYCLES_4 = bpy.app.version >= (4, 0, 0)
-_PRINCIPLED_V2_XFAIL = pytest.mark.xfail(CYCLES_4, strict=True, reason="Principled v2 is traced as v1: metal "
-                                         "scene LDE mean error 0.079 in 4.5 (docs/lpe_guides.md)")
 COMPARED = {"LDE": "LDE", "LSE": "LSE", "LDDE": "L.*DDE"}  # Cycles guide -> tracer expression
 NOTHING = "L[^LDST]E"  # a well-formed expression no path can match
 
@@ -104,7 +98,7 @@ def traced(guides, expression):
 
 # --------------------------------------------------------------------------- tracer against Cycles
 
-@pytest.mark.parametrize("guide", [pytest.param("LDE", marks=_PRINCIPLED_V2_XFAIL), "LSE"])
+@pytest.mark.parametrize("guide", ["LDE", "LSE"])
 def test_direct_light_matches_cycles(metal, guide):
     guides = metal["guides"]
     mean_error, block_error = compare(traced(guides, COMPARED[guide]), guides[guide], guides["alpha"])
@@ -467,7 +461,10 @@ def test_materials_become_cycles_closures():
     node.image = image
     tree.links.new(node.outputs["Color"], bsdf.inputs["Base Color"])
     principled, emission = convert_material(textured, warnings)["closures"]
-    assert len(warnings) == 1 and "rough transmission is traced as smooth glass" in warnings[0]
+    if "Coat Weight" in bsdf.inputs:  # Principled v2: rough transmission is modelled
+        assert warnings == []
+    else:
+        assert len(warnings) == 1 and "rough transmission is traced as smooth glass" in warnings[0]
     warnings.clear()
     assert principled["type"] == "principled"
     for key, value in (("metallic", 0.3), ("specular", 0.6), ("roughness", 0.2), ("transmission", 0.1),
@@ -542,6 +539,36 @@ def test_materials_become_cycles_closures():
         bpy.data.materials.remove(material)
     bpy.data.node_groups.remove(group)
     bpy.data.images.remove(image)
+
+
+def test_principled_v2_inputs_are_exported():
+    """Blender 4's Principled v2: its specular level and tint, coat and
+    distribution reach the tracer's closure, with no warning, and compat
+    selects the tracer's Principled v2 model."""
+    from tempera.blender.scene_export import convert_material
+
+    material = bpy.data.materials.new("LPE v2")
+    material.use_nodes = True
+    bsdf = material.node_tree.nodes["Principled BSDF"]
+    if "Coat Weight" not in bsdf.inputs:
+        pytest.skip("Principled v1 (Blender 3.x)")
+    values = {"Coat Weight": 0.7, "Coat Roughness": 0.2, "Coat IOR": 1.6, "Specular IOR Level": 0.3}
+    for name, value in values.items():
+        bsdf.inputs[name].default_value = value
+    bsdf.inputs["Coat Tint"].default_value = (1.0, 0.5, 0.25, 1)
+    bsdf.inputs["Specular Tint"].default_value = (1.0, 0.9, 0.8, 1)
+    warnings = []
+    (closure,) = convert_material(material, warnings)["closures"]
+    assert warnings == []
+    for key, name in (("clearcoat", "Coat Weight"), ("clearcoat_roughness", "Coat Roughness"),
+                      ("coat_ior", "Coat IOR"), ("specular_ior_level", "Specular IOR Level")):
+        assert closure[key] == pytest.approx(values[name])
+    np.testing.assert_allclose(closure["coat_tint"], [1.0, 0.5, 0.25], rtol=1e-6)
+    np.testing.assert_allclose(closure["specular_tint"], [1.0, 0.9, 0.8], rtol=1e-6)
+    assert closure["multiscatter"]  # the node's default distribution
+    bsdf.distribution = "GGX"
+    assert not convert_material(material, warnings)["closures"][0]["multiscatter"]
+    assert compat.cycles_closure_model()["principled_v2"]
 
 
 def test_light_units():

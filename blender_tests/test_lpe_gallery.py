@@ -39,8 +39,6 @@ import bpy  # noqa: E402
 # compat.cycles_closure_model: 7.8 % -> 2.0 % in 4.5.)
 CYCLES_4 = bpy.app.version >= (4, 0, 0)
 CYCLES_4_DEVIATIONS = {
-    "principled_layers": {"LSE": "Principled v2's coat is not modelled (ignored, with a warning): the tracer's "
-                                 "LSE is 45 % below Cycles'"},
     "layer_weight": {"LSE": "Cycles 4's glossy highlights under Layer Weight mixes are 5 % brighter than 3.4's; "
                             "not its height-correlated shadowing (modelled, < 0.1 % at roughness 0.2): the "
                             "tracer is 7.3 % below"},
@@ -49,6 +47,10 @@ CYCLES_4_DEVIATIONS = {
 }
 
 SAMPLES = int(os.environ.get("GALLERY_SAMPLES", 128))  # Cycles and the tracer alike (override to study noise)
+# Scenes whose LSE is still noisy at 128 samples (unless GALLERY_SAMPLES overrides): principled_layers'
+# coat reflects a small light in a sharp highlight; in Cycles 4 its LSE error is 5.7 % at 128 samples,
+# 1.5 % at 256 and 2.1 % at 1024 (both renderers' 128-sample means are 4 % off their converged values).
+SCENE_SAMPLES = {} if "GALLERY_SAMPLES" in os.environ else {"principled_layers": 256}
 MEAN_TOLERANCE = 0.05
 CORRELATION_TOLERANCE = 0.98
 BLUR = 2  # box radius in pixels: 5 x 5
@@ -137,8 +139,9 @@ def gallery_figures(cycles, traced):
 def test_gallery_scene_matches_cycles(key, tmp_path):
     scene = lpe_gallery.build(key)
     try:
-        cycles = cycles_buffers(scene, tmp_path)
-        traced, warnings = traced_buffers(scene)
+        samples = SCENE_SAMPLES.get(key, SAMPLES)
+        cycles = cycles_buffers(scene, tmp_path, samples)
+        traced, warnings = traced_buffers(scene, samples)
     finally:
         lpe_gallery.remove(scene)
     figures, full_mean = gallery_figures(cycles, traced)

@@ -109,13 +109,14 @@ def _closure(value, what):
     r = _Reader(value, what)
     c = _native.Closure()
     c.type = _enum(_native.Closure.Type, r.text("type", CLOSURE_TYPES))
-    for key in ("weight", "color", "subsurface_color"):
+    for key in ("weight", "color", "subsurface_color", "specular_tint", "coat_tint"):
         if r.has(key):
             setattr(c, key, r.required(key))
     for key in ("roughness", "ior", "metallic", "specular", "transmission", "subsurface", "clearcoat",
-                "clearcoat_roughness"):
+                "clearcoat_roughness", "specular_ior_level", "coat_ior"):
         if r.has(key):
             setattr(c, key, r.number(key))
+    c.multiscatter = bool(r.get("multiscatter", False))
     for key in ("color_texture", "roughness_texture"):
         if r.has(key):
             setattr(c, key, _texture_ref(r.required(key), f"{what} {key}"))
@@ -259,7 +260,7 @@ def scene_from_dict(scene: dict):
     s.camera = _camera(r.required("camera"))
     if r.has("closure_model"):  # which Cycles' microfacets: {"height_correlated_shadowing": bool, ...}
         c = _Reader(r.required("closure_model"), "scene closure_model")
-        for key in ("height_correlated_shadowing", "microfacet_glass_fresnel"):
+        for key in ("height_correlated_shadowing", "microfacet_glass_fresnel", "principled_v2"):
             setattr(s.closure_model, key, bool(c.get(key, False)))
         c.finish()
     r.finish()

@@ -133,8 +133,13 @@ void bind_scene_types(py::module_& m) {
       .def_readwrite("transmission", &Closure::transmission)
       .def_readwrite("subsurface", &Closure::subsurface)
       .def_readwrite("clearcoat", &Closure::clearcoat)
-      .def_readwrite("clearcoat_roughness", &Closure::clearcoat_roughness);
+      .def_readwrite("clearcoat_roughness", &Closure::clearcoat_roughness)
+      .def_readwrite("specular_ior_level", &Closure::specular_ior_level)
+      .def_readwrite("coat_ior", &Closure::coat_ior)
+      .def_readwrite("multiscatter", &Closure::multiscatter);
   float3_field(closure, "weight", &Closure::weight);
+  float3_field(closure, "specular_tint", &Closure::specular_tint);
+  float3_field(closure, "coat_tint", &Closure::coat_tint);
   float3_field(closure, "subsurface_color", &Closure::subsurface_color);
   float3_field(closure, "color", &Closure::color);
 
@@ -219,7 +224,9 @@ void bind_scene_types(py::module_& m) {
       .def_readwrite("height_correlated_shadowing", &ClosureModel::height_correlated_shadowing,
                      "Smith shadowing 1 / (1 + Lambda(i) + Lambda(o)) (Cycles 4.0+) instead of G1(i) G1(o)")
       .def_readwrite("microfacet_glass_fresnel", &ClosureModel::microfacet_glass_fresnel,
-                     "rough glass weighted by the Fresnel of each microfacet (Cycles 4.0+), not of the normal");
+                     "rough glass weighted by the Fresnel of each microfacet (Cycles 4.0+), not of the normal")
+      .def_readwrite("principled_v2", &ClosureModel::principled_v2,
+                     "Principled closures are Cycles 4.0's layered Principled v2, not 3.x's v1");
 
   py::class_<Scene> scene(m, "Scene", "The tracer's scene: triangles, materials, lights, world and camera.");
   scene.def(py::init<>())

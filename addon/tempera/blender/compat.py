@@ -185,9 +185,11 @@ def cycles_closure_model():
     closure_model: Cycles 4.0 rewrote them (height-correlated Smith
     shadowing; rough glass as one closure with the Fresnel of each
     microfacet). No RNA property of a registered type tells them apart (the
-    node types are not in bpy.types until a node exists), so the version does."""
+    node types are not in bpy.types until a node exists), so the version does.
+    Cycles 4.0 also brought Principled v2 (coat, F82 metal, Lambertian diffuse
+    under a dielectric layer), which the tracer models as "principled_v2"."""
     cycles4 = bpy.app.version >= (4, 0, 0)
-    return {"height_correlated_shadowing": cycles4, "microfacet_glass_fresnel": cycles4}
+    return {"height_correlated_shadowing": cycles4, "microfacet_glass_fresnel": cycles4, "principled_v2": cycles4}
 
 
 def set_sharp_distribution(node):

@@ -272,7 +272,7 @@ def default_surface():
     if compat.default_surface_is_principled():
         return {"base_color": grey, "closures": [{"type": "principled", "color": grey, "metallic": 0.0,
                                                   "specular": 0.5, "roughness": 0.5, "transmission": 0.0,
-                                                  "ior": 1.5}]}
+                                                  "ior": 1.5, "multiscatter": True}]}  # the node's default
     return {"base_color": grey, "closures": [{"type": "diffuse", "color": grey}]}
 
 

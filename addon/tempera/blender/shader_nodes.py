@@ -518,13 +518,14 @@ class ShaderInterpreter:
         if v2:  # Blender 4: F0 from the IOR, scaled by the level (0.5 = as is)
             level = self.constant_scalar(inp["Specular IOR Level"], ctx, "Specular IOR Level")
             f0 = ((ior - 1) / (ior + 1)) ** 2 * 2 * level
-            specular = f0 / 0.08
+            specular = f0 / 0.08  # what Principled v1 (the tracer's 3.x model) makes of it
         else:
             specular = self.constant_scalar(inp["Specular"], ctx, f"Principled '{node.name}' Specular")
         transmission = self.constant_scalar(get("Transmission Weight", "Transmission"), ctx,
                                             f"Principled '{node.name}' Transmission")
         roughness = self.scalar(get("Roughness"), ctx)
-        if transmission > 0 and (not roughness.constant or float(roughness.const) >= SINGULAR_ROUGHNESS):
+        rough = not roughness.constant or float(roughness.const) >= SINGULAR_ROUGHNESS
+        if transmission > 0 and rough and not v2:  # v2's transmission is the tracer's rough glass
             self.warn(f"Principled '{node.name}': rough transmission is traced as smooth glass.")
         closure = self._closure("principled", color=base, metallic=metallic, specular=specular,
                                 transmission=transmission, ior=ior, roughness=roughness)
@@ -554,9 +555,10 @@ class ShaderInterpreter:
                 closure["clearcoat"] = clearcoat
                 closure["clearcoat_roughness"] = self.constant_scalar(inp["Clearcoat Roughness"], ctx,
                                                                       "Clearcoat Roughness")
+        if v2:
+            self.principled_v2(node, closure, ctx)
         ignored = []
-        for names, neutral in ((("Subsurface Weight",), 0.0), (("Sheen Weight", "Sheen"), 0.0),
-                               (("Coat Weight",), 0.0), (("Anisotropic",), 0.0)):
+        for names, neutral in ((("Sheen Weight", "Sheen"), 0.0), (("Anisotropic",), 0.0)):
             socket = get(*names)
             if socket is not None and (socket.is_linked or abs(float(socket.default_value) - neutral) > 1e-6):
                 ignored.append(socket.name)
@@ -566,6 +568,36 @@ class ShaderInterpreter:
         if get("Normal") is not None and get("Normal").is_linked:
             self.warn(f"Principled '{node.name}': the normal map is ignored.")
         return out
+
+    def principled_v2(self, node, closure, ctx):
+        """Principled v2's own inputs (Blender 4.0+), which the tracer's
+        Principled v2 model (closure_model "principled_v2") reads: the specular
+        level and tint, the coat and the distribution. Subsurface scattering is
+        traced as the Lambertian diffuse of the base colour."""
+        inp = node.inputs
+        name = f"Principled '{node.name}'"
+        closure["specular_ior_level"] = self.constant_scalar(inp["Specular IOR Level"], ctx, f"{name} Specular IOR Level")
+        closure["specular_tint"] = self._constant_color(inp["Specular Tint"], ctx, f"{name} Specular Tint")
+        closure["multiscatter"] = getattr(node, "distribution", "GGX") == "MULTI_GGX"
+        coat = self.constant_scalar(inp["Coat Weight"], ctx, f"{name} Coat Weight")
+        if coat > 0:
+            closure["clearcoat"] = coat  # the tracer's coat weight and roughness fields
+            closure["clearcoat_roughness"] = self.constant_scalar(inp["Coat Roughness"], ctx, f"{name} Coat Roughness")
+            closure["coat_ior"] = self.constant_scalar(inp["Coat IOR"], ctx, f"{name} Coat IOR")
+            closure["coat_tint"] = self._constant_color(inp["Coat Tint"], ctx, f"{name} Coat Tint")
+            if inp["Coat Normal"].is_linked:
+                self.warn(f"{name}: the coat normal is ignored.")
+        socket = inp["Subsurface Weight"]
+        if socket.is_linked or float(socket.default_value) > 0:
+            self.warn(f"{name}: subsurface scattering is traced as diffuse reflection of the base colour "
+                      "(no light transport under the surface).")
+
+    def _constant_color(self, socket, ctx, what):
+        v = self.color(socket, ctx)
+        if v.texels is not None:
+            self.warn(f"{what} is driven by a texture; its mean is used.")
+            return np.asarray(v.texels[:, :, :3].reshape(-1, 3).mean(0), np.float32)
+        return np.asarray(v.const, np.float32)[:3]
 
     def fallback(self, node, ctx):
         """The closest lobe for a shader the tracer does not model, in its own colour."""

@@ -66,7 +66,8 @@ struct Factor {
 // reflections S, refraction T; transparent is no event (the path goes on).
 struct Closure {
   enum class Type {
-    principled,   // Principled BSDF (Cycles 3.x v1: Disney diffuse, GGX with its Fresnel, smooth glass, clearcoat)
+    principled,   // Principled BSDF: Cycles 3.x v1 (Disney diffuse, GGX with its Fresnel, smooth glass,
+                  // clearcoat), or Cycles 4 v2's layers with ClosureModel::principled_v2
     diffuse,      // Lambert, or Oren-Nayar with a roughness
     glossy,       // microfacet reflection tinted by color, no Fresnel (Glossy, Anisotropic)
     glass,        // smooth dielectric: Fresnel reflection S + refraction T, both tinted
@@ -88,6 +89,13 @@ struct Closure {
   float subsurface = 0;  // mixes subsurface_color into the diffuse colour (scattering itself not traced)
   Float3 subsurface_color{0.8f, 0.8f, 0.8f};
   float clearcoat = 0, clearcoat_roughness = 0.03f;  // a GGX lobe, F0 0.04, weight 0.25 clearcoat
+  // Principled v2 (ClosureModel::principled_v2) reads clearcoat and
+  // clearcoat_roughness as Coat Weight and Coat Roughness, and these:
+  float specular_ior_level = 0.5f;     // scales the F0 the IOR gives by 2 x level
+  Float3 specular_tint{1, 1, 1};       // dielectric F0's tint; metal's F82 tint
+  float coat_ior = 1.5f;
+  Float3 coat_tint{1, 1, 1};           // absorption of the coat at normal incidence
+  bool multiscatter = false;           // Multiscatter GGX: the energy single scattering loses is restored
 };
 
 // A surface. With `closures` empty it is the single Principled closure given
@@ -175,6 +183,11 @@ struct Camera {
 struct ClosureModel {
   bool height_correlated_shadowing = false;
   bool microfacet_glass_fresnel = false;
+  // Principled closures are Cycles 4.0's Principled v2 (principled_v2.hpp):
+  // coat over metal, glass and a dielectric specular layer over Lambertian
+  // diffuse, each layer weighted by 1 - the albedo of the layers above;
+  // false: Cycles 3.x's v1 (Disney diffuse, Principled Fresnel, clearcoat).
+  bool principled_v2 = false;
 };
 
 struct Scene {

@@ -1,5 +1,7 @@
 #include "bsdf.hpp"
 
+#include "principled_v2.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -111,28 +113,12 @@ float closure_roughness(const Scene& scene, const Closure& c, const SurfaceInput
   return std::clamp(r, 0.0f, 1.0f);
 }
 
-void add_lobe(ShadingPoint& s, const Lobe& lobe) {
-  if (s.count < kMaxLobes && max_component(lobe.weight) > 0) s.lobes[s.count++] = lobe;
-}
-
 // Cycles 3.x's Principled Fresnel: the dielectric Fresnel of `eta`, remapped
 // so that it starts at f0 (the specular colour) at normal incidence.
 Float3 principled_fresnel(const Lobe& l, float cos_theta) {
   const float normal = fresnel_dielectric(1, l.eta);
   const float t = (fresnel_dielectric(cos_theta, l.eta) - normal) / (1 - normal);
   return l.f0 + (Float3{1, 1, 1} - l.f0) * t;
-}
-
-// A reflection of `roughness`: a mirror below kSingularRoughness, else microfacet.
-Lobe reflection_lobe(Float3 weight, float roughness, bool beckmann, FresnelMode fresnel, Float3 f0) {
-  Lobe l;
-  l.kind = roughness < kSingularRoughness ? LobeKind::mirror : LobeKind::microfacet;
-  l.weight = weight;
-  l.alpha2 = std::max(roughness * roughness * roughness * roughness, 1e-8f);
-  l.beckmann = beckmann;
-  l.fresnel = fresnel;
-  l.f0 = f0;
-  return l;
 }
 
 void add_principled(ShadingPoint& s, Float3 weight, Float3 base, float metallic, float specular, float roughness,
@@ -165,6 +151,10 @@ void add_closure(const Scene& scene, ShadingPoint& s, const Closure& c, const Su
   const Float3 color = closure_color(scene, c, at);
   switch (c.type) {
     case Closure::Type::principled: {
+      if (scene.closure_model.principled_v2) {
+        add_principled_v2(s, c, weight, color, closure_roughness(scene, c, at));
+        break;
+      }
       const float ss = std::clamp(c.subsurface, 0.0f, 1.0f);
       add_principled(s, weight, color * (1 - ss) + c.subsurface_color * ss, c.metallic, c.specular,
                      closure_roughness(scene, c, at), c.transmission, c.ior);
@@ -252,6 +242,9 @@ float lobe_energy(const ShadingPoint& s, const Lobe& l) {
   }
   if (l.fresnel == FresnelMode::schlick) return luminance(l.weight * schlick(l.f0, dot(s.n, s.wo)));
   if (l.fresnel == FresnelMode::principled) return luminance(l.weight * principled_fresnel(l, dot(s.n, s.wo)));
+  if (l.fresnel == FresnelMode::f82) return luminance(l.weight * fresnel_f82(l.f0, l.f82_b, dot(s.n, s.wo)));
+  if (l.fresnel == FresnelMode::dielectric && l.kind == LobeKind::mirror)  // a smooth coat
+    return luminance(l.weight) * fresnel_dielectric(dot(s.n, s.wo), l.eta);
   return luminance(l.weight);
 }
 
@@ -271,6 +264,21 @@ ShadingPoint start(const SurfaceInput& at) {
 }
 
 }  // namespace
+
+void add_lobe(ShadingPoint& s, const Lobe& lobe) {
+  if (s.count < kMaxLobes && max_component(lobe.weight) > 0) s.lobes[s.count++] = lobe;
+}
+
+Lobe reflection_lobe(Float3 weight, float roughness, bool beckmann, FresnelMode fresnel, Float3 f0) {
+  Lobe l;
+  l.kind = roughness < kSingularRoughness ? LobeKind::mirror : LobeKind::microfacet;
+  l.weight = weight;
+  l.alpha2 = std::max(roughness * roughness * roughness * roughness, 1e-8f);
+  l.beckmann = beckmann;
+  l.fresnel = fresnel;
+  l.f0 = f0;
+  return l;
+}
 
 float fresnel_dielectric(float cos_i, float eta) {
   cos_i = std::fabs(cos_i);
@@ -335,6 +343,8 @@ void filter_caustics(ShadingPoint& s, bool reflective, bool refractive) {
     Lobe l = s.lobes[i];
     if (l.kind == LobeKind::microfacet || l.kind == LobeKind::mirror) {
       if (!reflective) continue;
+    } else if (l.layered && !reflective) {
+      l.weight = l.unlayered_weight;
     } else if (l.kind == LobeKind::microfacet_transmission) {
       if (!refractive) continue;
     } else if (l.kind == LobeKind::dielectric) {
@@ -431,6 +441,7 @@ LobeValue evaluate_lobe(const ShadingPoint& s, const Lobe& l, Float3 wi) {
   Float3 f = l.weight * (d * g / (4 * cos_o));
   if (l.fresnel == FresnelMode::schlick) f *= schlick(l.f0, dot(wi, h));
   else if (l.fresnel == FresnelMode::principled) f *= principled_fresnel(l, dot(wi, h));
+  else if (l.fresnel == FresnelMode::f82) f *= fresnel_f82(l.f0, l.f82_b, dot(wi, h));
   else if (l.fresnel == FresnelMode::dielectric) f = f * fresnel_dielectric(dot(wi, h), l.eta);
   return {f, d * cos_h / (4 * dot(s.wo, h))};
 }
@@ -481,6 +492,8 @@ bool sample(const ShadingPoint& s, Rng& rng, Scatter& out) {
     Float3 w = l.weight / l.pick;
     if (l.fresnel == FresnelMode::schlick) w *= schlick(l.f0, cos_o);
     else if (l.fresnel == FresnelMode::principled) w *= principled_fresnel(l, cos_o);
+    else if (l.fresnel == FresnelMode::f82) w *= fresnel_f82(l.f0, l.f82_b, cos_o);
+    else if (l.fresnel == FresnelMode::dielectric) w = w * fresnel_dielectric(cos_o, l.eta);
     out = {LpeEvent::S, &l, mirror, w, 0, false};
     return true;
   }

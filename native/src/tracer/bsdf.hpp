@@ -23,7 +23,8 @@ enum class LobeKind {
   lambert, oren_nayar, principled_diffuse, translucent, microfacet, microfacet_transmission, mirror, dielectric
 };
 // principled: Cycles 3.x's Principled Fresnel, f0 + (1 - f0) (F(cos, eta) - F(1, eta)) / (1 - F(1, eta)).
-enum class FresnelMode { none, schlick, dielectric, principled };
+// f82: Principled v2's metal, Schlick's from f0 less the F82-tint term b cos (1 - cos)^6 (principled_v2.hpp).
+enum class FresnelMode { none, schlick, dielectric, principled, f82 };
 
 struct Lobe {
   LobeKind kind = LobeKind::lambert;
@@ -33,10 +34,15 @@ struct Lobe {
   bool beckmann = false;    // microfacet: Beckmann instead of GGX
   bool correlated = false;  // microfacet: height-correlated Smith shadowing (ClosureModel)
   FresnelMode fresnel = FresnelMode::none;  // microfacet_transmission, dielectric: 1 - F(microfacet)
-  Float3 f0;                // schlick
+  Float3 f0;                // schlick, principled, f82
+  Float3 f82_b;             // f82: the tint term's b
   float eta = 1;            // dielectric: n behind / n in front; microfacet with dielectric Fresnel
   bool reflect = true, refract = true;  // dielectric: which parts exist (refraction-only closures, caustic filter)
   bool sharp = false;       // mirror: a Sharp distribution (never blurred by Filter Glossy)
+  // lambert under Principled v2's reflective layers: its weight when reflective caustics are
+  // filtered, for Cycles then builds neither those layers nor the layering weight they pass down.
+  bool layered = false;
+  Float3 unlayered_weight;
   float pick = 0;           // selection probability
   bool singular() const { return kind == LobeKind::mirror || kind == LobeKind::dielectric; }
   bool diffuse() const {
@@ -100,5 +106,10 @@ struct Scatter {
 bool sample(const ShadingPoint& s, Rng& rng, Scatter& out);
 
 float fresnel_dielectric(float cos_i, float eta);
+
+// Building blocks of the closures' lobes (bsdf.cpp), shared with principled_v2.cpp.
+void add_lobe(ShadingPoint& s, const Lobe& lobe);
+// A reflection of `roughness`: a mirror below kSingularRoughness, else microfacet.
+Lobe reflection_lobe(Float3 weight, float roughness, bool beckmann, FresnelMode fresnel, Float3 f0);
 
 }  // namespace tempera::tracer
