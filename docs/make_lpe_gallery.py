@@ -2,7 +2,8 @@
 3.x; other Blenders write lpe_gallery_X.Y.png and lpe_gallery_X.Y.json): every
 scene of the validation gallery (scenes/lpe_gallery.py) rendered by Cycles
 and traced by Tempera at the test's settings (blender_tests/test_lpe_gallery.py:
-80 x 60, 128 samples each, caustics off), with the test's figures.
+80 x 60, 128 samples each, 2048 for the
+scenes with sub-pixel highlights, caustics off), with the test's figures.
 
     PYTHONPATH=addon blender -b --factory-startup --python docs/make_lpe_gallery.py
     PYTHONPATH=addon ~/.cache/tempera/venv-bpy45/bin/python docs/make_lpe_gallery.py  # PyPI bpy 4.5
@@ -43,8 +44,8 @@ def main():
         scene = lpe_gallery.build(key)
         try:
             with tempfile.TemporaryDirectory() as tmp:
-                cycles = gallery.cycles_buffers(scene, tmp)
-            traced, warnings = gallery.traced_buffers(scene)
+                cycles = gallery.cycles_buffers(scene, tmp, gallery.samples_for(key))
+            traced, warnings = gallery.traced_buffers(scene, gallery.samples_for(key))
         finally:
             lpe_gallery.remove(scene)
         result, _ = gallery.gallery_figures(cycles, traced)
