@@ -46,11 +46,11 @@ CYCLES_4_DEVIATIONS = {
 
 SAMPLES = int(os.environ.get("GALLERY_SAMPLES", 128))  # Cycles and the tracer alike (override to study noise)
 # Scenes whose LSE is a highlight smaller than a pixel (GGX roughness 0.2
-# under the small key: one or two pixels hold half of the buffer's light),
-# so its mean rests on the few samples that land in them: over seeds,
-# 128 samples scatter it by 3-4 % in Cycles 3.4, 4.2 and the tracer alike,
-# and single runs differed by 6-7 %. At 4096 samples the tracer is within
-# 1.2 % of Cycles 3.4 and 4.2 (docs/lpe_guides.md, "Sub-pixel highlights").
+# under the small key: two or three pixels hold half of the buffer's light),
+# so its mean rests on the few samples that land in them. Over seeds, 128
+# samples scatter it by 3-4 % in Cycles 3.4, 4.2 and the tracer alike, and
+# single runs differed by up to 7 %; at 4096 samples the tracer is within
+# 1.2 % of Cycles (docs/lpe_guides.md, "Sub-pixel highlights").
 # 16 x the samples: a quarter of the scatter.
 SUBPIXEL_HIGHLIGHT = {"layer_weight", "bounce_limits"}
 SUBPIXEL_HIGHLIGHT_SAMPLES = 16 * SAMPLES
