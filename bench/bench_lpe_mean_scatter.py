@@ -28,21 +28,6 @@ import lpe_gallery  # noqa: E402
 import test_lpe_gallery as gallery  # noqa: E402
 
 
-def cycles_mean(scene, tmp, buffer, samples, seed, mask):
-    from tempera.blender import guide_render
-
-    layer = scene.view_layers[0]
-    guide_render._configure(scene, layer, samples, gallery.PASSES, seed)
-    path = guide_render._render(scene, Path(tmp) / f"{samples}_{seed}.exr", 1)
-    p = guide_render._read_passes(path, layer.name, gallery.PASSES)
-    rgb = {k: v[:, :, :3] for k, v in p.items()}
-    image = {"FULL": rgb["Combined"], "LDE": rgb["DiffDir"] * rgb["DiffCol"],
-             "LSE": rgb["GlossDir"] * rgb["GlossCol"], "LDDE": rgb["DiffInd"] * rgb["DiffCol"]}[buffer]
-    if mask is None:
-        mask = p["Combined"][:, :, 3] > 0.99
-    return image @ gallery.LUMINANCE, mask
-
-
 def summary(means, converged, converged_image):
     means = np.asarray(means)
     return {"means": means.tolist(), "scatter": float(means.std(ddof=1) / means.mean()) if len(means) > 1 else None,
@@ -60,32 +45,28 @@ def main():
     parser.add_argument("--json")
     args = parser.parse_args(argv)
 
-    from tempera.blender.scene_export import evaluated_depsgraph, export_scene, path_settings
-    from tempera.lpe import trace_lpe
-
     scene = lpe_gallery.build(args.scene)
     try:
         with tempfile.TemporaryDirectory() as tmp:
-            reference, mask = cycles_mean(scene, tmp, args.buffer, args.converged, 0, None)
-            cycles = [float(cycles_mean(scene, tmp, args.buffer, args.samples, s, mask)[0][mask].mean())
-                      for s in range(args.seeds)]
-        size = (scene.render.resolution_x, scene.render.resolution_y)
-        scene_dict, _ = export_scene(scene, evaluated_depsgraph(scene, scene.view_layers[0], 1), size)
-        settings = path_settings(scene)  # after Cycles' render set-up: caustics off, as Cycles rendered
-
-        def traced(samples, seed):
-            (image,), _ = trace_lpe(scene_dict, [gallery.BUFFERS[args.buffer]], samples=samples, seed=seed,
-                                    **settings)
-            return image @ gallery.LUMINANCE
-
-        traced_reference = traced(args.converged, 0)
-        tracer = [float(traced(args.samples, s)[mask].mean()) for s in range(args.seeds)]
+            cycles = [gallery.cycles_buffers(scene, tmp, args.samples, seed) for seed in range(args.seeds)]
+            reference = gallery.cycles_buffers(scene, tmp, args.converged)
+        # After Cycles' render set-up (caustics off, as Cycles rendered), as the test traces.
+        traced = [gallery.traced_buffers(scene, args.samples, seed)[0] for seed in range(args.seeds)]
+        traced_reference = gallery.traced_buffers(scene, args.converged)[0]
     finally:
         lpe_gallery.remove(scene)
+    mask = reference["alpha"] > 0.99
+
+    def lum(buffers):
+        return buffers[args.buffer] @ gallery.LUMINANCE * mask
+
+    def mean(buffers):
+        return float(lum(buffers)[mask].mean())
+
     result = {"blender": bpy.app.version_string, "scene": args.scene, "buffer": args.buffer,
               "samples": args.samples, "converged_samples": args.converged,
-              "cycles": summary(cycles, float(reference[mask].mean()), reference * mask),
-              "tracer": summary(tracer, float(traced_reference[mask].mean()), traced_reference * mask)}
+              "cycles": summary([mean(b) for b in cycles], mean(reference), lum(reference)),
+              "tracer": summary([mean(b) for b in traced], mean(traced_reference), lum(traced_reference))}
     result["converged_error"] = abs(result["tracer"]["converged"] / result["cycles"]["converged"] - 1)
     print(json.dumps(result, indent=1))
     if args.json:

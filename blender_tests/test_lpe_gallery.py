@@ -112,12 +112,12 @@ def compare(traced, reference, mask, full_mean):
     return abs(t_mean - r_mean) / r_mean, correlation, r_mean, t_mean
 
 
-def cycles_buffers(scene, tmp, samples=SAMPLES):
+def cycles_buffers(scene, tmp, samples=SAMPLES, seed=0):
     """Cycles' buffers of the scene, with the guide cache's render settings."""
     from tempera.blender import guide_render
 
     layer = scene.view_layers[0]
-    guide_render._configure(scene, layer, samples, PASSES, 0)
+    guide_render._configure(scene, layer, samples, PASSES, seed)
     path = guide_render._render(scene, Path(tmp) / f"{scene.name}.exr", 1)
     p = guide_render._read_passes(path, layer.name, PASSES)
     rgb = {k: v[:, :, :3] for k, v in p.items()}
@@ -126,7 +126,7 @@ def cycles_buffers(scene, tmp, samples=SAMPLES):
             "alpha": p["Combined"][:, :, 3]}
 
 
-def traced_buffers(scene, samples=SAMPLES):
+def traced_buffers(scene, samples=SAMPLES, seed=0):
     """The tracer's buffers at the scene's current settings (after
     cycles_buffers: caustics off, as Cycles rendered)."""
     from tempera.blender.scene_export import evaluated_depsgraph, export_scene, path_settings
@@ -134,7 +134,8 @@ def traced_buffers(scene, samples=SAMPLES):
 
     size = (scene.render.resolution_x, scene.render.resolution_y)
     scene_dict, warnings = export_scene(scene, evaluated_depsgraph(scene, scene.view_layers[0], 1), size)
-    images, alpha = trace_lpe(scene_dict, list(BUFFERS.values()), samples=samples, **path_settings(scene))
+    images, alpha = trace_lpe(scene_dict, list(BUFFERS.values()), samples=samples, seed=seed,
+                              **path_settings(scene))
     return dict(zip(BUFFERS, images), alpha=alpha), warnings
 
 
