@@ -2,7 +2,7 @@
 3.x; other Blenders write lpe_gallery_X.Y.png and lpe_gallery_X.Y.json): every
 scene of the validation gallery (scenes/lpe_gallery.py) rendered by Cycles
 and traced by Tempera at the test's settings (blender_tests/test_lpe_gallery.py:
-80 x 60, 128 samples each (the test's SCENE_SAMPLES excepted), caustics off), with the test's figures.
+80 x 60, 128 samples each but the test's SCENE_SAMPLES, caustics off), with the test's figures.
 
     PYTHONPATH=addon blender -b --factory-startup --python docs/make_lpe_gallery.py
     PYTHONPATH=addon ~/.cache/tempera/venv-bpy45/bin/python docs/make_lpe_gallery.py  # PyPI bpy 4.5
@@ -41,11 +41,10 @@ def main():
     tiles, figures = [], {}
     for key in lpe_gallery.SCENES:
         scene = lpe_gallery.build(key)
-        samples = gallery.SCENE_SAMPLES.get(key, gallery.SAMPLES)  # as the test
         try:
             with tempfile.TemporaryDirectory() as tmp:
-                cycles = gallery.cycles_buffers(scene, tmp, samples)
-            traced, warnings = gallery.traced_buffers(scene, samples)
+                cycles = gallery.cycles_buffers(scene, tmp, gallery.samples_for(key))
+            traced, warnings = gallery.traced_buffers(scene, gallery.samples_for(key))
         finally:
             lpe_gallery.remove(scene)
         result, _ = gallery.gallery_figures(cycles, traced)
