@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "tempera/patch_usage.hpp"
+#include "tempera/radix_sort.hpp"
 #include "tempera/reversed_retrieval.hpp"
 
 namespace tempera {
@@ -83,15 +84,17 @@ UsageStats retrieve_with_budget(const PatchSpace& space, const SearchConstraints
   ReversedRetrieval rr(space, cons, nnf, params, stream);
   rr.eligible() = cons.source_valid;
   UsageStats stats;
+  std::vector<float> errors;  // kept across rounds with its scratch, to spare a million-entry allocation each
+  std::vector<std::uint32_t> sort_scratch;
   while (stats.rounds < params.max_rounds &&
          double(rr.assigned_count()) < params.coverage_goal * double(rr.active())) {
     const auto winners = rr.round(stats.rounds++);
     // The knee of this round's sorted candidate errors.
-    std::vector<float> errors;
+    errors.clear();
     for (std::size_t p = 0; p < rr.candidate().size(); ++p)
       if (rr.eligible()[p] && rr.candidate()[p] != kNoTarget) errors.push_back(rr.candidate_dist()[p]);
     if (errors.empty()) break;
-    std::sort(errors.begin(), errors.end());
+    radix_sort(errors, sort_scratch);
     const float knee_error = errors[error_knee(errors) - 1];
     // Sources whose best open target is already past the knee only get worse
     // as targets fill up: retire them.

@@ -48,11 +48,11 @@ class ReversedRetrieval {
                     const ReversedRetrievalParams& params, std::uint64_t stream)
       : space_(space), cons_(cons), nnf_(nnf), params_(params), stream_(stream),
         sw_(space.source->width), sh_(space.source->height), tw_(nnf.width), th_(nnf.height),
-        assigned_(std::size_t(tw_) * th_, 0), eligible_(std::size_t(sw_) * sh_, 0),
+        open_(cons.target_active), eligible_(std::size_t(sw_) * sh_, 0),
         wide_search_(std::size_t(sw_) * sh_, 0),
-        candidate_(std::size_t(sw_) * sh_, kNoTarget), candidate_dist_(std::size_t(sw_) * sh_, kNoDistance) {
-    for (std::size_t i = 0; i < assigned_.size(); ++i)
-      if (cons.target_active[i]) ++active_;
+        candidate_(std::size_t(sw_) * sh_, kNoTarget), candidate_dist_(std::size_t(sw_) * sh_, kNoDistance),
+        best_source_(std::size_t(tw_) * th_) {
+    for (std::uint8_t a : open_) active_ += a != 0;
   }
 
   std::vector<std::uint8_t>& eligible() { return eligible_; }
@@ -77,13 +77,11 @@ class ReversedRetrieval {
     nnf_.x[a.target] = a.source % sw_;
     nnf_.y[a.target] = a.source / sw_;
     nnf_.dist[a.target] = a.dist / border_scale(a.target % tw_, a.target / tw_);
-    assigned_[a.target] = 1;
+    open_[a.target] = 0;
     candidate_[a.source] = kNoTarget;
     candidate_dist_[a.source] = kNoDistance;
     ++assigned_count_;
   }
-
-  bool is_assigned(std::size_t target) const { return assigned_[target] != 0; }
 
  private:
   // Target patches at the frame border are clipped, so their raw distances
@@ -105,13 +103,14 @@ class ReversedRetrieval {
   bool open_target(int qx, int qy, int segment) const {
     if (qx < 0 || qy < 0 || qx >= tw_ || qy >= th_) return false;
     const std::size_t q = std::size_t(qy) * tw_ + qx;
-    return cons_.target_active[q] && !assigned_[q] && cons_.segment_of_target(q) == segment;
+    return open_[q] && cons_.segment_of_target(q) == segment;
   }
 
   void collect_unassigned() {
-    unassigned_.assign(cons_.valid_by_segment.size(), {});
-    for (std::size_t q = 0; q < assigned_.size(); ++q)
-      if (cons_.target_active[q] && !assigned_[q]) unassigned_[cons_.segment_of_target(q)].push_back(std::int32_t(q));
+    unassigned_.resize(cons_.valid_by_segment.size());
+    for (auto& list : unassigned_) list.clear();  // keeps the capacity for the next round
+    for (std::size_t q = 0; q < open_.size(); ++q)
+      if (open_[q]) unassigned_[cons_.segment_of_target(q)].push_back(std::int32_t(q));
   }
 
   // Keeps still-open candidates, adopts targets whose forward match is this
@@ -119,13 +118,15 @@ class ReversedRetrieval {
   // Only the random picks need the wide random search of the sweep; the
   // others are refined by propagation alone (half the cost of a round).
   void seed_candidates(int round_index) {
-    for (std::size_t p = 0; p < candidate_.size(); ++p) {
-      if (!eligible_[p] || (candidate_[p] != kNoTarget && assigned_[candidate_[p]])) {
-        candidate_[p] = kNoTarget;
-        candidate_dist_[p] = kNoDistance;
+    parallel_for(sh_, params_.threads, [&](int sy) {
+      for (std::size_t p = std::size_t(sy) * sw_, end = p + sw_; p < end; ++p) {
+        if (!eligible_[p] || (candidate_[p] != kNoTarget && !open_[candidate_[p]])) {
+          candidate_[p] = kNoTarget;
+          candidate_dist_[p] = kNoDistance;
+        }
+        wide_search_[p] = 0;
       }
-      wide_search_[p] = 0;
-    }
+    });
     for (const auto& list : unassigned_) {
       for (std::int32_t q : list) {
         const std::size_t p = std::size_t(nnf_.y[q]) * sw_ + nnf_.x[q];
@@ -154,6 +155,7 @@ class ReversedRetrieval {
 
   void prefetch_target(int qx, int qy) const {
     if (qx < 0 || qy < 0 || qx >= tw_ || qy >= th_) return;
+    __builtin_prefetch(&open_[std::size_t(qy) * tw_ + qx]);
     const int r = space_.radius;
     const int x0 = std::max(0, qx - r), bytes = (2 * r + 1) * space_.target->bytes_per_pixel();
     for (int dy = -r; dy <= std::min(r, 1 - r); ++dy) {
@@ -176,10 +178,17 @@ class ReversedRetrieval {
 
   void sweep(int round_index, int iteration) {
     const int band_rows = 32, bands = (sh_ + band_rows - 1) / band_rows;
-    const std::vector<std::int32_t> snapshot = candidate_;
     const bool forward = iteration % 2 == 0;
     const int step = forward ? 1 : -1;
     const int max_radius = std::max(tw_, th_);
+    // A band propagates from the row before it (in sweep order) as it was
+    // before the sweep, so that no band reads another's progress.
+    std::vector<std::int32_t> edge(std::size_t(bands) * sw_, kNoTarget);
+    for (int band = 0; band < bands; ++band) {
+      const int ey = forward ? band * band_rows - 1 : std::min(sh_, (band + 1) * band_rows);
+      if (ey >= 0 && ey < sh_)
+        std::copy_n(candidate_.begin() + std::ptrdiff_t(ey) * sw_, sw_, edge.begin() + std::ptrdiff_t(band) * sw_);
+    }
     parallel_for(bands, params_.threads, [&](int band) {
       const int y0 = band * band_rows, y1 = std::min(sh_, y0 + band_rows);
       Rng rng(params_.seed, mix64(stream_ * 104729 + round_index * 131 + iteration) ^ std::uint64_t(band));
@@ -190,6 +199,18 @@ class ReversedRetrieval {
           const std::size_t p = std::size_t(sy) * sw_ + sx;
           if (!eligible_[p] || candidate_[p] == kNoTarget) continue;
           const int segment = cons_.segment_of_source(p);
+          // The random draws do not depend on the search, so they come first:
+          // the offsets of the random search (around the propagated best)
+          // and a random open target, whose list slot is then fetched while
+          // propagation runs.
+          int off[64], n = 0;
+          for (int r = wide_search_[p] ? max_radius : 0; r >= 1 && n < 64; r /= 2, n += 2) {
+            off[n] = rng.between(-r, r);
+            off[n + 1] = rng.between(-r, r);
+          }
+          const auto& list = unassigned_[segment];
+          const std::int32_t* open_pick = list.empty() ? nullptr : &list[rng.below(int(list.size()))];
+          if (open_pick) __builtin_prefetch(open_pick);
           std::int32_t best = candidate_[p];
           float best_dist = candidate_dist_[p];
           const int nbr[2][2] = {{-step, 0}, {0, -step}};
@@ -197,7 +218,7 @@ class ReversedRetrieval {
             const int nx = sx + d[0], ny = sy + d[1];
             if (nx < 0 || ny < 0 || nx >= sw_ || ny >= sh_) continue;
             const std::size_t np = std::size_t(ny) * sw_ + nx;
-            const std::int32_t nq = (ny >= y0 && ny < y1) ? candidate_[np] : snapshot[np];
+            const std::int32_t nq = (ny >= y0 && ny < y1) ? candidate_[np] : edge[std::size_t(band) * sw_ + nx];
             if (nq == kNoTarget) continue;
             // The neighbour's target shifted back by d, with d rotated from
             // source into target space.
@@ -206,20 +227,15 @@ class ReversedRetrieval {
             try_target(sx, sy, nq % tw_ - int(std::lround(ox)), nq / tw_ - int(std::lround(oy)), segment, best,
                        best_dist);
           }
-          // Random search around the propagated best; candidates are drawn
-          // first and prefetched (see patchmatch.cpp).
-          int cand[64], n = 0;
-          for (int r = wide_search_[p] ? max_radius : 0; r >= 1 && n < 64; r /= 2, n += 2) {
-            cand[n] = best % tw_ + rng.between(-r, r);
-            cand[n + 1] = best / tw_ + rng.between(-r, r);
-            prefetch_target(cand[n], cand[n + 1]);
-          }
-          for (int k = 0; k < n; k += 2) try_target(sx, sy, cand[k], cand[k + 1], segment, best, best_dist);
-          const auto& list = unassigned_[segment];
-          if (!list.empty()) {
-            const std::int32_t q = list[rng.below(int(list.size()))];
-            try_target(sx, sy, q % tw_, q / tw_, segment, best, best_dist);
-          }
+          // Random search around the propagated best, then the random open
+          // target; all are prefetched before the first is tested (see
+          // patchmatch.cpp).
+          const std::int32_t pick = open_pick ? *open_pick : kNoTarget;
+          if (open_pick) prefetch_target(pick % tw_, pick / tw_);
+          const int bx = best % tw_, by = best / tw_;
+          for (int k = 0; k < n; k += 2) prefetch_target(bx + off[k], by + off[k + 1]);
+          for (int k = 0; k < n; k += 2) try_target(sx, sy, bx + off[k], by + off[k + 1], segment, best, best_dist);
+          if (open_pick) try_target(sx, sy, pick % tw_, pick / tw_, segment, best, best_dist);
           candidate_[p] = best;
           candidate_dist_[p] = best_dist;
         }
@@ -229,13 +245,15 @@ class ReversedRetrieval {
 
   // Best source per target, in parallel: an atomic minimum over (distance
   // bits, source index), so the winner does not depend on thread timing.
-  std::vector<Assignment> resolve_collisions() const {
-    std::vector<std::atomic<std::uint64_t>> best(assigned_.size());
-    for (auto& b : best) b.store(~0ull, std::memory_order_relaxed);
+  std::vector<Assignment> resolve_collisions() {
+    auto& best = best_source_;
+    parallel_for(th_, params_.threads, [&](int qy) {
+      for (std::size_t q = std::size_t(qy) * tw_, end = q + tw_; q < end; ++q) best[q].store(~0ull, std::memory_order_relaxed);
+    });
     parallel_for(sh_, params_.threads, [&](int sy) {
       for (std::size_t p = std::size_t(sy) * sw_, end = p + sw_; p < end; ++p) {
         const std::int32_t q = candidate_[p];
-        if (!eligible_[p] || q == kNoTarget || assigned_[q]) continue;
+        if (!eligible_[p] || q == kNoTarget || !open_[q]) continue;
         std::uint32_t bits;
         std::memcpy(&bits, &candidate_dist_[p], sizeof bits);  // >= 0: bits order like values
         const std::uint64_t key = (std::uint64_t(bits) << 32) | std::uint64_t(p);
@@ -260,10 +278,13 @@ class ReversedRetrieval {
   const ReversedRetrievalParams& params_;
   std::uint64_t stream_;
   int sw_, sh_, tw_, th_;
-  std::vector<std::uint8_t> assigned_, eligible_, wide_search_;
+  // open_: active and not yet assigned, one byte a target, so that testing a
+  // random candidate costs one cache miss, not two.
+  std::vector<std::uint8_t> open_, eligible_, wide_search_;
   std::vector<std::int32_t> candidate_;
   std::vector<float> candidate_dist_;
   std::vector<std::vector<std::int32_t>> unassigned_;
+  std::vector<std::atomic<std::uint64_t>> best_source_;  // resolve_collisions' per-target minimum, kept across rounds
   std::size_t active_ = 0, assigned_count_ = 0, wide_searches_ = 0;
 };
 
