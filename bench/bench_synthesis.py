@@ -222,6 +222,7 @@ def main():
     parser.add_argument("--pm-iters", type=int, default=2)
     parser.add_argument("--guide-variance", type=float, default=0.999)
     parser.add_argument("--feature-precision", help="int16 or float (default: the engine's)")
+    parser.add_argument("--skip-converged", choices=("true", "false"), help="default: the engine's")
     parser.add_argument("--sweep", action="store_true", help="0.25, 1 and 4 Mpix, each in its own process")
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--json")
@@ -230,6 +231,8 @@ def main():
             "--pm-iters", str(args.pm_iters), "--guide-variance", str(args.guide_variance), "--seed", str(args.seed)]
     if args.feature_precision:
         rest += ["--feature-precision", args.feature_precision]
+    if args.skip_converged:
+        rest += ["--skip-converged", args.skip_converged]
     if args.sweep:
         return sweep(args, rest)
     if args.compare:
@@ -238,6 +241,8 @@ def main():
     src, tgt, style = benchmark_scene(s)
     guides = [(a, b, 1.0) for a, b in zip(src, tgt)]
     extra = {"feature_precision": args.feature_precision} if args.feature_precision else {}
+    if args.skip_converged:
+        extra["skip_converged"] = args.skip_converged == "true"
     release_free_heap()
     before_mb = rss_mb()
     peak_reset = reset_peak_rss()
@@ -265,9 +270,10 @@ def main():
                      "guide_variance": args.guide_variance, "threads": args.threads, "seed": args.seed,
                      "feature_precision": args.feature_precision or "default"},
         "guide_channels_matched": stats["guide_channels"],
-        # usage_wide_searches: absent in builds before it was counted (--compare).
+        # usage_wide_searches, converged_skips: absent in builds before they were counted (--compare).
         "levels": [{k: getattr(l, k) for k in ("width", "height", "search_seconds", "usage_seconds", "vote_seconds",
-                                               "usage_rounds", "usage_wide_searches", "reversed_coverage", "energy")
+                                               "usage_rounds", "usage_wide_searches", "converged_skips", "reversed_coverage",
+                                               "energy")
                     if hasattr(l, k)} for l in stats["levels"]],
         "source_coverage": stats["source_coverage"],
         "machine": f"{platform.processor() or platform.machine()}, {__import__('os').cpu_count()} cores",
