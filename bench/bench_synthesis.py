@@ -142,7 +142,8 @@ def compare(args, rest):
     for name, results in runs.items():
         summary[name] = {k: statistics.median(r[k] for r in results)
                          for k in ("wall_seconds", "cpu_seconds", "peak_rss_mb", "engine_peak_mb", "final_energy",
-                                   "guide_error", "source_coverage") if all(k in r for r in results)}
+                                   "guide_error", "source_coverage", "budget_coverage", "finest_search_seconds")
+                         if all(k in r for r in results)}
         summary[name]["wall_all"] = [r["wall_seconds"] for r in results]
     a, b = summary["this"], summary[args.compare]
     summary["ratio_this_over_other"] = {k: a[k] / b[k] for k in a if k in b and k != "wall_all"}
@@ -266,9 +267,11 @@ def main():
         # The error budget's own figure: the fraction of the finest frame that
         # reversed retrieval placed (the rest keeps its forward match).
         "budget_coverage": finest["reversed_coverage"],
+        "finest_search_seconds": round(finest["search_seconds"], 2),
         "settings": {"em_iterations": args.em_iters, "pm_iterations": args.pm_iters,
                      "guide_variance": args.guide_variance, "threads": args.threads, "seed": args.seed,
-                     "feature_precision": args.feature_precision or "default"},
+                     "feature_precision": args.feature_precision or "default",
+                     "skip_converged": args.skip_converged or "default"},
         "guide_channels_matched": stats["guide_channels"],
         # usage_wide_searches, converged_skips: absent in builds before they were counted (--compare).
         "levels": [{k: getattr(l, k) for k in ("width", "height", "search_seconds", "usage_seconds", "vote_seconds",

@@ -52,17 +52,19 @@ std::vector<std::uint8_t> changed_pixels(const ImageView& before, const ImageVie
   return out;
 }
 
-std::vector<std::uint8_t> pixels_to_search(const OffsetField& field, const std::vector<std::uint32_t>& before,
+void mark_moved(const OffsetField& field, const std::vector<std::uint32_t>& before, std::vector<std::uint8_t>& moved) {
+  const std::vector<std::uint32_t> now = match_fingerprints(field);
+  moved.resize(now.size(), 0);
+  for (std::size_t i = 0; i < now.size(); ++i) moved[i] |= now[i] != before[i];
+}
+
+std::vector<std::uint8_t> pixels_to_search(int w, int h, const std::vector<std::uint8_t>& moved,
                                            const std::vector<std::uint8_t>& image_changed, int radius,
                                            const std::vector<std::uint8_t>& active) {
-  const int w = field.width, h = field.height;
-  const std::vector<std::uint32_t> now = match_fingerprints(field);
-  std::vector<std::uint8_t> moved(now.size());
-  for (std::size_t i = 0; i < now.size(); ++i) moved[i] = now[i] != before[i];
   std::vector<std::uint8_t> out = dilate(image_changed, w, h, radius);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      const std::size_t i = field.index(x, y);
+      const std::size_t i = std::size_t(y) * w + x;
       const bool nbr_moved = moved[i] || (x > 0 && moved[i - 1]) || (x + 1 < w && moved[i + 1]) ||
                              (y > 0 && moved[i - w]) || (y + 1 < h && moved[i + w]);
       out[i] = active[i] && (out[i] || nbr_moved);

@@ -750,12 +750,13 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
                               (!pm.candidates || pm.candidates->empty());
   std::vector<std::uint8_t> to_search;  // empty: search every active pixel
   std::vector<std::uint32_t> matches_before;
+  std::vector<std::uint8_t> moved;  // by this iteration's search or budget
   for (int it = 0; it < em; ++it) {
     const std::uint64_t stream = std::uint64_t(l) * 1000 + std::uint64_t(it) + 1;
     t0 = Clock::now();
     set_target_style(level, bprime);
     refresh_distances(level.space, level.constraints, field, options_.threads);
-    if (skip_converged) matches_before = match_fingerprints(field);
+    if (skip_converged) matches_before = match_fingerprints(field), moved.assign(matches_before.size(), 0);
     // One search, split into single iterations when a term's costs follow the field.
     const int chunk = refresh_each_iteration ? 1 : pm_iters;
     for (int first = 0; first < pm_iters; first += chunk) {
@@ -775,6 +776,7 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
       patchmatch(level.space, level.constraints, field, part, stream);
       level.constraints.source_cost.clear();
     }
+    if (skip_converged) mark_moved(field, matches_before, moved);
     stats.search_seconds += seconds_since(t0);
     t0 = Clock::now();
     for (const auto& t : terms_) {
@@ -792,7 +794,8 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
     stats.vote_seconds += seconds_since(t0);
     if (skip_converged && !bprime.empty()) {
       t0 = Clock::now();
-      to_search = pixels_to_search(field, matches_before, changed_pixels(bprime.view(), voted.view()),
+      mark_moved(field, matches_before, moved);
+      to_search = pixels_to_search(field.width, field.height, moved, changed_pixels(bprime.view(), voted.view()),
                                    level.space.radius, level.constraints.target_active);
       stats.search_seconds += seconds_since(t0);
     }

@@ -48,27 +48,35 @@ TEST(ConvergedPixels, OnlyChangedMatchesTheirNeighboursAndPatchesAreSearched) {
   const int w = 12, h = 10, r = 2;
   OffsetField field = random_offsets(w, h, 1);
   const std::vector<std::uint32_t> before = match_fingerprints(field);
-  std::vector<std::uint8_t> active(std::size_t(w) * h, 1), unchanged(active.size(), 0);
-  EXPECT_EQ(count(pixels_to_search(field, before, unchanged, r, active)), 0u);
+  std::vector<std::uint8_t> active(std::size_t(w) * h, 1), unchanged(active.size(), 0), moved;
+  auto search = [&](const std::vector<std::uint8_t>& image_changed) {
+    return pixels_to_search(w, h, moved, image_changed, r, active);
+  };
+  mark_moved(field, before, moved);
+  EXPECT_EQ(count(search(unchanged)), 0u);
 
   field.x[field.index(6, 5)] += 1;  // a moved match: it and its 4 neighbours
-  auto search = pixels_to_search(field, before, unchanged, r, active);
-  EXPECT_EQ(count(search), 5u);
-  for (auto [x, y] : {std::pair{6, 5}, {5, 5}, {7, 5}, {6, 4}, {6, 6}}) EXPECT_TRUE(search[field.index(x, y)]);
-  field.x[field.index(6, 5)] -= 1;
+  mark_moved(field, before, moved);
+  field.x[field.index(6, 5)] -= 1;  // put back (by the budget): still moved in this iteration
+  mark_moved(field, before, moved);
+  std::vector<std::uint8_t> s = search(unchanged);
+  EXPECT_EQ(count(s), 5u);
+  for (auto [x, y] : {std::pair{6, 5}, {5, 5}, {7, 5}, {6, 4}, {6, 6}}) EXPECT_TRUE(s[field.index(x, y)]);
+  moved.assign(moved.size(), 0);
   field.rx[field.index(0, 0)] = 0.25f;  // a moved remainder counts as well (corner: 3 pixels)
-  EXPECT_EQ(count(pixels_to_search(field, before, unchanged, r, active)), 3u);
-  field.rx[field.index(0, 0)] = 0.0f;
+  mark_moved(field, before, moved);
+  EXPECT_EQ(count(search(unchanged)), 3u);
+  moved.assign(moved.size(), 0);
 
   std::vector<std::uint8_t> changed = unchanged;  // a changed B' pixel: every patch that holds it
   changed[field.index(8, 2)] = 1;
-  search = pixels_to_search(field, before, changed, r, active);
-  EXPECT_EQ(count(search), 5u * 5u);  // x 6..10, y 0..4
+  s = search(changed);
+  EXPECT_EQ(count(s), 5u * 5u);  // x 6..10, y 0..4
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
-      EXPECT_EQ(search[field.index(x, y)], std::abs(x - 8) <= r && y <= 4) << x << "," << y;
+      EXPECT_EQ(s[field.index(x, y)], std::abs(x - 8) <= r && y <= 4) << x << "," << y;
   active[field.index(8, 2)] = 0;  // inactive pixels are never searched
-  EXPECT_FALSE(pixels_to_search(field, before, changed, r, active)[field.index(8, 2)]);
+  EXPECT_FALSE(search(changed)[field.index(8, 2)]);
 }
 
 TEST(ConvergedPixels, ChangesBelowOneStepAreUnchanged) {

@@ -29,11 +29,15 @@ std::vector<std::uint32_t> match_fingerprints(const OffsetField& field);
 // Per pixel: some channel of `after` differs from `before` by kConvergedChange or more.
 std::vector<std::uint8_t> changed_pixels(const ImageView& before, const ImageView& after);
 
-// Per target pixel: 1 = search it in the next iteration. A pixel is searched
-// if it is active and its match or a 4-neighbour's differs from `before`
-// (fingerprints taken before this iteration's search), or a pixel of its
-// patch (side 2 radius + 1) changed in B'.
-std::vector<std::uint8_t> pixels_to_search(const OffsetField& field, const std::vector<std::uint32_t>& before,
+// Sets moved[i] where the match of pixel i differs from `before`. Called
+// after the search and again after the error budget's reassignment, so that a
+// match the search changed and the budget put back still counts as moved.
+void mark_moved(const OffsetField& field, const std::vector<std::uint32_t>& before, std::vector<std::uint8_t>& moved);
+
+// Per target pixel of a w x h frame: 1 = search it in the next iteration. A
+// pixel is searched if it is active and its match or a 4-neighbour's moved,
+// or a pixel of its patch (side 2 radius + 1) changed in B'.
+std::vector<std::uint8_t> pixels_to_search(int w, int h, const std::vector<std::uint8_t>& moved,
                                            const std::vector<std::uint8_t>& image_changed, int radius,
                                            const std::vector<std::uint8_t>& active);
 
