@@ -22,7 +22,6 @@ SynthesisOptions fluidymation_defaults() {
   o.guide_variance = 1.0;       // per-pixel temporal weights need the guides uncompressed
   o.feature_precision = FeaturePrecision::Float;  // rotated patches match in float anyway
   o.em_iterations = 3;
-  o.skip_converged = false;  // measured for StyLit only (docs/benchmarks.md, issue 11)
   o.pm_iterations = 2;
   return o;
 }

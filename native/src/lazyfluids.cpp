@@ -106,7 +106,6 @@ SynthesisOptions lazyfluids_defaults() {
   SynthesisOptions o;
   o.patch_size = 5;
   o.usage = PatchUsage::Uniform;
-  o.skip_converged = false;  // measured for StyLit only (docs/benchmarks.md, issue 11)
   o.style_channel_weights = {1, 1, 1, 3};
   o.guide_variance = 1;  // per-pixel λ_q maps need the guides uncompressed anyway
   return o;

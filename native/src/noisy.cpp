@@ -24,7 +24,6 @@ SynthesisOptions noisy_defaults() {
   SynthesisOptions o;
   o.patch_size = 7;
   o.em_iterations = 4;   // "4 iterations of search and vote" per level (§4)
-  o.skip_converged = false;  // measured for StyLit only (docs/benchmarks.md, issue 11)
   o.pm_iterations = 2;   // "8 PatchMatch iterations at each pyramid level": 2 per search x 4 searches
   o.usage = PatchUsage::None;
   o.output = OutputMode::Mode;  // "the mode of colours" (§3.2)
