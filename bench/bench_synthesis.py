@@ -142,7 +142,8 @@ def compare(args, rest):
     for name, results in runs.items():
         summary[name] = {k: statistics.median(r[k] for r in results)
                          for k in ("wall_seconds", "cpu_seconds", "peak_rss_mb", "engine_peak_mb", "final_energy",
-                                   "guide_error", "source_coverage") if all(k in r for r in results)}
+                                   "guide_error", "source_coverage", "budget_coverage", "finest_search_seconds")
+                         if all(k in r for r in results)}
         summary[name]["wall_all"] = [r["wall_seconds"] for r in results]
     a, b = summary["this"], summary[args.compare]
     summary["ratio_this_over_other"] = {k: a[k] / b[k] for k in a if k in b and k != "wall_all"}
@@ -222,6 +223,7 @@ def main():
     parser.add_argument("--pm-iters", type=int, default=2)
     parser.add_argument("--guide-variance", type=float, default=0.999)
     parser.add_argument("--feature-precision", help="int16 or float (default: the engine's)")
+    parser.add_argument("--skip-converged", choices=("true", "false"), help="default: the engine's")
     parser.add_argument("--sweep", action="store_true", help="0.25, 1 and 4 Mpix, each in its own process")
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--json")
@@ -230,6 +232,8 @@ def main():
             "--pm-iters", str(args.pm_iters), "--guide-variance", str(args.guide_variance), "--seed", str(args.seed)]
     if args.feature_precision:
         rest += ["--feature-precision", args.feature_precision]
+    if args.skip_converged:
+        rest += ["--skip-converged", args.skip_converged]
     if args.sweep:
         return sweep(args, rest)
     if args.compare:
@@ -238,6 +242,8 @@ def main():
     src, tgt, style = benchmark_scene(s)
     guides = [(a, b, 1.0) for a, b in zip(src, tgt)]
     extra = {"feature_precision": args.feature_precision} if args.feature_precision else {}
+    if args.skip_converged:
+        extra["skip_converged"] = args.skip_converged == "true"
     release_free_heap()
     before_mb = rss_mb()
     peak_reset = reset_peak_rss()
@@ -261,13 +267,16 @@ def main():
         # The error budget's own figure: the fraction of the finest frame that
         # reversed retrieval placed (the rest keeps its forward match).
         "budget_coverage": finest["reversed_coverage"],
+        "finest_search_seconds": round(finest["search_seconds"], 2),
         "settings": {"em_iterations": args.em_iters, "pm_iterations": args.pm_iters,
                      "guide_variance": args.guide_variance, "threads": args.threads, "seed": args.seed,
-                     "feature_precision": args.feature_precision or "default"},
+                     "feature_precision": args.feature_precision or "default",
+                     "skip_converged": args.skip_converged or "default"},
         "guide_channels_matched": stats["guide_channels"],
-        # usage_wide_searches: absent in builds before it was counted (--compare).
+        # usage_wide_searches, converged_skips: absent in builds before they were counted (--compare).
         "levels": [{k: getattr(l, k) for k in ("width", "height", "search_seconds", "usage_seconds", "vote_seconds",
-                                               "usage_rounds", "usage_wide_searches", "reversed_coverage", "energy")
+                                               "usage_rounds", "usage_wide_searches", "converged_skips", "reversed_coverage",
+                                               "energy")
                     if hasattr(l, k)} for l in stats["levels"]],
         "source_coverage": stats["source_coverage"],
         "machine": f"{platform.processor() or platform.machine()}, {__import__('os').cpu_count()} cores",

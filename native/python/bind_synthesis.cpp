@@ -192,6 +192,7 @@ void bind_synthesis(py::module_& m) {
       .def_readonly("vote_seconds", &LevelStats::vote_seconds)
       .def_readonly("usage_rounds", &LevelStats::usage_rounds)
       .def_readonly("usage_wide_searches", &LevelStats::usage_wide_searches)
+      .def_readonly("converged_skips", &LevelStats::converged_skips)
       .def_readonly("reversed_coverage", &LevelStats::reversed_coverage)
       .def_readonly("source_coverage", &LevelStats::source_coverage);
   add_item_access(level);

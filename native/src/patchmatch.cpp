@@ -158,7 +158,7 @@ void patchmatch(const PatchSpace& space, const SearchConstraints& cons, OffsetFi
         for (int col = 0; col < tw; ++col) {
           const int tx = forward ? col : tw - 1 - col;
           const std::size_t i = field.index(tx, ty);
-          if (!cons.target_active[i]) continue;
+          if (!cons.target_active[i] || (params.searched && !(*params.searched)[i])) continue;
           const int segment = cons.segment_of_target(i);
           Best b{field.x[i], field.y[i], field.rx[i], field.ry[i], field.dist[i], 0.0f};
           b.cost = b.dist + cons.cost(std::size_t(b.y) * m.sw + b.x);

@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "tempera/color.hpp"
+#include "tempera/converged_pixels.hpp"
 #include "tempera/error.hpp"
 #include "tempera/guide_compression.hpp"
 #include "tempera/patch_usage.hpp"
@@ -741,11 +742,21 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
   std::vector<TermState> states(terms_.size());
   const bool refresh_each_iteration =
       std::any_of(terms_.begin(), terms_.end(), [](const auto& t) { return t->refresh_each_iteration(); });
+  // Converged pixels are skipped where a pixel's search problem depends on
+  // its match, its neighbours' and its patch alone: not with terms that read
+  // the field or price sources (they change with every other pixel), nor with
+  // a method's candidates (new ones each level).
+  const bool skip_converged = options_.skip_converged && pm.field_terms.empty() &&
+                              (!pm.candidates || pm.candidates->empty());
+  std::vector<std::uint8_t> to_search;  // empty: search every active pixel
+  std::vector<std::uint32_t> matches_before;
+  std::vector<std::uint8_t> moved;  // by this iteration's search or budget
   for (int it = 0; it < em; ++it) {
     const std::uint64_t stream = std::uint64_t(l) * 1000 + std::uint64_t(it) + 1;
     t0 = Clock::now();
     set_target_style(level, bprime);
     refresh_distances(level.space, level.constraints, field, options_.threads);
+    if (skip_converged) matches_before = match_fingerprints(field), moved.assign(matches_before.size(), 0);
     // One search, split into single iterations when a term's costs follow the field.
     const int chunk = refresh_each_iteration ? 1 : pm_iters;
     for (int first = 0; first < pm_iters; first += chunk) {
@@ -757,9 +768,15 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
       if (!source_costs) level.constraints.source_cost.clear();
       PatchMatchParams part = pm;
       part.first_iteration = first, part.iterations = chunk;
+      if (!to_search.empty() && !source_costs) {
+        part.searched = &to_search;
+        for (std::size_t i = 0; i < to_search.size(); ++i)
+          stats.converged_skips += std::size_t(chunk) * (level.constraints.target_active[i] && !to_search[i]);
+      }
       patchmatch(level.space, level.constraints, field, part, stream);
       level.constraints.source_cost.clear();
     }
+    if (skip_converged) mark_moved(field, matches_before, moved);
     stats.search_seconds += seconds_since(t0);
     t0 = Clock::now();
     for (const auto& t : terms_) {
@@ -773,8 +790,16 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
     t0 = Clock::now();
     VoteParams vp = vote_params;
     vp.stream = stream;
-    bprime = vote(level.style.view(), level.space, level.constraints, field, bprime.view(), vp);
+    Image voted = vote(level.style.view(), level.space, level.constraints, field, bprime.view(), vp);
     stats.vote_seconds += seconds_since(t0);
+    if (skip_converged && !bprime.empty()) {
+      t0 = Clock::now();
+      mark_moved(field, matches_before, moved);
+      to_search = pixels_to_search(field.width, field.height, moved, changed_pixels(bprime.view(), voted.view()),
+                                   level.space.radius, level.constraints.target_active);
+      stats.search_seconds += seconds_since(t0);
+    }
+    bprime = std::move(voted);
     if (progress && !progress(double(it + 1) / em)) throw CancelledError("synthesis cancelled");
   }
   stats.source_coverage = source_coverage(field, level.constraints, level.source.width);

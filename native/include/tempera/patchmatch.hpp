@@ -63,6 +63,9 @@ struct PatchMatchParams {
   // split into single iterations, e.g. to refresh usage costs in between,
   // equals the unsplit one.
   int first_iteration = 0;
+  // Optional: the active target pixels to improve (converged_pixels.hpp);
+  // the others keep their match and still propagate it. Null = all.
+  const std::vector<std::uint8_t>* searched = nullptr;
 };
 
 // Random valid source for every active target pixel, with distances.

@@ -62,6 +62,9 @@ struct LevelStats {
   double search_seconds = 0, usage_seconds = 0, vote_seconds = 0;
   int usage_rounds = 0;
   std::size_t usage_wide_searches = 0;  // reversed retrieval's sources seeded at random (whole-frame search)
+  // Searches of target pixels the forward search skipped as converged
+  // (converged_pixels.hpp), summed over the level's EM iterations.
+  std::size_t converged_skips = 0;
   double reversed_coverage = 0;  // fraction of targets placed by reversed retrieval (last iteration)
   double source_coverage = 0;    // fraction of valid source patches used at the end
 };
