@@ -14,8 +14,39 @@ namespace tempera {
 FeatureImage::FeatureImage(int w, int h, int channels)
     : width(w), height(h), stride(padded(channels)), data(std::size_t(w) * h * padded(channels), 0.0f) {}
 
+FeatureImage FeatureImage::fixed_point(int w, int h, int channels, const std::vector<float>& channel_offset,
+                                       float quant_step, int max_value) {
+  FeatureImage f;
+  f.width = w, f.height = h, f.stride = padded(channels);
+  f.use_fixed_point(channel_offset, quant_step, max_value);
+  return f;
+}
+
+float FeatureImage::code(std::size_t slot, float v) const {
+  return std::clamp(std::nearbyint((v - offset[slot]) / step), 0.0f, float(fixed_max));
+}
+
+// Switches to fixed-point storage, every slot holding the code of 0.
+void FeatureImage::use_fixed_point(const std::vector<float>& channel_offset, float quant_step, int max_value) {
+  if (int(channel_offset.size()) != stride || !(quant_step > 0.0f) || quantized() ||
+      (max_value != kFixed12 && max_value != kFixed8))
+    throw ValueError("internal: bad feature quantization");
+  offset = channel_offset;
+  step = quant_step;
+  fixed_max = max_value;
+  const std::size_t n = std::size_t(width) * height * stride;
+  if (bytes())
+    fixed8.resize(n);
+  else
+    fixed.resize(n);
+  for (std::size_t i = 0; i < std::size_t(stride); ++i) {
+    if (code(i, 0.0f) == 0.0f) continue;  // resize zeroed it already
+    for (std::size_t j = i; j < n; j += std::size_t(stride)) store(j, 0.0f);
+  }
+}
+
 void FeatureImage::store(std::size_t i, float v) {
-  const float q = std::clamp(std::nearbyint((v - offset[i % std::size_t(stride)]) / step), 0.0f, float(fixed_max));
+  const float q = code(i % std::size_t(stride), v);
   if (bytes())
     fixed8[i] = std::uint8_t(q);
   else
@@ -41,6 +72,10 @@ void FeatureImage::set_channels(int first, const ImageView& image, const std::ve
       data[i * stride + first + c] = image.data[i * image.channels + c] * scales[c];
 }
 
+void FeatureImage::set_channels(const std::vector<ChannelWrite>& writes) {
+  for (const ChannelWrite& w : writes) set_channels(w.first, w.image, w.scales);
+}
+
 void FeatureImage::zero_channels(int first, int count) {
   const std::size_t n = std::size_t(width) * height;
   for (std::size_t i = 0; i < n; ++i)
@@ -53,43 +88,79 @@ void FeatureImage::zero_channels(int first, int count) {
 }
 
 void FeatureImage::quantize(const std::vector<float>& channel_offset, float quant_step, int max_value) {
-  if (int(channel_offset.size()) != stride || !(quant_step > 0.0f) || quantized() ||
-      (max_value != kFixed12 && max_value != kFixed8))
-    throw ValueError("internal: bad feature quantization");
-  offset = channel_offset;
-  step = quant_step;
-  fixed_max = max_value;
-  if (bytes())
-    fixed8.resize(data.size());
-  else
-    fixed.resize(data.size());
+  use_fixed_point(channel_offset, quant_step, max_value);
   for (std::size_t i = 0; i < data.size(); ++i) store(i, data[i]);
   std::vector<float>().swap(data);
 }
+
+namespace {
+
+// Per-slot minimum and maximum of feature values.
+struct SlotRange {
+  std::vector<float> lo, hi;
+  explicit SlotRange(int stride)
+      : lo(std::size_t(stride), std::numeric_limits<float>::infinity()),
+        hi(std::size_t(stride), -std::numeric_limits<float>::infinity()) {}
+  void add(std::size_t slot, float v) {
+    lo[slot] = std::min(lo[slot], v);
+    hi[slot] = std::max(hi[slot], v);
+  }
+  // The per-slot minimum as offsets, the widest slot's range / max_value as the step.
+  void to_fixed_point(int max_value, std::vector<float>& offset, float& step) {
+    float range = 0.0f;
+    for (std::size_t c = 0; c < lo.size(); ++c) {
+      if (!(lo[c] <= hi[c])) lo[c] = hi[c] = 0.0f;
+      range = std::max(range, hi[c] - lo[c]);
+    }
+    offset = lo;
+    // A flat feature set still needs a positive step.
+    step = range > 0.0f ? range / float(max_value) : 1.0f;
+  }
+};
+
+// Adds the final values of slots [first_slot, stride) that `writes` leave.
+void add_writes(SlotRange& range, const std::vector<ChannelWrite>& writes, int stride, int first_slot) {
+  std::vector<int> last(std::size_t(stride), -1);  // per slot: the write that sets it last
+  for (std::size_t k = 0; k < writes.size(); ++k)
+    for (int c = 0; c < writes[k].image.channels; ++c)
+      if (writes[k].first + c >= first_slot) last[std::size_t(writes[k].first + c)] = int(k);
+  for (int slot = first_slot; slot < stride; ++slot)
+    if (last[std::size_t(slot)] < 0) range.add(std::size_t(slot), 0.0f);  // never written: 0, as allocated
+  for (std::size_t k = 0; k < writes.size(); ++k) {
+    const ChannelWrite& w = writes[k];
+    if (w.first + w.image.channels > stride || int(w.scales.size()) != w.image.channels)
+      throw ValueError("internal: feature channels do not fit the feature image");
+    std::vector<std::size_t> kept;  // channels of this write that are final
+    for (int c = 0; c < w.image.channels; ++c)
+      if (w.first + c >= first_slot && last[std::size_t(w.first + c)] == int(k)) kept.push_back(std::size_t(c));
+    const std::size_t n = w.image.pixel_count(), channels = std::size_t(w.image.channels);
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t c : kept) range.add(std::size_t(w.first) + c, w.image.data[i * channels + c] * w.scales[c]);
+  }
+}
+
+}  // namespace
 
 void fixed_point_range(const FeatureImage& source, const FeatureImage& target, int target_first, int max_value,
                        std::vector<float>& offset, float& step) {
   const int stride = source.stride;
   if (target.stride != stride) throw ValueError("internal: feature strides differ");
-  std::vector<float> lo(std::size_t(stride), std::numeric_limits<float>::infinity());
-  std::vector<float> hi(std::size_t(stride), -std::numeric_limits<float>::infinity());
+  SlotRange range(stride);
   auto extend = [&](const FeatureImage& f, int first) {
     for (std::size_t i = 0; i < f.data.size(); i += std::size_t(stride))
-      for (int c = first; c < stride; ++c) {
-        lo[std::size_t(c)] = std::min(lo[std::size_t(c)], f.data[i + std::size_t(c)]);
-        hi[std::size_t(c)] = std::max(hi[std::size_t(c)], f.data[i + std::size_t(c)]);
-      }
+      for (int c = first; c < stride; ++c) range.add(std::size_t(c), f.data[i + std::size_t(c)]);
   };
   extend(source, 0);
   extend(target, target_first);
-  float range = 0.0f;
-  for (int c = 0; c < stride; ++c) {
-    if (!(lo[std::size_t(c)] <= hi[std::size_t(c)])) lo[std::size_t(c)] = hi[std::size_t(c)] = 0.0f;
-    range = std::max(range, hi[std::size_t(c)] - lo[std::size_t(c)]);
-  }
-  offset = lo;
-  // A flat feature set still needs a positive step.
-  step = range > 0.0f ? range / float(max_value) : 1.0f;
+  range.to_fixed_point(max_value, offset, step);
+}
+
+void fixed_point_range(const std::vector<ChannelWrite>& source, const std::vector<ChannelWrite>& target, int stride,
+                       int target_first, int max_value, std::vector<float>& offset, float& step) {
+  SlotRange range(stride);
+  add_writes(range, source, stride, 0);
+  add_writes(range, target, stride, target_first);
+  range.to_fixed_point(max_value, offset, step);
 }
 
 // Fixed-point SSD kernels. Values are at most 12 bits, so a difference fits

@@ -478,24 +478,29 @@ void Solver::build_level(int l, Level& level, const LevelStart* start) const {
   const bool release = start && start->last_use;
   const int total = p.source[std::size_t(l)].channels();
   level.space = geometry(l, level.source, level.target);
-  level.source = FeatureImage(p.source_size[l].first, p.source_size[l].second, total);
-  level.target = FeatureImage(p.target_size[l].first, p.target_size[l].second, total);
-  level.space.source = &level.source;
-  level.space.target = &level.target;
   level.style = extract_channels(p.source[l].view(), 0, p.style_channels);
+  Image lab = options_.color_space == ColorSpace::Lab ? srgb_to_lab(level.style.view()) : Image();
   // All channels as they are (the guides are weighted already), then the
   // style's as matched: no full-size copy of the guides.
-  level.source.set_channels(0, p.source[l].view(), 1.0f);
-  if (release) p.source[l] = Image();
-  if (total > p.style_channels) level.target.set_channels(p.style_channels, p.target[l].view(), 1.0f);
-  if (release) p.target[l] = Image();
-  if (start) replace_guide_targets(l, *start, level.target);
-  if (options_.color_space == ColorSpace::Lab)
-    level.source.set_channels(0, srgb_to_lab(level.style.view()).view(), p.style_scales);
-  else
-    level.source.set_channels(0, level.style.view(), p.style_scales);
-  const int sw = level.source.width, sh = level.source.height, tw = level.target.width, th = level.target.height;
+  const std::vector<ChannelWrite> source_writes = {
+      {0, p.source[l].view(), std::vector<float>(std::size_t(total), 1.0f)},
+      {0, lab.empty() ? level.style.view() : lab.view(), p.style_scales}};
+  std::vector<ChannelWrite> target_writes;
+  if (total > p.style_channels) {
+    const ImageView guides = p.target[l].view();
+    target_writes.push_back({p.style_channels, guides, std::vector<float>(std::size_t(guides.channels), 1.0f)});
+  }
+  if (start) add_guide_target_writes(l, *start, target_writes);
   const bool weighted = std::any_of(p.weight_maps.begin(), p.weight_maps.end(), [](auto& m) { return !m.empty(); });
+  allocate_features(level, source_writes, target_writes, weighted);
+  level.space.source = &level.source;
+  level.space.target = &level.target;
+  level.source.set_channels(source_writes);  // source_writes dangle from here on
+  lab = Image();
+  if (release) p.source[l] = Image();
+  level.target.set_channels(target_writes);
+  if (release) p.target[l] = Image();
+  const int sw = level.source.width, sh = level.source.height, tw = level.target.width, th = level.target.height;
   if (weighted) {
     level.target_weights = FeatureImage(tw, th, total);
     std::fill(level.target_weights.data.begin(), level.target_weights.data.end(), 1.0f);
@@ -509,7 +514,6 @@ void Solver::build_level(int l, Level& level, const LevelStart* start) const {
     }
     level.space.target_weights = &level.target_weights;
   }
-  quantize_features(level);
   SearchConstraints& cons = level.constraints;
   const int margin = level.space.source_margin();
   const SourceLayout& lay = p.layout[std::size_t(l)];
@@ -548,33 +552,47 @@ void Solver::build_level(int l, Level& level, const LevelStart* start) const {
 }
 
 // Fixed-point features where the patch distance has a fixed-point path:
-// axis-aligned patches with no window and no per-pixel weights.
-void Solver::quantize_features(Level& level) const {
+// axis-aligned patches with no window and no per-pixel weights. Their offsets
+// and step are read off the writes, so the level's features are never held
+// in float as well (that copy was twice their size, and the peak at 1 Mpix).
+void Solver::allocate_features(Level& level, const std::vector<ChannelWrite>& source_writes,
+                               const std::vector<ChannelWrite>& target_writes, bool weighted) const {
+  const int total = source_writes.front().image.channels;
+  const int sw = level.source.width, sh = level.source.height, tw = level.target.width, th = level.target.height;
   const PatchSpace& s = level.space;
-  if (options_.feature_precision == FeaturePrecision::Float || s.rotated() || s.window || s.target_weights) return;
+  if (options_.feature_precision == FeaturePrecision::Float || s.rotated() || s.window || weighted) {
+    level.source = FeatureImage(sw, sh, total);
+    level.target = FeatureImage(tw, th, total);
+    return;
+  }
   const int max_value =
       options_.feature_precision == FeaturePrecision::Int8 ? FeatureImage::kFixed8 : FeatureImage::kFixed12;
   std::vector<float> offset;
   float step = 0.0f;
-  fixed_point_range(level.source, level.target, plan_->style_channels, max_value, offset, step);
-  level.source.quantize(offset, step, max_value);
-  level.target.quantize(offset, step, max_value);
+  fixed_point_range(source_writes, target_writes, FeatureImage::padded(total), plan_->style_channels, max_value,
+                    offset, step);
+  level.source = FeatureImage::fixed_point(sw, sh, total, offset, step, max_value);
+  level.target = FeatureImage::fixed_point(tw, th, total, offset, step, max_value);
 }
 
-void Solver::replace_guide_targets(int l, const LevelStart& start, FeatureImage& target) const {
+// Per-level guide targets (LevelStart::guide_targets) as writes over the
+// target's guide slots, weighted like the plan's.
+void Solver::add_guide_target_writes(int l, const LevelStart& start, std::vector<ChannelWrite>& writes) const {
   const Plan& p = *plan_;
+  const auto [tw, th] = p.target_size[std::size_t(l)];
   for (const auto& [layer, image] : start.guide_targets) {
     if (p.guide_channels.size() != p.guide_weights.size())
       throw ValueError("per-level guide targets need uncompressed guides (guide_variance 1)");
     if (layer < 0 || layer >= int(p.guide_weights.size()))
       throw ValueError(concat("guide layer ", layer, " does not exist (there are ", p.guide_weights.size(), ")"));
-    if (image->width() != target.width || image->height() != target.height ||
-        image->channels() != p.guide_channels[std::size_t(layer)])
-      throw ValueError(concat("guide target of layer ", layer, " at level ", l, " must be ", target.width, "x",
-                              target.height, " with ", p.guide_channels[std::size_t(layer)], " channels"));
+    const int channels = p.guide_channels[std::size_t(layer)];
+    if (image->width() != tw || image->height() != th || image->channels() != channels)
+      throw ValueError(concat("guide target of layer ", layer, " at level ", l, " must be ", tw, "x", th, " with ",
+                              channels, " channels"));
     int first = p.style_channels;
     for (int k = 0; k < layer; ++k) first += p.guide_channels[std::size_t(k)];
-    target.set_channels(first, image->view(), std::sqrt(p.guide_weights[std::size_t(layer)]));
+    writes.push_back({first, image->view(),
+                      std::vector<float>(std::size_t(channels), std::sqrt(p.guide_weights[std::size_t(layer)]))});
   }
 }
 

@@ -17,6 +17,16 @@
 
 namespace tempera {
 
+// One write of feature channels: channel c of `image`, times scales[c], goes
+// to feature slot first + c of every pixel. A level's features are a list of
+// writes applied in order (a later write replaces an earlier one's slots), so
+// the fixed-point range can be read off the writes before any feature exists.
+struct ChannelWrite {
+  int first = 0;
+  ImageView image;
+  std::vector<float> scales;  // one per channel of `image`
+};
+
 struct FeatureImage {
   int width = 0;
   int height = 0;
@@ -38,6 +48,12 @@ struct FeatureImage {
 
   FeatureImage() = default;
   FeatureImage(int w, int h, int channels);
+  // Fixed-point features (see quantize) with every slot holding the code of
+  // 0, what a float feature image starts with: built this way and written
+  // with set_channels, they equal float features quantized afterwards, without
+  // the float copy (twice their size) ever being held.
+  static FeatureImage fixed_point(int w, int h, int channels, const std::vector<float>& channel_offset,
+                                  float quant_step, int max_value);
   static int padded(int channels) { return (channels + 7) / 8 * 8; }
   bool quantized() const { return fixed_max > 0; }
   bool bytes() const { return fixed_max == kFixed8; }
@@ -56,6 +72,8 @@ struct FeatureImage {
   void set_channels(int first, const ImageView& image, float scale);
   // The same with one scale per channel of `image`.
   void set_channels(int first, const ImageView& image, const std::vector<float>& scales);
+  // Applies `writes` in order.
+  void set_channels(const std::vector<ChannelWrite>& writes);
   // Sets slots [first, first + count) of every pixel to 0.
   void zero_channels(int first, int count);
   // Replaces the float features by fixed-point ones in [0, max_value]
@@ -66,6 +84,8 @@ struct FeatureImage {
  private:
   std::size_t index(int x, int y) const { return (std::size_t(y) * width + x) * stride; }
   void store(std::size_t i, float v);
+  float code(std::size_t slot, float v) const;  // the fixed-point value of v in slot `slot`
+  void use_fixed_point(const std::vector<float>& channel_offset, float quant_step, int max_value);
 };
 
 // Offsets and step that quantize `source` (all channels) and `target`
@@ -74,6 +94,12 @@ struct FeatureImage {
 // per-channel minimum, and the widest channel range / max_value as the step.
 void fixed_point_range(const FeatureImage& source, const FeatureImage& target, int target_first, int max_value,
                        std::vector<float>& offset, float& step);
+
+// The same offsets and step for the features that `source` and `target`
+// (lists of writes, see ChannelWrite) would build, read off the writes: only
+// each slot's last write counts, and slots no write reaches hold 0.
+void fixed_point_range(const std::vector<ChannelWrite>& source, const std::vector<ChannelWrite>& target, int stride,
+                       int target_first, int max_value, std::vector<float>& offset, float& step);
 
 // Exact integer SSD of n fixed-point values (at most 12 bits), with the kernel
 // the CPU supports (AVX-512BW, AVX2, or scalar); `kernel` forces one, for tests.

@@ -262,7 +262,12 @@ class ReversedRetrieval {
         }
       }
     });
+    // Sized once: a growing vector holds its old and new buffers at once,
+    // and a round's winners are up to 12 bytes per target.
     std::vector<Assignment> out;
+    out.reserve(std::size_t(std::count_if(best.begin(), best.end(), [](const auto& b) {
+      return b.load(std::memory_order_relaxed) != ~0ull;
+    })));
     for (std::size_t q = 0; q < best.size(); ++q) {
       const std::uint64_t key = best[q].load(std::memory_order_relaxed);
       if (key == ~0ull) continue;

@@ -104,8 +104,9 @@ class Solver {
   OffsetField cold_start(int level, Level& lv, Image& bprime) const;
   void fix_pixels(int level, const Level& lv, const Image* values, OffsetField& field, Image& bprime) const;
   void set_target_style(Level& lv, const Image& bprime) const;
-  void quantize_features(Level& lv) const;
-  void replace_guide_targets(int level, const LevelStart& start, FeatureImage& target) const;
+  void allocate_features(Level& lv, const std::vector<ChannelWrite>& source_writes,
+                         const std::vector<ChannelWrite>& target_writes, bool weighted) const;
+  void add_guide_target_writes(int level, const LevelStart& start, std::vector<ChannelWrite>& writes) const;
   std::unique_ptr<Plan> plan_;
   SynthesisOptions options_;
   EnergyTerms terms_;
