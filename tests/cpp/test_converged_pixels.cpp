@@ -11,8 +11,10 @@
 #include "tempera/converged_pixels.hpp"
 #include "tempera/patchmatch.hpp"
 #include "tempera/synthesis.hpp"
+#include "test_inputs.hpp"
 
 using namespace tempera;
+using tempera::test_inputs::noise_texture;
 
 namespace {
 
@@ -32,14 +34,6 @@ FeatureImage random_features(int w, int h, int channels, unsigned seed) {
     for (int x = 0; x < w; ++x)
       for (int c = 0; c < channels; ++c) f.pixel(x, y)[c] = float(rng() % 1000) * 1e-3f;
   return f;
-}
-
-Image noise_texture(int w, int h, int c, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> u(0.0f, 1.0f);
-  Image img(w, h, c);
-  for (std::size_t i = 0; i < img.pixel_count() * c; ++i) img.data()[i] = u(rng);
-  return img;
 }
 
 }  // namespace
@@ -102,7 +96,8 @@ TEST(ConvergedPixels, PatchMatchLeavesUnsearchedPixelsAlone) {
   std::vector<std::uint8_t> searched(start.x.size(), 0);
   for (std::size_t i = 0; i < searched.size(); ++i) searched[i] = (i / 7) % 2;  // runs of 7 on, 7 off
   OffsetField field = start;
-  PatchMatchParams pm{2, 5, 2};
+  PatchMatchParams pm;
+  pm.iterations = 2, pm.seed = 5, pm.threads = 2;
   pm.searched = &searched;
   patchmatch(space, cons, field, pm, 1);
   double before = 0, after = 0;

@@ -8,18 +8,12 @@
 
 #include "tempera/patch_distance.hpp"
 #include "tempera/synthesis.hpp"
+#include "test_inputs.hpp"
 
 using namespace tempera;
+using tempera::test_inputs::noise_texture;
 
 namespace {
-
-Image noise_texture(int w, int h, int c, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> u(0.0f, 1.0f);
-  Image img(w, h, c);
-  for (std::size_t i = 0; i < img.pixel_count() * c; ++i) img.data()[i] = u(rng);
-  return img;
-}
 
 Image ramp_guide(int w, int h) {
   Image g(w, h, 2);

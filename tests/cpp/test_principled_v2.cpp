@@ -7,40 +7,15 @@
 #include <cstring>
 
 #include "tempera/embree_tracer.hpp"
+#include "test_inputs.hpp"
 
 using namespace tempera;
+using tempera::test_inputs::add_sphere;
+using tempera::test_inputs::top_camera;
 
 namespace {
 
 constexpr float kPi = 3.14159265358979f;
-
-void add_sphere(Scene& s, Float3 centre, float radius, int material, int rings = 48, int segments = 96) {
-  const auto base = std::uint32_t(s.vertices.size());
-  for (int i = 0; i <= rings; ++i)
-    for (int j = 0; j < segments; ++j) {
-      const float theta = kPi * float(i) / float(rings), phi = 2 * kPi * float(j) / float(segments);
-      s.vertices.push_back(centre + Float3{std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
-                                           std::cos(theta)} * radius);
-    }
-  for (int i = 0; i < rings; ++i)
-    for (int j = 0; j < segments; ++j) {
-      const std::uint32_t a = base + i * segments + j, b = base + i * segments + (j + 1) % segments;
-      const std::uint32_t c = a + segments, d = b + segments;
-      s.triangles.push_back({a, c, d});
-      s.triangles.push_back({a, d, b});
-      s.triangle_materials.insert(s.triangle_materials.end(), {material, material});
-    }
-}
-
-Camera top_camera(float z, float size, int pixels) {
-  Camera c;
-  c.type = Camera::Type::orthographic;
-  c.camera_to_world = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, z, 0, 0, 0, 1};
-  c.width = c.height = pixels;
-  c.ortho_width = c.ortho_height = size;
-  c.clip_start = 0.01f;
-  return c;
-}
 
 double mean(const Image& image) {
   double sum = 0;

@@ -7,8 +7,10 @@
 
 #include "tempera/error.hpp"
 #include "tempera/synthesis.hpp"
+#include "test_inputs.hpp"
 
 using namespace tempera;
+using tempera::test_inputs::noise_texture;
 
 namespace {
 
@@ -23,14 +25,6 @@ Image coordinate_guide(int w, int h) {
       g.at(x, y, 1) = float(y) / h;
     }
   return g;
-}
-
-Image noise_texture(int w, int h, int c, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> u(0.0f, 1.0f);
-  Image img(w, h, c);
-  for (std::size_t i = 0; i < img.pixel_count() * c; ++i) img.data()[i] = u(rng);
-  return img;
 }
 
 SynthesisOptions fast_options(PatchUsage usage) {
