@@ -275,9 +275,6 @@ def test_render_guides_writes_the_lpe_channels(metal):
     assert metal["report"]["warnings"] == []  # everything in this scene is modelled
 
 
-@pytest.mark.xfail(bpy.app.version >= (5, 0, 0), strict=True,
-                   reason="5.0 renders every material through its nodes (a default, partly glossy Principled "
-                   "BSDF for the scene's plain materials): block error 0.041 against the 0.03 of this test")
 def test_animated_frames_are_traced_at_their_frame(tmp_path):
     """The moving cube of guide_scene.py: each frame's L.*E against Cycles'
     FULL of the same frame (no glossy surfaces, so they hold the same paths)."""
