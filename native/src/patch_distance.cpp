@@ -274,6 +274,91 @@ std::int64_t fixed_ssd_scalar(const T* a, const T* b, int n) {
 template <class T>
 using FixedSsd = std::int64_t (*)(const T*, const T*, int);
 
+// Whole patches: `rows` rows of n values, `pitch` values apart in each image,
+// summed row by row until the sum reaches `limit` (the early exit). One call
+// a candidate, not one a row: a candidate costs a few rows, and the call and
+// the 64-bit reduction per row were as dear as the arithmetic. A row of up to
+// kShortRow values (a 5x5 patch of 8 channels is 40) is reduced in 32 bits:
+// its lanes hold at most 2 * 4095^2 * 4 and its sum at most kShortRow * 4095^2.
+constexpr int kShortRow = 96;
+
+template <class T>
+using PatchSsd = std::int64_t (*)(const T*, std::size_t, const T*, std::size_t, int, int, std::int64_t);
+
+// Horizontal sum of 8 int32 lanes (exact: see kShortRow).
+[[gnu::target("avx2")]] inline std::int32_t hsum32(__m256i v) {
+  const __m128i s = _mm_add_epi32(_mm256_castsi256_si128(v), _mm256_extracti128_si256(v, 1));
+  const __m128i t = _mm_add_epi32(s, _mm_unpackhi_epi64(s, s));
+  return _mm_cvtsi128_si32(_mm_add_epi32(t, _mm_shuffle_epi32(t, 1)));
+}
+
+template <class T, FixedSsd<T> Row>
+std::int64_t patch_rows(const T* a, std::size_t pa, const T* b, std::size_t pb, int rows, int n, std::int64_t limit) {
+  std::int64_t sum = 0;
+  for (int k = 0; k < rows && sum < limit; ++k) sum += Row(a + k * pa, b + k * pb, n);
+  return sum;
+}
+
+[[gnu::target("avx512f,avx512bw,avx512vl")]] inline __m512i load_row16(const std::int16_t* p, __mmask32 m) {
+  return _mm512_maskz_loadu_epi16(m, p);
+}
+[[gnu::target("avx512f,avx512bw,avx512vl")]] inline __m512i load_row16(const std::uint8_t* p, __mmask32 m) {
+  return _mm512_cvtepu8_epi16(_mm256_maskz_loadu_epi8(m, p));
+}
+
+template <class T>
+[[gnu::target("avx512f,avx512bw,avx512vl")]] std::int64_t patch_ssd_avx512(const T* a, std::size_t pa, const T* b,
+                                                                  std::size_t pb, int rows, int n,
+                                                                  std::int64_t limit) {
+  if (n > kShortRow) return patch_rows<T, fixed_ssd_avx512>(a, pa, b, pb, rows, n, limit);
+  std::int64_t sum = 0;
+  for (int k = 0; k < rows && sum < limit; ++k, a += pa, b += pb) {
+    __m512i acc = _mm512_setzero_si512();
+    for (int i = 0; i < n; i += 32) {
+      const __mmask32 m = n - i >= 32 ? ~__mmask32(0) : (__mmask32(1) << (n - i)) - 1;
+      const __m512i d = _mm512_sub_epi16(load_row16(a + i, m), load_row16(b + i, m));
+      acc = _mm512_add_epi32(acc, _mm512_madd_epi16(d, d));
+    }
+    sum += hsum32(_mm256_add_epi32(_mm512_castsi512_si256(acc), _mm512_extracti64x4_epi64(acc, 1)));
+  }
+  return sum;
+}
+
+[[gnu::target("avx2")]] inline __m256i load16(const std::int16_t* p) {
+  return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p));
+}
+[[gnu::target("avx2")]] inline __m256i load16(const std::uint8_t* p) {
+  return _mm256_cvtepu8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
+}
+
+[[gnu::target("avx2")]] inline __m128i load8(const std::int16_t* p) {
+  return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p));
+}
+[[gnu::target("avx2")]] inline __m128i load8(const std::uint8_t* p) {
+  return _mm_cvtepu8_epi16(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)));
+}
+
+template <class T>
+[[gnu::target("avx2")]] std::int64_t patch_ssd_avx2(const T* a, std::size_t pa, const T* b, std::size_t pb,
+                                                    int rows, int n, std::int64_t limit) {
+  if (n > kShortRow) return patch_rows<T, fixed_ssd_avx2>(a, pa, b, pb, rows, n, limit);
+  std::int64_t sum = 0;
+  for (int k = 0; k < rows && sum < limit; ++k, a += pa, b += pb) {
+    __m256i acc = _mm256_setzero_si256();
+    int i = 0;
+    for (; i + 16 <= n; i += 16) {
+      const __m256i d = _mm256_sub_epi16(load16(a + i), load16(b + i));
+      acc = _mm256_add_epi32(acc, _mm256_madd_epi16(d, d));
+    }
+    if (i < n) {  // rows are whole pixels, a multiple of 8 values
+      const __m128i d = _mm_sub_epi16(load8(a + i), load8(b + i));
+      acc = _mm256_add_epi32(acc, _mm256_zextsi128_si256(_mm_madd_epi16(d, d)));
+    }
+    sum += hsum32(acc);
+  }
+  return sum;
+}
+
 template <class T>
 FixedSsd<T> kernel_of(FixedKernel k) {
   switch (k) {
@@ -287,12 +372,31 @@ FixedSsd<T> kernel_of(FixedKernel k) {
   return fixed_ssd_scalar<T>;
 }
 
-// Picked once, at load time.
-const FixedSsd<std::int16_t> best_fixed_ssd = kernel_of<std::int16_t>(FixedKernel::Best);
-const FixedSsd<std::uint8_t> best_fixed8_ssd = kernel_of<std::uint8_t>(FixedKernel::Best);
+template <class T>
+PatchSsd<T> patch_kernel_of(FixedKernel k) {
+  switch (k) {
+    case FixedKernel::Scalar: return patch_rows<T, fixed_ssd_scalar<T>>;
+    case FixedKernel::Avx2: return patch_ssd_avx2<T>;
+    case FixedKernel::Avx512: return patch_ssd_avx512<T>;
+    case FixedKernel::Best: break;
+  }
+  if (fixed_kernel_supported(FixedKernel::Avx512)) return patch_ssd_avx512<T>;
+  if (fixed_kernel_supported(FixedKernel::Avx2)) return patch_ssd_avx2<T>;
+  return patch_rows<T, fixed_ssd_scalar<T>>;
+}
 
-std::int64_t best_ssd(const std::int16_t* a, const std::int16_t* b, int n) { return best_fixed_ssd(a, b, n); }
-std::int64_t best_ssd(const std::uint8_t* a, const std::uint8_t* b, int n) { return best_fixed8_ssd(a, b, n); }
+// Picked once, at load time.
+const PatchSsd<std::int16_t> best_patch_ssd16 = patch_kernel_of<std::int16_t>(FixedKernel::Best);
+const PatchSsd<std::uint8_t> best_patch_ssd8 = patch_kernel_of<std::uint8_t>(FixedKernel::Best);
+
+std::int64_t best_patch_ssd(const std::int16_t* a, std::size_t pa, const std::int16_t* b, std::size_t pb, int rows,
+                            int n, std::int64_t limit) {
+  return best_patch_ssd16(a, pa, b, pb, rows, n, limit);
+}
+std::int64_t best_patch_ssd(const std::uint8_t* a, std::size_t pa, const std::uint8_t* b, std::size_t pb, int rows,
+                            int n, std::int64_t limit) {
+  return best_patch_ssd8(a, pa, b, pb, rows, n, limit);
+}
 
 }  // namespace
 
@@ -402,11 +506,13 @@ float distance_fixed(const PatchSpace& s, int sx, int sy, int tx, int ty, float 
     else
       return f.fixed_pixel(x, y);
   };
-  std::int64_t sum = 0;
-  for (int dy = w.dy0; dy <= w.dy1; ++dy) {
-    sum += best_ssd(row(*s.source, sx + w.dx0, sy + dy), row(*s.target, tx + w.dx0, ty + dy), n);
-    if (double(sum) >= limit) break;
-  }
+  // The integer sum reaches `limit` exactly when it reaches its ceiling.
+  const std::int64_t stop = limit < 9e18 ? std::int64_t(std::ceil(limit)) : std::numeric_limits<std::int64_t>::max();
+  const std::size_t pitch_a = std::size_t(s.source->width) * s.source->stride;
+  const std::size_t pitch_b = std::size_t(s.target->width) * s.target->stride;
+  const std::int64_t sum = best_patch_ssd(row(*s.source, sx + w.dx0, sy + w.dy0), pitch_a,
+                                          row(*s.target, tx + w.dx0, ty + w.dy0), pitch_b, w.dy1 - w.dy0 + 1, n,
+                                          stop);
   return float(double(sum) * step2);
 }
 

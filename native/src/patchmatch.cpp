@@ -145,11 +145,25 @@ void patchmatch(const PatchSpace& space, const SearchConstraints& cons, OffsetFi
                                            [](int s) { return s >= 0; });
   const std::vector<std::uint8_t>& matched = cons.matched();
   for (int iter = params.first_iteration; iter < params.first_iteration + params.iterations; ++iter) {
-    const OffsetField snapshot = field;  // what other bands see of this band's neighbours
-    const Matcher m(space, cons, params, &snapshot);
-    const int max_radius = std::max(m.sw, m.sh);
     const bool forward = iter % 2 == 0;
     const int step = forward ? 1 : -1;
+    // What a band sees of its neighbours in other bands: the field as it was
+    // before the sweep. Terms that read the field read all of it; propagation
+    // only the row before each band's first (row b of `edges` for band b), so
+    // the common case copies a row a band, not the whole field every sweep.
+    const OffsetField snapshot = params.field_terms.empty() ? OffsetField() : field;
+    OffsetField edges(tw, bands);
+    for (int band = 0; band < bands; ++band) {
+      const int ey = forward ? band * params.band_rows - 1 : std::min(th, (band + 1) * params.band_rows);
+      if (ey < 0 || ey >= th) continue;
+      const std::size_t from = field.index(0, ey), to = edges.index(0, band);
+      std::copy_n(field.x.begin() + from, tw, edges.x.begin() + to);
+      std::copy_n(field.y.begin() + from, tw, edges.y.begin() + to);
+      std::copy_n(field.rx.begin() + from, tw, edges.rx.begin() + to);
+      std::copy_n(field.ry.begin() + from, tw, edges.ry.begin() + to);
+    }
+    const Matcher m(space, cons, params, &snapshot);
+    const int max_radius = std::max(m.sw, m.sh);
     parallel_for(bands, params.threads, [&](int band) {
       const int y0 = band * params.band_rows, y1 = std::min(th, y0 + params.band_rows);
       Rng rng(params.seed, mix64(stream * 1000003ull + iter) ^ std::uint64_t(band));
@@ -171,10 +185,11 @@ void patchmatch(const PatchSpace& space, const SearchConstraints& cons, OffsetFi
             const std::size_t ni = field.index(nx, ny);
             if (!matched[ni]) continue;
             const bool inside = ny >= y0 && ny < y1;
-            const OffsetField& src = inside ? field : snapshot;
+            const OffsetField& src = inside ? field : edges;
+            const std::size_t si = inside ? ni : edges.index(nx, band);
             int cx, cy;
-            propagate_candidate(space, src.x[ni], src.y[ni], nx, ny, d[0], d[1], cx, cy);
-            m.try_candidate(cx, cy, src.rx[ni], src.ry[ni], tx, ty, segment, b);
+            propagate_candidate(space, src.x[si], src.y[si], nx, ny, d[0], d[1], cx, cy);
+            m.try_candidate(cx, cy, src.rx[si], src.ry[si], tx, ty, segment, b);
           }
           // Candidates the method proposes (Bénard's ribbons).
           if (params.candidates && !params.candidates->empty())
