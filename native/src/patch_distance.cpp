@@ -421,6 +421,18 @@ std::int64_t fixed_ssd(const std::uint8_t* a, const std::uint8_t* b, int n, Fixe
   return kernel_of<std::uint8_t>(kernel)(a, b, n);
 }
 
+std::int64_t fixed_patch_ssd(const std::int16_t* a, std::size_t pitch_a, const std::int16_t* b, std::size_t pitch_b,
+                             int rows, int n, std::int64_t limit, FixedKernel kernel) {
+  if (!fixed_kernel_supported(kernel)) throw ValueError("fixed-point kernel not supported by this CPU");
+  return patch_kernel_of<std::int16_t>(kernel)(a, pitch_a, b, pitch_b, rows, n, limit);
+}
+
+std::int64_t fixed_patch_ssd(const std::uint8_t* a, std::size_t pitch_a, const std::uint8_t* b, std::size_t pitch_b,
+                             int rows, int n, std::int64_t limit, FixedKernel kernel) {
+  if (!fixed_kernel_supported(kernel)) throw ValueError("fixed-point kernel not supported by this CPU");
+  return patch_kernel_of<std::uint8_t>(kernel)(a, pitch_a, b, pitch_b, rows, n, limit);
+}
+
 void sample_bilinear(const float* data, int width, int height, int stride, int channels, float x,
                      float y, float* out) {
   x = std::clamp(x, 0.0f, float(width - 1));

@@ -117,7 +117,7 @@ TEST(ConvergedPixels, PatchMatchLeavesUnsearchedPixelsAlone) {
 }
 
 // The engine skips converged pixels at the finest level past the first EM
-// iteration and still lowers the energy; switched off (the default) it skips none.
+// iteration and still lowers the energy; switched off it skips none.
 TEST(ConvergedPixels, TheEngineSkipsSomeAndTheEnergyStillDrops) {
   const int w = 64, h = 48;
   // Hatching: ink strokes whose density follows a gradient (as the bench's
@@ -138,6 +138,7 @@ TEST(ConvergedPixels, TheEngineSkipsSomeAndTheEnergyStillDrops) {
   in.guides.add("g", sg.view(), tg.view(), 2.0f);
   for (PatchUsage usage : {PatchUsage::None, PatchUsage::Budget}) {
     SynthesisOptions off;
+    off.skip_converged = false;
     off.threads = 2;
     off.usage = usage;
     SynthesisOptions on = off, on1 = off;

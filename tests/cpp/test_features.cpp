@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "tempera/patch_distance.hpp"
@@ -67,6 +68,62 @@ TEST(FixedFeatures, SimdKernelsAgreeWithScalarExactly) {
   if (fixed_kernel_supported(FixedKernel::Avx2)) {
     EXPECT_GT(checked16, 15 * 4 * 2 * 2);
     EXPECT_GT(checked8, 15 * 4 * 2 * 2);
+  }
+}
+
+namespace {
+
+// Whole-patch kernels against row sums with the same early exit: short rows
+// (reduced in 32 bits), long ones (the row kernels), extreme values, limits
+// that stop at every row and never.
+template <class T>
+int check_patch_kernels(int max_value) {
+  std::mt19937 rng(9);
+  std::uniform_int_distribution<int> value(0, max_value);
+  int checked = 0;
+  for (int n : {8, 16, 24, 40, 56, 72, 96, 104, 248}) {
+    const int rows = 7;
+    const std::size_t pitch_a = std::size_t(n) + 24, pitch_b = std::size_t(n) + 8;
+    std::vector<T> a(pitch_a * rows), b(pitch_b * rows);
+    for (int trial = 0; trial < 3; ++trial) {
+      for (auto& v : a) v = T(value(rng));
+      for (std::size_t i = 0; i < b.size(); ++i)
+        b[i] = trial == 2 ? T(a[i % pitch_a] > max_value / 2 ? 0 : max_value) : T(value(rng));
+      std::vector<std::int64_t> partial(rows + 1, 0);  // partial[k]: the first k rows
+      for (int k = 0; k < rows; ++k) {
+        std::int64_t row = 0;
+        for (int i = 0; i < n; ++i) {
+          const std::int64_t d = std::int64_t(a[k * pitch_a + i]) - b[k * pitch_b + i];
+          row += d * d;
+        }
+        partial[k + 1] = partial[k] + row;
+      }
+      std::vector<std::int64_t> limits = {0, 1, std::numeric_limits<std::int64_t>::max()};
+      for (int k = 1; k <= rows; ++k) limits.push_back(partial[k]), limits.push_back(partial[k] + 1);
+      for (std::int64_t limit : limits) {
+        int k = 1;
+        while (k < rows && partial[k] < limit) ++k;
+        const std::int64_t expected = limit <= 0 ? 0 : partial[k];
+        for (FixedKernel kernel : {FixedKernel::Scalar, FixedKernel::Avx2, FixedKernel::Avx512, FixedKernel::Best}) {
+          if (!fixed_kernel_supported(kernel)) continue;
+          EXPECT_EQ(fixed_patch_ssd(a.data(), pitch_a, b.data(), pitch_b, rows, n, limit, kernel), expected)
+              << "n " << n << " limit " << limit << " kernel " << int(kernel);
+          ++checked;
+        }
+      }
+    }
+  }
+  return checked;
+}
+
+}  // namespace
+
+TEST(FixedFeatures, PatchKernelsStopWhereTheRowSumsDo) {
+  const int checked16 = check_patch_kernels<std::int16_t>(FeatureImage::kFixed12);
+  const int checked8 = check_patch_kernels<std::uint8_t>(FeatureImage::kFixed8);
+  if (fixed_kernel_supported(FixedKernel::Avx2)) {  // more than the scalar kernel was tested
+    EXPECT_GT(checked16, 9 * 3 * 17 * 2);
+    EXPECT_GT(checked8, 9 * 3 * 17 * 2);
   }
 }
 

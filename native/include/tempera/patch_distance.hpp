@@ -107,6 +107,13 @@ enum class FixedKernel { Best, Scalar, Avx2, Avx512 };
 bool fixed_kernel_supported(FixedKernel kernel);
 std::int64_t fixed_ssd(const std::int16_t* a, const std::int16_t* b, int n, FixedKernel kernel = FixedKernel::Best);
 std::int64_t fixed_ssd(const std::uint8_t* a, const std::uint8_t* b, int n, FixedKernel kernel = FixedKernel::Best);
+// The SSD of a whole patch: `rows` rows of n values, pitch_a and pitch_b
+// values apart, summed row by row while the sum is below `limit` (the early
+// exit: the result is the full sum, or the first partial sum >= limit).
+std::int64_t fixed_patch_ssd(const std::int16_t* a, std::size_t pitch_a, const std::int16_t* b, std::size_t pitch_b,
+                             int rows, int n, std::int64_t limit, FixedKernel kernel = FixedKernel::Best);
+std::int64_t fixed_patch_ssd(const std::uint8_t* a, std::size_t pitch_a, const std::uint8_t* b, std::size_t pitch_b,
+                             int rows, int n, std::int64_t limit, FixedKernel kernel = FixedKernel::Best);
 
 // What a patch comparison needs: the two feature images, the patch radius and,
 // for rotation-aware matching, per-pixel orientation angles (radians; the
