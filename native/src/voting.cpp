@@ -83,6 +83,30 @@ std::size_t weighted_mode(const std::vector<float>& values, int c, std::size_t n
   return m.first[best];
 }
 
+// Calls fn(q, dx, dy) for every voting patch that covers target (tx, ty),
+// row by row: the patch centred at q = (tx - dx, ty - dy), in which the
+// target is at offset (dx, dy). Returns how many there were. Every vote
+// gathers in this order, so its sums are the same floats in every loop.
+template <class Fn>
+[[gnu::always_inline]] inline int for_each_covering_patch(const OffsetField& field,
+                                                           const std::vector<std::uint8_t>& voters, int r, int tx,
+                                                           int ty, Fn&& fn) {
+  int count = 0;
+  for (int dy = -r; dy <= r; ++dy) {
+    const int qy = ty - dy;
+    if (qy < 0 || qy >= field.height) continue;
+    for (int dx = -r; dx <= r; ++dx) {
+      const int qx = tx - dx;
+      if (qx < 0 || qx >= field.width) continue;
+      const std::size_t qi = field.index(qx, qy);
+      if (!voters[qi]) continue;
+      fn(qi, dx, dy);
+      ++count;
+    }
+  }
+  return count;
+}
+
 // Mean votes of axis-aligned patches, the EM loop's M-step: the same sums in
 // the same order as the general loop below (so the same floats), without its
 // per-sample copies and branches; it was a tenth of a StyLit frame.
@@ -90,25 +114,15 @@ constexpr int kMeanVoteChannels = 8;
 
 void vote_mean_row(const ImageView& style, const OffsetField& field, const std::vector<std::uint8_t>& active,
                    const std::vector<std::uint8_t>& voters, int r, int ty, Image& out) {
-  const int tw = field.width, th = field.height, c = style.channels;
-  for (int tx = 0; tx < tw; ++tx) {
+  const int c = style.channels;
+  for (int tx = 0; tx < field.width; ++tx) {
     const std::size_t i = field.index(tx, ty);
     if (!active[i]) continue;
     float sum[kMeanVoteChannels] = {};
-    int count = 0;
-    for (int dy = -r; dy <= r; ++dy) {
-      const int qy = ty - dy;
-      if (qy < 0 || qy >= th) continue;
-      for (int dx = -r; dx <= r; ++dx) {
-        const int qx = tx - dx;
-        if (qx < 0 || qx >= tw) continue;
-        const std::size_t qi = field.index(qx, qy);
-        if (!voters[qi]) continue;
-        const float* s = style.pixel(field.x[qi] + dx, field.y[qi] + dy);
-        for (int k = 0; k < c; ++k) sum[k] += s[k];
-        ++count;
-      }
-    }
+    const int count = for_each_covering_patch(field, voters, r, tx, ty, [&](std::size_t qi, int dx, int dy) {
+      const float* s = style.pixel(field.x[qi] + dx, field.y[qi] + dy);
+      for (int k = 0; k < c; ++k) sum[k] += s[k];
+    });
     if (count == 0) continue;
     float* o = out.pixel(tx, ty);
     for (int k = 0; k < c; ++k) o[k] = sum[k] / float(count);
@@ -144,25 +158,13 @@ Image vote(const ImageView& style, const PatchSpace& space, const SearchConstrai
       }
       std::fill(sum.begin(), sum.end(), 0.0f);
       candidates.clear();
-      int count = 0;
-      // Gather from every patch (centred at q') that covers q; q - q' is the
-      // offset of q inside that patch.
-      for (int dy = -r; dy <= r; ++dy) {
-        const int qy = ty - dy;
-        if (qy < 0 || qy >= th) continue;
-        for (int dx = -r; dx <= r; ++dx) {
-          const int qx = tx - dx;
-          if (qx < 0 || qx >= tw) continue;
-          const std::size_t qi = field.index(qx, qy);
-          if (!voters[qi]) continue;
-          voter.sample(qi, qx, qy, dx, dy, sample.data());
-          if (params.mode == OutputMode::Mean)
-            for (int k = 0; k < c; ++k) sum[k] += sample[k];
-          else
-            candidates.insert(candidates.end(), sample.begin(), sample.end());
-          ++count;
-        }
-      }
+      const int count = for_each_covering_patch(field, voters, r, tx, ty, [&](std::size_t qi, int dx, int dy) {
+        voter.sample(qi, tx - dx, ty - dy, dx, dy, sample.data());
+        if (params.mode == OutputMode::Mean)
+          for (int k = 0; k < c; ++k) sum[k] += sample[k];
+        else
+          candidates.insert(candidates.end(), sample.begin(), sample.end());
+      });
       if (count == 0) continue;
       if (params.mode == OutputMode::Mean) {
         for (int k = 0; k < c; ++k) o[k] = sum[k] / float(count);
