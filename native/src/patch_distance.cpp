@@ -279,7 +279,8 @@ using FixedSsd = std::int64_t (*)(const T*, const T*, int);
 // a candidate, not one a row: a candidate costs a few rows, and the call and
 // the 64-bit reduction per row were as dear as the arithmetic. A row of up to
 // kShortRow values (a 5x5 patch of 8 channels is 40) is reduced in 32 bits:
-// its lanes hold at most 2 * 4095^2 * 4 and its sum at most kShortRow * 4095^2.
+// its sum, and so every partial sum of its lanes, is at most
+// 96 * 4095^2 < 2^31. Longer rows go through the blocked row kernels.
 constexpr int kShortRow = 96;
 
 template <class T>
