@@ -13,13 +13,16 @@ builds the same scene with build() and runs the method on it.
 """
 import argparse
 import math
+import random
 import sys
 
 import addon_utils
 import bpy
+import mathutils
 
 END = 30  # the cube falls, breaks on the floor (frame ~14) and the shards scatter
 CAMERA = ((0, -9, 1.2), (math.pi / 2, 0, 0))
+FRACTURE_SEED = 1  # the same shards in every run
 
 
 def _select(objects):
@@ -43,6 +46,10 @@ def build(scene, size=(240, 135)):
     cube = bpy.context.object
     _select([cube])
     before = set(scene.objects)
+    # Cell Fracture jitters its cells with Python's and mathutils' random
+    # numbers, unseeded: the shards (and so the bake) differed from run to run.
+    random.seed(FRACTURE_SEED)
+    mathutils.noise.seed_set(FRACTURE_SEED)
     assert bpy.ops.object.add_fracture_cell_objects(source={"VERT_OWN"}) == {"FINISHED"}
     shards = [o for o in scene.objects if o not in before]
     bpy.data.objects.remove(cube)  # the user deletes the unbroken cube
