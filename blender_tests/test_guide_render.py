@@ -1,5 +1,6 @@
 """tempera.blender.guide_render on a tiny animated scene rendered headless:
 a cube moving right with linear keyframes in front of a static backdrop."""
+import math
 import tempfile
 from pathlib import Path
 
@@ -176,8 +177,43 @@ def _unset_colorspace(key, before):
     """Blender 5.0 leaves an image format's linear colour space unset ('') in a
     new scene and fills in the format's default the first time file_format
     changes; '' cannot be set back, and with the scene's colour management
-    followed it is not used."""
-    return key.endswith("linear_colorspace_settings.name") and before == ""
+    followed it is not used. 5.3 adds the space's interop_id, 'NONE' while
+    the name is unset, filled in with it."""
+    return ((key.endswith("linear_colorspace_settings.name") and before == "")
+            or (key.endswith("linear_colorspace_settings.interop_id") and before == "NONE"))
+
+
+def test_the_world_has_no_velocity_while_the_camera_turns(tmp_path):
+    """Velocity guides are the motion of surfaces. Blender 5.2 writes the
+    world's apparent motion into the Vector pass as the camera turns, where
+    3.4-5.0 and 5.3 write 0 (compat.surface_vector_pass); on the Suzanne
+    turntable it moved the coherent method's background by up to 7 px a
+    frame. With the camera panning over a backdrop that leaves the world in
+    view, the world's pixels must have no velocity and the backdrop's must."""
+    from tempera import guide_cache
+    from tempera.blender.guide_render import render_guides
+
+    scene = _build_scene("Turning camera")
+    try:
+        # The world shows left, right, above and below ("Backdrop.001" while another test's scene is open).
+        backdrop = next(o for o in scene.objects if o.name.startswith("Backdrop"))
+        backdrop.scale = (3, 0.1, 2)
+        camera = scene.camera
+        for f, degrees in ((1, -4.0), (5, 4.0)):
+            camera.rotation_euler[2] = math.radians(degrees)
+            camera.keyframe_insert("rotation_euler", frame=f)
+        for fcurve in compat.action_fcurves(camera):
+            for key in fcurve.keyframe_points:
+                key.interpolation = "LINEAR"
+        render_guides(scene, [3], tmp_path / "cache", dict(PARAMS, samples=2, ld12e_samples=1))
+        g = guide_cache.read_frame(tmp_path / "cache", 3, ["velocity_backward", "velocity_forward", "alpha"])
+    finally:
+        _remove_scene(scene)
+    world, surface = g["alpha"] == 0, g["alpha"] == 1
+    assert world.sum() > 200 and surface.sum() > 200
+    for name in ("velocity_backward", "velocity_forward"):
+        assert not g[name][world].any(), name
+        assert np.median(np.abs(g[name][surface][:, 0])) > 1, name  # 2 degrees a frame: pixels, not 0
 
 
 def test_settings_and_file_are_unchanged(rendered):

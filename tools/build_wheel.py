@@ -1,7 +1,11 @@
 #!/usr/bin/env python3
-"""Builds the self-contained wheel: scikit-build-core, then auditwheel repair.
+"""Builds the self-contained wheel for one CPython: scikit-build-core, then
+auditwheel repair.
 
     tools/build_wheel.py --python VENV/bin/python --out dist
+
+The wheel is for the CPython that --python runs: venv-tools (3.11) gives the
+cp311 wheel of Blender 4.2-5.0, venv-tools313 the cp313 wheel of 5.1+.
 
 1. `pip wheel --no-build-isolation` with the given Python (a venv holding
    scikit-build-core, pybind11 and auditwheel: tools/setup_venvs.sh makes
@@ -12,8 +16,9 @@
    rewrites the module's and the CLI's needs and RPATH to them; the wheel gets
    a manylinux tag.
 3. Checks the result: no needed library outside the wheel except the policy's
-   (libc, libm, libstdc++, ...), writes the wheel's path into OUT/wheel.txt
-   and prints it on the last line.
+   (libc, libm, libstdc++, ...), writes the wheel's path into
+   OUT/wheel-cpXY.txt and prints it on the last line. Wheels of the other
+   CPython in OUT are left alone.
 """
 import argparse
 import os
@@ -64,13 +69,14 @@ def main():
         env["CMAKE_BUILD_PARALLEL_LEVEL"] = args.jobs
     run([args.python, "-m", "pip", "wheel", "--no-build-isolation", "--no-deps", "-w", raw, ROOT], env=env)
     (wheel,) = raw.glob("tempera_native-*.whl")
-    for old in out.glob("tempera_native-*.whl"):
+    tag = wheel.name.split("-")[2]  # name-version-python-abi-platform.whl
+    for old in out.glob(f"tempera_native-*-{tag}-*.whl"):
         old.unlink()
     run([args.python, "-m", "auditwheel", "repair", "--wheel-dir", out, wheel], env=env)
-    (repaired,) = out.glob("tempera_native-*manylinux*.whl")
+    (repaired,) = out.glob(f"tempera_native-*-{tag}-*manylinux*.whl")
     libs = check_repaired(repaired)
     shutil.rmtree(raw, ignore_errors=True)
-    (out / "wheel.txt").write_text(f"{repaired}\n")  # for make: the extension packs this one
+    (out / f"wheel-{tag}.txt").write_text(f"{repaired}\n")  # for make: the extension packs this one
     print(f"vendored {len(libs)} libraries: {', '.join(libs)}")
     print(f"{repaired} ({repaired.stat().st_size // (1024 * 1024)} MiB)")
 

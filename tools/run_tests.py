@@ -7,6 +7,8 @@
     blender42  blender_tests in blender.org 4.2 LTS (PyPI bpy), the extension's minimum version
     blender45  blender_tests in blender.org 4.5 LTS (PyPI bpy), extension zip installed as a user does
     blender50  blender_tests in blender.org 5.0 (PyPI bpy), extension zip
+    blender52  blender_tests in blender.org 5.2 LTS (PyPI bpy on CPython 3.13), extension zip's cp313 wheel
+    blender53  blender_tests in blender.org 5.3 (PyPI bpy on CPython 3.13), extension zip's cp313 wheel
     wheel      tests/wheel: pip install of the repaired wheel, ldd, the Dask farm (venv-tools)
     flamenco   farm/flamenco tests under Node (node --test)
 
@@ -64,13 +66,17 @@ def main():
     parser.add_argument("--build", default="build")
     parser.add_argument("--addon-zip", help="legacy add-on zip (level blender)")
     parser.add_argument("--extension-zip", help="extension zip (levels blender45, blender50)")
-    parser.add_argument("--wheel", help="repaired wheel (levels blender*, wheel)")
+    parser.add_argument("--wheel", help="repaired cp311 wheel (levels blender*, wheel)")
+    parser.add_argument("--wheel313", help="repaired cp313 wheel (levels blender52, blender53)")
     parser.add_argument("--blender", default="blender")
     parser.add_argument("--bpy42", help="Python with PyPI bpy 4.2 (tools/setup_venvs.sh)")
     parser.add_argument("--bpy45", help="Python with PyPI bpy 4.5")
     parser.add_argument("--bpy50", help="Python with PyPI bpy 5.0")
+    parser.add_argument("--bpy52", help="CPython 3.13 with PyPI bpy 5.2 LTS")
+    parser.add_argument("--bpy53", help="CPython 3.13 with PyPI bpy 5.3")
     parser.add_argument("--tools-python", help="Python with dask and pytest (venv-tools)")
-    parser.add_argument("--levels", default="cpp,python,blender,blender42,blender45,blender50,wheel,flamenco")
+    parser.add_argument("--levels", default="cpp,python,blender,blender42,blender45,blender50,blender52,blender53,"
+                                            "wheel,flamenco")
     args = parser.parse_args()
     build = (ROOT / args.build).resolve()
     reports = Path(tempfile.mkdtemp(prefix="tempera-tests-"))
@@ -85,14 +91,19 @@ def main():
             print(f"=== missing {', '.join('--' + n for n in missing)}", flush=True)
         return not missing
 
-    def blender_level(name, python, version):
-        if not needs("extension-zip", version):
+    def blender_level(name, python, version, wheel="wheel"):
+        if not needs("extension-zip", version, wheel):
             return None
+        if not Path(python).exists():
+            print(f"=== {name}: {python} does not exist (tools/setup_venvs.sh makes it; a CPython 3.13 for 5.1+, "
+                  "see README.md)", flush=True)
+            return None
+        level_env = dict(env, TEMPERA_TEST_WHEEL=str(Path(getattr(args, wheel)).resolve()))
         return run_level(
             f"Blender tests ({name}, extension)",
             [python, ROOT / "blender_tests" / "run.py", "--extension-zip", Path(args.extension_zip).resolve(),
              "--junit", reports / f"{version}.xml"],
-            reports / f"{version}.xml", env=env)
+            reports / f"{version}.xml", env=level_env)
 
     levels = {
         "cpp": lambda: run_level(
@@ -113,6 +124,8 @@ def main():
         "blender42": lambda: blender_level("blender.org 4.2", args.bpy42, "bpy42"),
         "blender45": lambda: blender_level("blender.org 4.5", args.bpy45, "bpy45"),
         "blender50": lambda: blender_level("blender.org 5.0", args.bpy50, "bpy50"),
+        "blender52": lambda: blender_level("blender.org 5.2 LTS", args.bpy52, "bpy52", "wheel313"),
+        "blender53": lambda: blender_level("blender.org 5.3", args.bpy53, "bpy53", "wheel313"),
         "wheel": lambda: needs("wheel", "tools-python") and run_level(
             "Wheel and Dask farm tests",
             [args.tools_python, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests/wheel",

@@ -99,9 +99,10 @@ def test_extension_manifest_permissions_and_packer(tmp_path):
         import make_extension
     finally:
         sys.path.pop(0)
-    name = f"tempera_native-{tempera.__version__}-cp311-cp311-manylinux_2_35_x86_64.whl"
-    text = make_extension.manifest_text(name, tempera.__version__)
-    assert tomllib.loads(text)["wheels"] == [f"./wheels/{name}"]
+    names = [f"tempera_native-{tempera.__version__}-{tag}-{tag}-manylinux_2_35_x86_64.whl"
+             for tag in ("cp311", "cp313")]
+    text = make_extension.manifest_text(names, tempera.__version__)
+    assert tomllib.loads(text)["wheels"] == [f"./wheels/{name}" for name in names]
     wrong = tmp_path / "tempera_native-9.9.9-cp311-cp311-manylinux_2_35_x86_64.whl"
     wrong.write_bytes(b"")
     result = sp.run([sys.executable, str(ROOT / "tools" / "make_extension.py"), "--wheel", str(wrong),
@@ -111,7 +112,38 @@ def test_extension_manifest_permissions_and_packer(tmp_path):
     unrepaired.write_bytes(b"")
     result = sp.run([sys.executable, str(ROOT / "tools" / "make_extension.py"), "--wheel", str(unrepaired),
                      "--out", str(tmp_path / "x.zip")], capture_output=True, text=True)
-    assert result.returncode != 0 and "not a repaired cp311 manylinux" in result.stderr
+    assert result.returncode != 0 and "not a repaired cp311 or cp313 manylinux" in result.stderr
+    cp312 = tmp_path / f"tempera_native-{tempera.__version__}-cp312-cp312-manylinux_2_35_x86_64.whl"
+    cp312.write_bytes(b"")
+    result = sp.run([sys.executable, str(ROOT / "tools" / "make_extension.py"), "--wheel", str(cp312),
+                     "--out", str(tmp_path / "x.zip")], capture_output=True, text=True)
+    assert result.returncode != 0 and "not a repaired cp311 or cp313 manylinux" in result.stderr
+
+
+def test_extension_packs_one_wheel_per_cpython(tmp_path):
+    """Blender 4.2-5.0 run CPython 3.11 and 5.1+ CPython 3.13: the zip carries a wheel for each
+    and its manifest lists both (Blender installs the one that matches); two wheels for one
+    CPython are refused."""
+    import subprocess as sp
+    import zipfile
+
+    wheels = []
+    for tag in ("cp311", "cp313"):
+        wheel = tmp_path / f"tempera_native-{tempera.__version__}-{tag}-{tag}-manylinux_2_35_x86_64.whl"
+        wheel.write_bytes(tag.encode())
+        wheels.append(wheel)
+    args = [sys.executable, str(ROOT / "tools" / "make_extension.py"), "--out", str(tmp_path / "ext.zip")]
+    result = sp.run(args + [a for w in wheels for a in ("--wheel", str(w))], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    with zipfile.ZipFile(tmp_path / "ext.zip") as zf:
+        manifest = tomllib.loads(zf.read("blender_manifest.toml").decode())
+        assert manifest["wheels"] == [f"./wheels/{w.name}" for w in wheels]
+        assert [zf.read(f"wheels/{w.name}") for w in wheels] == [b"cp311", b"cp313"]
+    twin = tmp_path / "twin" / wheels[1].name
+    twin.parent.mkdir()
+    twin.write_bytes(b"")
+    result = sp.run(args + ["--wheel", str(wheels[1]), "--wheel", str(twin)], capture_output=True, text=True)
+    assert result.returncode != 0 and "two cp313 wheels" in result.stderr
 
 
 def test_legacy_zip_leaves_the_manifest_out(tmp_path):

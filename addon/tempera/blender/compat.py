@@ -1,7 +1,7 @@
 """Differences between the Blender versions Tempera runs in, in one place.
 
-Tested: Debian's Blender 3.4, blender.org 4.2 LTS, 4.5 LTS and 5.0 (PyPI
-bpy). Every function here works in all of them; the rest of the add-on, the scene scripts
+Tested: Debian's Blender 3.4, blender.org 4.2 LTS, 4.5 LTS, 5.0, 5.2 LTS and
+5.3 (PyPI bpy). Every function here works in all of them; the rest of the add-on, the scene scripts
 (scenes/) and the in-Blender tests call these instead of testing versions
 themselves. Each helper asks Blender for the feature (hasattr, enum items),
 not for a version number, so a point release that back-ports a change is
@@ -45,6 +45,9 @@ The breaks handled:
   (available since 4.4): `sequencer_strips()`.
 * The Image Editor's paint mode: SpaceImageEditor.mode "PAINT" (its
   ui_mode in versions that split the two): `image_paint_mode()`.
+* 5.2: Cycles writes the camera's motion against the world into the Vector
+  pass where no surface is hit; 3.4-5.0 and 5.3 write 0 there:
+  `surface_vector_pass()`.
 
 Two breaks of the list in issue 16 need no helper: Tempera reads its
 settings as RNA properties only (never `scene["tempera"]`, which 5.0 no
@@ -263,3 +266,20 @@ def image_paint_mode(space):
             setattr(space, prop, "PAINT")
             return True
     return False
+
+
+def surface_vector_pass(vector, alpha):
+    """The Vector pass (H, W, 4) with 0 where the film is empty (alpha 0).
+
+    Tempera's velocities are the motion of the surfaces the pixels see. Where
+    a pixel sees only the world, Blender 3.4-5.0 and 5.3 write 0 (measured:
+    every such pixel, exactly), but 5.2 writes the world's apparent motion as
+    the camera turns (up to 7 px a frame on the Suzanne turntable), which made
+    the coherent method advect its background by it. Rendering does not tell
+    the two apart, so this applies in every version; where the pass is already
+    0 there it changes nothing."""
+    vector = np.asarray(vector, np.float32)
+    empty = np.asarray(alpha).reshape(vector.shape[:2]) == 0
+    if not empty.any():
+        return vector
+    return np.where(empty[:, :, None], np.float32(0), vector)

@@ -423,9 +423,16 @@ def light_path_guides(main, ld12e):
     }
 
 
+def surface_velocities(passes):
+    """(velocity_backward, velocity_forward) of the surfaces a render's
+    Vector and Combined passes show."""
+    vector = compat.surface_vector_pass(passes["Vector"], passes["Combined"][:, :, 3])
+    return guide_cache.velocities_from_vector_pass(vector)
+
+
 def frame_guides(main, ld12e, v_plus_prev, v_minus_next, masks, params):
     """Every guide of one frame, as written to the cache."""
-    backward, forward = guide_cache.velocities_from_vector_pass(main["Vector"])
+    backward, forward = surface_velocities(main)
     eps = params["occlusion_epsilon"]
     lines = guide_cache.line_guide(main["Depth"], main["Normal"], params["line_depth_threshold"],
                                    params["line_normal_angle"])
@@ -602,27 +609,26 @@ def _render_frames(scene, todo, keys, manifest, out_dir, tmp, params, progress, 
 
     finished = {}  # frame -> manifest entry, of this run
 
-    def vector_pass(frame):
-        """Vector pass of a neighbouring frame: rendered now, finished in this
-        run, in the cache, or from a quick motion-only render (one sample:
-        only its velocities are used)."""
+    def velocities(frame):
+        """(backward, forward) velocities of a neighbouring frame: rendered
+        now, finished in this run, in the cache, or from a quick motion-only
+        render (one sample: only its velocities are used)."""
         if frame in renders:
-            return _read_passes(renders[frame][0], layer.name, {"Vector": "XYZW"})["Vector"]
+            return surface_velocities(_read_passes(renders[frame][0], layer.name, MOTION_PASSES))
         if frame in finished or guide_cache.is_frame_current(out_dir, manifest, frame, keys.get(frame)):
             cached = guide_cache.read_frame(out_dir, frame, ["velocity_backward", "velocity_forward"])
-            back, fwd = cached["velocity_backward"], cached["velocity_forward"]
-            return np.dstack([-back[:, :, 0], back[:, :, 1], -fwd[:, :, 0], fwd[:, :, 1]])  # inverse conversion
+            return cached["velocity_backward"], cached["velocity_forward"]
         _configure(scene, layer, 1, MOTION_PASSES, params["seed"])
         path = _render(scene, tmp / f"motion_{frame}.exr", frame)
-        return _read_passes(path, layer.name, MOTION_PASSES)["Vector"]
+        return surface_velocities(_read_passes(path, layer.name, MOTION_PASSES))
 
     warnings = []
 
     def finish(i, frame):
         main = _read_passes(renders[frame][0], layer.name, main_passes)
         ld12e = _read_passes(renders[frame][1], layer.name, LD12E_PASSES)
-        _, v_plus_prev = guide_cache.velocities_from_vector_pass(vector_pass(frame - 1))
-        v_minus_next, _ = guide_cache.velocities_from_vector_pass(vector_pass(frame + 1))
+        _, v_plus_prev = velocities(frame - 1)
+        v_minus_next, _ = velocities(frame + 1)
         frame_data = frame_guides(main, ld12e, v_plus_prev, v_minus_next, masks, params)
         height, width = main["Combined"].shape[:2]
         samples, clip = fluids.pop(frame, (None, None))
