@@ -18,7 +18,7 @@ and exits with pytest's exit code ("no tests collected" counts as a failure).
 Extra arguments go to pytest, e.g. `-k save` or `-x`. The tests learn what
 was installed from TEMPERA_TEST_ADDON_MODULE ('tempera' or
 'bl_ext.user_default.tempera') and TEMPERA_TEST_INSTALL ('legacy' or
-'extension').
+'extension'); with the extension, TEMPERA_CLI is the CLI of its wheel.
 """
 import argparse
 import os
@@ -62,6 +62,11 @@ def main():
             os.environ["TEMPERA_TEST_EXTENSION_ZIP"] = str(Path(args.extension_zip).resolve())
             os.environ["TEMPERA_TEST_ADDON_MODULE"] = blender_env.extension_module()
             os.environ["TEMPERA_TEST_INSTALL"] = "extension"
+            # The CLI that came with the extension's wheel, as its users have it: it shares the
+            # module's OpenImageIO (PyPI's 3.2), where build/bin/tempera links Debian's 2.4.
+            import tempera_native
+
+            os.environ["TEMPERA_CLI"] = str(tempera_native.cli())
         # The tests check that they see this copy of the add-on.
         os.environ["TEMPERA_TEST_SCRIPTS_DIR"] = str(installed)
         import pytest

@@ -36,6 +36,8 @@ def test_addon_is_enabled_from_the_installed_zip():
         assert module_file.parent.parent.name == "site-packages"
         native = Path(tempera._native.__file__).resolve()
         assert native.parent.name == "tempera_native" and native.parent.parent == module_file.parent.parent
+        # Blender unpacks wheels without file modes; the package gives its CLI the executable bit back.
+        assert os.access(native.parent / "bin" / "tempera", os.X_OK)
 
 
 def test_native_module_reads_and_writes_exr(tmp_path):

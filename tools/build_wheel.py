@@ -9,10 +9,13 @@ cp311 wheel of Blender 4.2-5.0, venv-tools313 the cp313 wheel of 5.1+.
 
 1. `pip wheel --no-build-isolation` with the given Python (a venv holding
    scikit-build-core, pybind11 and auditwheel: tools/setup_venvs.sh makes
-   ~/.cache/tempera/venv-tools) builds dist/raw/tempera_native-*-linux_x86_64.whl;
+   ~/.cache/tempera/venv-tools) builds dist/raw/tempera_native-*-linux_x86_64.whl,
+   linked against PyPI's OpenImageIO (tools/wheel_deps.py stages it; its
+   image formats are inside its two libraries) instead of Debian's, which
+   would bring 247 libraries;
 2. `auditwheel repair` copies the shared libraries it links that are not part
-   of the manylinux policy (OpenImageIO, OpenEXR, Embree, TBB and theirs) into
-   tempera_native.libs/ under hashed sonames (libtbb-1a2b3c4d.so.12) and
+   of the manylinux policy (OpenImageIO's two; Embree is static) into
+   tempera_native.libs/ under hashed sonames (libOpenImageIO-1a2b3c4d.so.3.2.2) and
    rewrites the module's and the CLI's needs and RPATH to them; the wheel gets
    a manylinux tag.
 3. Checks the result: no needed library outside the wheel except the policy's
@@ -21,15 +24,18 @@ cp311 wheel of Blender 4.2-5.0, venv-tools313 the cp313 wheel of 5.1+.
    CPython in OUT are left alone.
 """
 import argparse
+import json
 import os
 import shutil
 import subprocess
 import sys
+import tempfile
 import zipfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-VENDORED = ("libOpenImageIO", "libOpenImageIO_Util", "libembree3", "libtbb", "libOpenEXR", "libImath")
+# Embree is linked in statically (tools/wheel_deps.py says why); nothing else may come along.
+VENDORED = ("libOpenImageIO", "libOpenImageIO_Util")
 
 
 def run(cmd, **kwargs):
@@ -45,11 +51,22 @@ def check_repaired(wheel):
     missing = [v for v in VENDORED if not any(lib.startswith(v + "-") for lib in libs)]
     if missing:
         sys.exit(f"build_wheel: {wheel.name} does not vendor {missing} (has {libs})")
+    extra = [lib for lib in libs if not any(lib.startswith(v + "-") for v in VENDORED)]
+    if extra:
+        sys.exit(f"build_wheel: {wheel.name} vendors libraries beyond {VENDORED}: {extra}")
     for required in ("tempera_native/bin/tempera", "tempera/__init__.py", "tempera/__main__.py"):
         if required not in names:
             sys.exit(f"build_wheel: {wheel.name} lacks {required}")
-    if not any(n.startswith("tempera_native/_native") and n.endswith(".so") for n in names):
+    modules = [n for n in names if n.startswith("tempera_native/_native") and n.endswith(".so")]
+    if not modules:
         sys.exit(f"build_wheel: {wheel.name} lacks tempera_native/_native*.so")
+    with tempfile.TemporaryDirectory() as tmp, zipfile.ZipFile(wheel) as zf:
+        # A module may leave symbols for the loader (Python's); never Embree's, which is linked in.
+        undefined = subprocess.run(["nm", "-D", "--undefined-only", zf.extract(modules[0], tmp)],
+                                   capture_output=True, text=True, check=True).stdout
+    missing = [line.split()[-1] for line in undefined.splitlines() if "embree" in line or " rtc" in line]
+    if missing:
+        sys.exit(f"build_wheel: {modules[0]} leaves Embree symbols undefined: {missing[:5]}")
     return libs
 
 
@@ -67,7 +84,16 @@ def main():
     env = dict(os.environ, PATH=f"{Path(args.python).parent}{os.pathsep}{os.environ.get('PATH', '')}")
     if args.jobs:
         env["CMAKE_BUILD_PARALLEL_LEVEL"] = args.jobs
-    run([args.python, "-m", "pip", "wheel", "--no-build-isolation", "--no-deps", "-w", raw, ROOT], env=env)
+    staged = run([args.python, ROOT / "tools" / "wheel_deps.py", *(["--jobs", args.jobs] if args.jobs else [])],
+                 env=env, stdout=subprocess.PIPE, text=True).stdout.strip().splitlines()[-1]
+    oiio, embree = (Path(json.loads(staged)[name]) for name in ("openimageio", "embree"))
+    defines = {"OIIO_INCLUDE_DIR": oiio / "include", "OIIO_LIBRARY": oiio / "lib" / "libOpenImageIO.so",
+               "OIIO_UTIL_LIBRARY": oiio / "lib" / "libOpenImageIO_Util.so", "TEMPERA_EMBREE_DIR": embree}
+    settings = [f"--config-settings=cmake.define.{k}={v}" for k, v in defines.items()]
+    run([args.python, "-m", "pip", "wheel", "--no-build-isolation", "--no-deps", *settings, "-w", raw, ROOT],
+        env=env)
+    # auditwheel finds the staged OpenImageIO here (the installed binaries carry no RPATH).
+    env["LD_LIBRARY_PATH"] = os.pathsep.join(filter(None, [str(oiio / "lib"), env.get("LD_LIBRARY_PATH")]))
     (wheel,) = raw.glob("tempera_native-*.whl")
     tag = wheel.name.split("-")[2]  # name-version-python-abi-platform.whl
     for old in out.glob(f"tempera_native-*-{tag}-*.whl"):

@@ -18,6 +18,7 @@ PACKAGES=(
   libopenexr-dev        # EXR headers used by OpenImageIO's EXR support
   libembree-dev         # the light-path-expression tracer (same libembree3 Blender links)
   libtbb-dev            # Embree's and OpenImageIO's threading runtime headers
+  libfmt-dev            # fmt headers, which the wheel's OpenImageIO 3 headers include (tools/wheel_deps.py)
   python3-numpy         # arrays in and out of the native module
   python3-pytest        # Python and in-Blender tests
   python3-setuptools python3-pip  # offline pyproject build (--no-build-isolation)

@@ -5,6 +5,13 @@ host's own). Used by blender_tests/test_wheel.py inside each Blender:
 
     blender -b --factory-startup --python tools/wheel_probe.py -- SITE_DIR        (a Blender executable)
     PYTHON tools/wheel_probe.py --import-bpy SITE_DIR                            (a bpy-module Python)
+    PYTHON tools/wheel_probe.py --import-bpy-global SITE_DIR                     (as the executable has it)
+
+--import-bpy-global loads bpy and the libraries it bundles (OpenImageIO,
+Embree 4, TBB) into the global symbol scope, where the blender.org Blender
+executable has them (they are its own dependencies) but the bpy module, loaded
+like any extension module, does not: the wheel's libraries must work beside
+them there too.
 
 SITE_DIR is the unpacked wheel (its tempera/, tempera_native/ and
 tempera_native.libs/). Prints one line 'WHEEL_PROBE {json}'; exits non-zero
@@ -28,9 +35,12 @@ def mapped_libraries():
 
 def main(argv):
     args = argv[argv.index("--") + 1:] if "--" in argv else argv[1:]
-    if args and args[0] == "--import-bpy":
+    if args and args[0] in ("--import-bpy", "--import-bpy-global"):
+        if args[0] == "--import-bpy-global":
+            sys.setdlopenflags(os.RTLD_NOW | os.RTLD_GLOBAL)
         import bpy  # noqa: F401  (the host's libraries first, as in Blender)
 
+        sys.setdlopenflags(os.RTLD_NOW)
         args = args[1:]
     site = args[0]
     host_before = mapped_libraries()

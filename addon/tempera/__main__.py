@@ -30,7 +30,7 @@ def native_cli():
             raise FileNotFoundError(
                 "the tempera CLI is not installed with this package (no tempera_native: "
                 f"{exc}); set TEMPERA_CLI to build/bin/tempera") from exc
-        path = tempera_native.CLI
+        path = tempera_native.cli()
     if not (path.is_file() and os.access(path, os.X_OK)):
         raise FileNotFoundError(f"the tempera CLI '{path}' is missing or not executable")
     return path

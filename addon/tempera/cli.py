@@ -21,7 +21,7 @@ def bundled_cli():
         import tempera_native
     except ImportError:
         return None
-    path = Path(tempera_native.CLI)
+    path = Path(tempera_native.cli())  # with the executable bit Blender's installer drops
     return path if path.is_file() and os.access(path, os.X_OK) else None
 
 
@@ -35,6 +35,7 @@ def find_cli(path=""):
             candidate = candidate / "tempera"
         if not candidate.is_file():
             raise CliError(f"tempera CLI not found at '{candidate}'")
+        bundled_cli()  # `path` may name the wheel's own CLI, whose mode Blender's installer drops
         if not os.access(candidate, os.X_OK):
             raise CliError(f"tempera CLI at '{candidate}' is not executable")
         return candidate.resolve()

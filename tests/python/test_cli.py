@@ -53,13 +53,32 @@ def test_find_cli_on_path(cli_path, monkeypatch):
 
 
 def test_find_cli_falls_back_to_the_wheels_cli(cli_path, tmp_path, monkeypatch):
-    """Not on PATH, but installed with the wheel (tempera_native/bin/tempera): the extension's case."""
+    """Not on PATH, but installed with the wheel (tempera_native/bin/tempera): the extension's
+    case. Blender unpacks the wheel without file modes, and again whenever the extension is
+    enabled: the package gives its CLI the executable bit back when it is looked up."""
+    import importlib.util
+    import shutil
     import types
+    from pathlib import Path
 
+    package = tmp_path / "site" / "tempera_native"
+    (package / "bin").mkdir(parents=True)
+    source = Path(__file__).resolve().parents[2] / "native" / "python" / "tempera_native" / "__init__.py"
+    shutil.copy(source, package / "__init__.py")
+    bundled = package / "bin" / "tempera"
+    shutil.copy(cli_path, bundled)
+    bundled.chmod(0o644)  # as Blender's installer leaves it
+    spec = importlib.util.spec_from_file_location("tempera_native", package / "__init__.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
     monkeypatch.setenv("PATH", str(tmp_path))
-    monkeypatch.setitem(sys.modules, "tempera_native", types.SimpleNamespace(CLI=cli_path))
-    assert cli.find_cli() == cli_path.resolve()
-    monkeypatch.setitem(sys.modules, "tempera_native", types.SimpleNamespace(CLI=tmp_path / "missing"))
+    monkeypatch.setitem(sys.modules, "tempera_native", module)
+    bundled.chmod(0o644)  # unpacked again after the import (the extension enabled again)
+    assert cli.find_cli() == bundled.resolve()
+    assert os.stat(bundled).st_mode & 0o777 == 0o755
+    bundled.chmod(0o644)
+    assert cli.find_cli(str(bundled)) == bundled.resolve()  # named in the preferences
+    monkeypatch.setitem(sys.modules, "tempera_native", types.SimpleNamespace(cli=lambda: tmp_path / "missing"))
     with pytest.raises(cli.CliError, match="not found on PATH"):
         cli.find_cli()
 
