@@ -86,7 +86,7 @@ test: build addon-zip extension
 	    --extension-zip $(EXTENSION_ZIP) --wheel "$$(cat $(WHEEL_LIST))" \
 	    $$([ -f $(WHEEL313_LIST) ] && echo --wheel313 "$$(cat $(WHEEL313_LIST))") \
 	    --bpy42 $(BPY42) --bpy45 $(BPY45) --bpy50 $(BPY50) --bpy52 $(BPY52) --bpy53 $(BPY53) \
-	    --tools-python $(TOOLS_PY)
+	    --tools-python $(TOOLS_PY) --tools-python313 $(TOOLS313_PY)
 
 demo: build addon-zip
 	$(PYTHON) tools/run_demo.py --addon-zip $(ADDON_ZIP) --blender $(BLENDER) --out $(DEMO_OUT)

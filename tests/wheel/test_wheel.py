@@ -16,7 +16,8 @@ VENDORED = re.compile(r"lib(OpenImageIO|OpenImageIO_Util|embree3|tbb|OpenEXR|Ope
 
 def test_wheel_name_tag_and_metadata(wheel):
     version = cmake_project_version()
-    assert re.fullmatch(rf"tempera_native-{re.escape(version)}-cp311-cp311-manylinux_2_\d+_x86_64\.whl", wheel.name)
+    tag = f"cp{sys.version_info.major}{sys.version_info.minor}"  # the wheel for this Python: cp311, cp313
+    assert re.fullmatch(rf"tempera_native-{re.escape(version)}-{tag}-{tag}-manylinux_2_\d+_x86_64\.whl", wheel.name)
     with zipfile.ZipFile(wheel) as zf:
         names = zf.namelist()
         entry_points = zf.read(f"tempera_native-{version}.dist-info/entry_points.txt").decode()
