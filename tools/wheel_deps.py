@@ -92,11 +92,15 @@ def staged(dest, release, stage):
     return dest
 
 
+def run(cmd):
+    """Runs `cmd`, its output on stderr: stdout carries only the staged folders (build_wheel.py reads it)."""
+    print("+ " + " ".join(map(str, cmd)), file=sys.stderr, flush=True)
+    subprocess.run([str(c) for c in cmd], check=True, stdout=sys.stderr)
+
+
 def pip_download(tmp, *args):
-    cmd = [sys.executable, "-m", "pip", "download", "--no-deps", "--disable-pip-version-check", "-q",
-           "-d", str(tmp), f"OpenImageIO=={OIIO_RELEASE}", *args]
-    print("+ " + " ".join(cmd), flush=True)
-    subprocess.run(cmd, check=True, stdout=sys.stderr)
+    run([sys.executable, "-m", "pip", "download", "--no-deps", "--disable-pip-version-check", "-q",
+         "-d", tmp, f"OpenImageIO=={OIIO_RELEASE}", *args])
 
 
 def stage_libraries(wheel, lib):
@@ -171,7 +175,7 @@ def stage_embree(dest, jobs):
     with tempfile.TemporaryDirectory(prefix="tempera-embree-") as tmp:
         tmp = Path(tmp)
         archive = tmp / Path(EMBREE_SOURCE).name
-        print(f"+ download {EMBREE_SOURCE}", flush=True)
+        print(f"+ download {EMBREE_SOURCE}", file=sys.stderr, flush=True)
         with urllib.request.urlopen(EMBREE_SOURCE, timeout=120) as response:
             archive.write_bytes(response.read())
         digest = hashlib.sha256(archive.read_bytes()).hexdigest()
@@ -186,11 +190,6 @@ def stage_embree(dest, jobs):
         run(["cmake", "--build", build, "-j", str(jobs)])
         run(["cmake", "--install", build, "--component", "devel"])  # "lib" wants a readme.pdf the dfsg source lacks
         shutil.copy(source / "LICENSE.txt", dest / "LICENSE.txt")
-
-
-def run(cmd):
-    print("+ " + " ".join(map(str, cmd)), flush=True)
-    subprocess.run([str(c) for c in cmd], check=True, stdout=sys.stderr)
 
 
 def main():
