@@ -26,7 +26,7 @@ TOOLS313_PY ?= $(VENVS)/venv-tools313/bin/python
 WHEEL_LIST := dist/wheel-cp311.txt
 WHEEL313_LIST := dist/wheel-cp313.txt
 WHEEL_SOURCES := CMakeLists.txt pyproject.toml README.md native/python/tempera_native/__init__.py \
-                 tools/build_wheel.py tools/wheel_deps.py \
+                 tools/build_wheel.py tools/wheel_deps.py tools/manylinux/link.py tools/manylinux/glibc_2_28_compat.c \
                  $(shell find native addon/tempera -name '*.cpp' -o -name '*.hpp' -o -name '*.py' \
                          -o -name CMakeLists.txt 2>/dev/null)
 # The exemplar kit bundled in the add-on zip (scenes/exemplar_kit.py renders and paints it).

@@ -26,6 +26,7 @@ cp311 wheel of Blender 4.2-5.0, venv-tools313 the cp313 wheel of 5.1+.
 import argparse
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -36,6 +37,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 # Embree is linked in statically (tools/wheel_deps.py says why); nothing else may come along.
 VENDORED = ("libOpenImageIO", "libOpenImageIO_Util")
+# Rocky/Alma Linux 8 and blender.org's own Linux builds (manylinux_2_28).
+NEWEST_GLIBC = (2, 28)
 
 
 def run(cmd, **kwargs):
@@ -44,7 +47,12 @@ def run(cmd, **kwargs):
 
 
 def check_repaired(wheel):
-    """Names of the vendored libraries; exits if one expected is missing."""
+    """Names of the vendored libraries; exits if one expected is missing, or if the wheel
+    would not install on glibc 2.28."""
+    platforms = re.findall(r"manylinux_(\d+)_(\d+)_x86_64", wheel.name.rsplit("-", 1)[1])
+    if not platforms or min((int(a), int(b)) for a, b in platforms) > NEWEST_GLIBC:
+        sys.exit(f"build_wheel: {wheel.name} needs a glibc newer than {NEWEST_GLIBC[0]}.{NEWEST_GLIBC[1]} "
+                 "(auditwheel show names the symbols; tools/manylinux/link.py is the link that avoids them)")
     with zipfile.ZipFile(wheel) as zf:
         names = zf.namelist()
     libs = sorted(Path(n).name for n in names if n.startswith("tempera_native.libs/") and not n.endswith("/"))
@@ -88,7 +96,11 @@ def main():
                  env=env, stdout=subprocess.PIPE, text=True).stdout.strip().splitlines()[-1]
     oiio, embree = (Path(json.loads(staged)[name]) for name in ("openimageio", "embree"))
     defines = {"OIIO_INCLUDE_DIR": oiio / "include", "OIIO_LIBRARY": oiio / "lib" / "libOpenImageIO.so",
-               "OIIO_UTIL_LIBRARY": oiio / "lib" / "libOpenImageIO_Util.so", "TEMPERA_EMBREE_DIR": embree}
+               "OIIO_UTIL_LIBRARY": oiio / "lib" / "libOpenImageIO_Util.so", "TEMPERA_EMBREE_DIR": embree,
+               # Linked for glibc 2.28 (tools/manylinux/link.py says how), by zig's lld, which
+               # cannot read GCC's link-time-optimization objects (pybind11 asks for them otherwise).
+               "CMAKE_CXX_LINKER_LAUNCHER": f"{args.python};{ROOT / 'tools' / 'manylinux' / 'link.py'}",
+               "CMAKE_INTERPROCEDURAL_OPTIMIZATION": "OFF"}
     settings = [f"--config-settings=cmake.define.{k}={v}" for k, v in defines.items()]
     run([args.python, "-m", "pip", "wheel", "--no-build-isolation", "--no-deps", *settings, "-w", raw, ROOT],
         env=env)

