@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes the engine's option table (native/include/tempera/synthesis_options.hpp,
+"""Writes the engine's option table (native/include/tempera/engine/synthesis_options.hpp,
 as bound to Python) into docs/engine.md between its OPTIONS markers, so the
 docs never restate it by hand. tests/python/test_docs.py checks it is current.
 

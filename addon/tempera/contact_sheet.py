@@ -1,4 +1,4 @@
-"""Contact sheets: many same-kind images laid out on one grid (native/src/contact_sheet.cpp)."""
+"""Contact sheets: many same-kind images laid out on one grid (native/src/app/contact_sheet.cpp)."""
 import numpy as np
 
 from . import _native

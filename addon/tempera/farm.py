@@ -104,7 +104,7 @@ def _option_values(args, name):
 def tcia_segments(frames, stylize_args):
     """The coherent method's segments [first, ..., last] of a shot: from key
     to key and to the shot's ends, as `tempera stylize --method tcia` solves
-    them (native/src/tcia_job.cpp); None for per-frame StyLit."""
+    them (native/src/methods/tcia/tcia_job.cpp); None for per-frame StyLit."""
     if _option_values(stylize_args, "--method")[-1:] != ["tcia"]:
         return None
     keys = set()

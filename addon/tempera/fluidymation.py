@@ -1,9 +1,9 @@
 """Fluidymation (Platkevič et al. 2021): moving shapes painted with the
 motion of a natural medium (ink, watercolour) from a video exemplar with its
-masks (native/src/fluidymation.cpp, docs/fluidymation.md).
+masks (native/src/methods/fluidymation/fluidymation.cpp, docs/fluidymation.md).
 
 `MediaJob` runs the method over a guide cache as `tempera stylize --method
-fluidymation` does (native/src/fluidymation_job.cpp): frame by frame, each
+fluidymation` does (native/src/methods/fluidymation/fluidymation_job.cpp): frame by frame, each
 from the previous frame's matches, resumable per frame.
 """
 from __future__ import annotations

@@ -1,11 +1,11 @@
 """LazyFluids (Jamriška et al. 2015; thesis ch. 5): an RGBA exemplar of a
 fluid element carried along a target flow inside a target alpha mask, frame
 after frame, with strict uniform patch usage per boundary / interior segment
-so that the texture never washes out (native/src/lazyfluids.cpp,
+so that the texture never washes out (native/src/methods/lazyfluids/lazyfluids.cpp,
 docs/lazyfluids.md).
 
 `FluidJob` runs the method over a guide cache as `tempera stylize --method
-lazyfluids` does (native/src/lazyfluids_job.cpp): target alpha = the cache's
+lazyfluids` does (native/src/methods/lazyfluids/lazyfluids_job.cpp): target alpha = the cache's
 ``alpha``, flow = ``fluid_velocity`` (else ``velocity_forward``, else zero,
 with a warning), one resumable frame at a time.
 """

@@ -3,7 +3,7 @@
 StyLit matches light-path classes (thesis §8.3.2) that Cycles cannot isolate,
 e.g. caustics ``LS*DE`` or the second diffuse bounce alone. This renders any
 number of expressions in one pass with the native Embree tracer. The scene is
-a typed ``tempera._native.Scene`` (its classes mirror ``tempera/scene.hpp``
+a typed ``tempera._native.Scene`` (its classes mirror ``tempera/tracer/scene.hpp``
 field by field), or a plain dict of arrays turned into one by
 ``scene_from_dict`` (see ``docs/lpe_guides.md``, "Scene format"); the Blender
 exporter builds the dict.

@@ -3,7 +3,7 @@ temporal noise ("boiling") on a coherent stylized sequence.
 
 ``noisy_frame`` makes one frame T_i from the coherent frame R_i and the
 medium's exemplar S; ``NoisySequence`` runs a folder of frames with resume.
-The method lives in native/src/noisy.cpp; docs/noisy.md explains the slider.
+The method lives in native/src/methods/noisy/noisy.cpp; docs/noisy.md explains the slider.
 """
 from __future__ import annotations
 
@@ -59,7 +59,7 @@ def noise_width(level: int) -> float:
 
 
 class NoisySequence:
-    """The noise pass over a folder of coherent frames (native/src/noisy_sequence.cpp),
+    """The noise pass over a folder of coherent frames (native/src/methods/noisy/noisy_sequence.cpp),
     what ``tempera stylize --noise`` and the panel run after the coherent pass.
 
     exemplar   the medium S (the painting)

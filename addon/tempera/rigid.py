@@ -8,7 +8,7 @@ target frames (RGBA); ``generated_exemplar`` draws the project's own
 "hand-drawn" exemplar from a known generator, whose maps applied to the
 target (``oracle_maps``) are the exact answer the tests and the demo compare
 with. Tracks are the dicts of tempera.rigid_tracks (tracks.json). The method
-lives in native/src/rigid.cpp; docs/rigid_bodies.md gives every design choice.
+lives in native/src/methods/rigid/rigid.cpp; docs/rigid_bodies.md gives every design choice.
 """
 from __future__ import annotations
 

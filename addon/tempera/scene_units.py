@@ -103,7 +103,7 @@ def camera_intrinsics(kind, width, height, *, lens=50.0, sensor_width=36.0, sens
 def camera_ray(camera, x, y):
     """Camera-space origin and (unnormalised) direction of the ray through
     pixel centre (x + 0.5, y + 0.5), rows top-down, as the tracer defines it
-    (native/include/tempera/scene.hpp). Used to check intrinsics against
+    (native/include/tempera/tracer/scene.hpp). Used to check intrinsics against
     Blender's own projection."""
     ndc_x = 2.0 * (x + 0.5) / camera["width"] - 1.0
     ndc_y = 1.0 - 2.0 * (y + 0.5) / camera["height"]

@@ -2,8 +2,8 @@
 
 ``StylizeJob`` drives a whole sequence (what ``tempera stylize`` and the
 add-on's operator run); ``stylize_frame`` stylizes one frame from in-memory
-guides. Both are thin layers over the native code (native/src/stylit.cpp,
-native/src/stylize_job.cpp); see docs/cli.md for the job's files and resume.
+guides. Both are thin layers over the native code (native/src/methods/stylit/stylit.cpp,
+native/src/methods/stylit/stylize_job.cpp); see docs/cli.md for the job's files and resume.
 """
 from __future__ import annotations
 

@@ -1,13 +1,13 @@
 """Stylizing Animation by Example (Bénard et al. 2013): a whole shot at once,
 coarse to fine with forward and backward sweeps along the rendered motion, so
-the paint stays on the surfaces (native/src/tcia.cpp, docs/engine.md).
+the paint stays on the surfaces (native/src/methods/tcia/tcia.cpp, docs/engine.md).
 
 Painted keyframes are hard constraints and extra exemplars. Layers
 (objects or collections) are solved separately, each with its motion
-extrapolated into its background, and composited (native/src/tcia_layers.cpp).
+extrapolated into its background, and composited (native/src/methods/tcia/tcia_layers.cpp).
 
 `ShotJob` runs the method over a guide cache as `tempera stylize --method
-tcia` does (native/src/tcia_job.cpp): the shot in independent segments from
+tcia` does (native/src/methods/tcia/tcia_job.cpp): the shot in independent segments from
 key to key, each resumable (docs/cli.md).
 """
 from __future__ import annotations

@@ -4,7 +4,7 @@ Blender's Vector passes, and the flicker figure of two stylized frames.
 
 The temporal guide itself (the previous stylized frame advected along the
 motion, weighted by χ−) is part of StyLit per frame: tempera.stylize
-(native/src/stylit.cpp); flicker() here is the same native figure.
+(native/src/methods/stylit/stylit.cpp); flicker() here is the same native figure.
 """
 import numpy as np
 

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "tempera/error.hpp"
+#include "tempera/engine/error.hpp"
 
 namespace tempera::cli {
 

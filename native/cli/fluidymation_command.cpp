@@ -6,9 +6,9 @@
 #include <iostream>
 
 #include "cli_args.hpp"
-#include "tempera/error.hpp"
-#include "tempera/fluidymation_job.hpp"
-#include "tempera/image_io.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/methods/fluidymation/fluidymation_job.hpp"
+#include "tempera/app/image_io.hpp"
 
 namespace fs = std::filesystem;
 

@@ -6,8 +6,8 @@
 #include <iostream>
 
 #include "cli_args.hpp"
-#include "tempera/error.hpp"
-#include "tempera/lazyfluids_job.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/methods/lazyfluids/lazyfluids_job.hpp"
 
 namespace fs = std::filesystem;
 

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "cli_args.hpp"
-#include "tempera/error.hpp"
+#include "tempera/engine/error.hpp"
 
 namespace {
 

@@ -5,8 +5,8 @@
 #include <iostream>
 
 #include "cli_args.hpp"
-#include "tempera/error.hpp"
-#include "tempera/noisy_sequence.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/methods/noisy/noisy_sequence.hpp"
 
 namespace tempera::cli {
 namespace {

@@ -11,9 +11,9 @@
 #include <iostream>
 
 #include "cli_args.hpp"
-#include "tempera/error.hpp"
-#include "tempera/paths.hpp"
-#include "tempera/process.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/app/paths.hpp"
+#include "tempera/app/process.hpp"
 
 namespace fs = std::filesystem;
 

@@ -13,12 +13,12 @@
 #include <sstream>
 
 #include "cli_args.hpp"
-#include "tempera/error.hpp"
-#include "tempera/image_io.hpp"
-#include "tempera/noisy_sequence.hpp"
-#include "tempera/process.hpp"
-#include "tempera/stylize_job.hpp"
-#include "tempera/tcia_job.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/app/image_io.hpp"
+#include "tempera/methods/noisy/noisy_sequence.hpp"
+#include "tempera/app/process.hpp"
+#include "tempera/methods/stylit/stylize_job.hpp"
+#include "tempera/methods/tcia/tcia_job.hpp"
 
 namespace fs = std::filesystem;
 

@@ -6,12 +6,12 @@
 #include <sstream>
 
 #include "cli_args.hpp"
-#include "tempera/error.hpp"
-#include "tempera/image_io.hpp"
-#include "tempera/patch_usage.hpp"
-#include "tempera/paths.hpp"
-#include "tempera/synthesis.hpp"
-#include "tempera/text_file.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/app/image_io.hpp"
+#include "tempera/engine/patch_usage.hpp"
+#include "tempera/app/paths.hpp"
+#include "tempera/engine/synthesis.hpp"
+#include "tempera/app/text_file.hpp"
 
 namespace tempera::cli {
 namespace {
@@ -109,7 +109,7 @@ int run_synth(const Args& args) {
   if (style_path.empty()) throw ValueError("--style is required");
   if (output_path.empty()) throw ValueError("--output is required");
   if (guides.empty()) throw ValueError("at least one --guide SRC TGT pair is required");
-  {  // issue 18: an output that is an input would be destroyed (tempera/paths.hpp)
+  {  // issue 18: an output that is an input would be destroyed (tempera/app/paths.hpp)
     std::vector<std::string> inputs = {style_path, source_mask_path, target_mask_path};
     for (const auto& g : guides) inputs.insert(inputs.end(), {g.source, g.target});
     refuse_output_on_inputs(output_path, inputs, "--output");

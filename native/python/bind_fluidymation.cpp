@@ -6,10 +6,10 @@
 #include "bind_frame_job.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
-#include "tempera/fluidymation.hpp"
-#include "tempera/fluidymation_job.hpp"
-#include "tempera/mask_flow.hpp"
-#include "tempera/motion_extent.hpp"
+#include "tempera/methods/fluidymation/fluidymation.hpp"
+#include "tempera/methods/fluidymation/fluidymation_job.hpp"
+#include "tempera/methods/fluidymation/mask_flow.hpp"
+#include "tempera/methods/fluidymation/motion_extent.hpp"
 
 namespace py = pybind11;
 using namespace tempera;
@@ -53,7 +53,7 @@ FluidymationJobConfig job_config(const py::dict& d, const FluidymationOptions& o
 
 void bind_fluidymation(py::module_& m) {
   py_bridge::bind_options_class<FluidymationOptions>(m, "FluidymationOptions", fluidymation_option_table(),
-                                                     "Options of Fluidymation (native/include/tempera/fluidymation.hpp).")
+                                                     "Options of Fluidymation (native/include/tempera/methods/fluidymation/fluidymation.hpp).")
       .def_readwrite("synthesis", &FluidymationOptions::synthesis, "engine options (defaults: fluidymation_defaults())")
       .def(
           "validate", [](const FluidymationOptions& o) { validate(o); },

@@ -11,7 +11,7 @@
 #include <pybind11/stl.h>
 
 #include "numpy_bridge.hpp"
-#include "tempera/synthesis.hpp"
+#include "tempera/engine/synthesis.hpp"
 
 namespace tempera::py_bridge {
 

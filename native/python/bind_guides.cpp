@@ -2,9 +2,9 @@
 // distance). Arrays are viewed in place and the GIL is released while the
 // native code runs; tempera.guides wraps these with numpy-friendly shapes.
 #include "numpy_bridge.hpp"
-#include "tempera/distance_transform.hpp"
-#include "tempera/motion.hpp"
-#include "tempera/orientation.hpp"
+#include "tempera/engine/distance_transform.hpp"
+#include "tempera/engine/motion.hpp"
+#include "tempera/methods/tcia/orientation.hpp"
 
 namespace py = pybind11;
 using namespace tempera;

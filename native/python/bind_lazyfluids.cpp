@@ -6,8 +6,8 @@
 #include "bind_frame_job.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
-#include "tempera/lazyfluids.hpp"
-#include "tempera/lazyfluids_job.hpp"
+#include "tempera/methods/lazyfluids/lazyfluids.hpp"
+#include "tempera/methods/lazyfluids/lazyfluids_job.hpp"
 
 namespace py = pybind11;
 using namespace tempera;
@@ -28,7 +28,7 @@ std::vector<ImageView> views(const py::list& arrays, const char* what, std::vect
 
 void bind_lazyfluids(py::module_& m) {
   py_bridge::bind_options_class<LazyFluidsOptions>(m, "LazyFluidsOptions", lazyfluids_option_table(),
-                                                   "Options of LazyFluids (native/include/tempera/lazyfluids.hpp).")
+                                                   "Options of LazyFluids (native/include/tempera/methods/lazyfluids/lazyfluids.hpp).")
       .def_readwrite("synthesis", &LazyFluidsOptions::synthesis, "engine options (defaults: lazyfluids_defaults())");
   m.def("lazyfluids_defaults", &lazyfluids_defaults, "The engine options of LazyFluids.");
   m.def(

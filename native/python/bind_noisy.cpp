@@ -6,7 +6,7 @@
 
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
-#include "tempera/noisy_sequence.hpp"
+#include "tempera/methods/noisy/noisy_sequence.hpp"
 
 namespace py = pybind11;
 using namespace tempera;
@@ -66,7 +66,7 @@ void bind_sequence(py::module_& m) {
 void bind_noisy(py::module_& m) {
   bind_sequence(m);
   py_bridge::bind_options_class<NoisyOptions>(m, "NoisyOptions", noisy_option_table(),
-                                              "Options of Color Me Noisy (native/include/tempera/noisy.hpp).")
+                                              "Options of Color Me Noisy (native/include/tempera/methods/noisy/noisy.hpp).")
       .def_readwrite("synthesis", &NoisyOptions::synthesis, "engine options (defaults: noisy_defaults())");
   m.def("noisy_defaults", &noisy_defaults, "The engine options Color Me Noisy uses.");
   m.def("noisy_levels", &noisy_levels, py::arg("noise"));

@@ -9,7 +9,7 @@
 #include <string>
 #include <type_traits>
 
-#include "tempera/option_table.hpp"
+#include "tempera/engine/option_table.hpp"
 
 namespace tempera::py_bridge {
 

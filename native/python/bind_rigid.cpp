@@ -10,11 +10,11 @@
 
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
-#include "tempera/error.hpp"
-#include "tempera/quadratic_fit.hpp"
-#include "tempera/rigid.hpp"
-#include "tempera/rigid_exemplar.hpp"
-#include "tempera/rigid_frame.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/methods/rigid/quadratic_fit.hpp"
+#include "tempera/methods/rigid/rigid.hpp"
+#include "tempera/methods/rigid/rigid_exemplar.hpp"
+#include "tempera/methods/rigid/rigid_frame.hpp"
 
 namespace py = pybind11;
 using namespace tempera;
@@ -100,13 +100,13 @@ const TrackFrame& frame_of(const Track& t, int f) {
 
 void bind_rigid(py::module_& m) {
   py_bridge::bind_options_class<RigidOptions>(m, "RigidOptions", rigid_option_table(),
-                                              "Options of the rigid-body method (native/include/tempera/rigid.hpp).");
+                                              "Options of the rigid-body method (native/include/tempera/methods/rigid/rigid.hpp).");
   py_bridge::bind_options_class<QuadraticFitOptions>(
       m, "QuadraticFitOptions", quadratic_fit_option_table(),
-      "Options of the quadratic registration (native/include/tempera/quadratic_fit.hpp).");
+      "Options of the quadratic registration (native/include/tempera/methods/rigid/quadratic_fit.hpp).");
   py_bridge::bind_options_class<ExemplarStyle>(
       m, "ExemplarStyle", exemplar_style_table(),
-      "The generated exemplar's style (native/include/tempera/rigid_exemplar.hpp).");
+      "The generated exemplar's style (native/include/tempera/methods/rigid/rigid_exemplar.hpp).");
 
   m.def(
       "bouncing_ball",

@@ -1,4 +1,4 @@
-// The tracer's scene types (tempera/scene.hpp) as Python classes, field by
+// The tracer's scene types (tempera/tracer/scene.hpp) as Python classes, field by
 // field: names and defaults have one source, the C++ structs. Vectors are
 // set and read as tuples (Float3) or numpy arrays (geometry, images);
 // lists of materials, closures and lights are copied in and out whole
@@ -7,7 +7,7 @@
 #include <pybind11/stl.h>
 
 #include "numpy_bridge.hpp"
-#include "tempera/scene.hpp"
+#include "tempera/tracer/scene.hpp"
 
 namespace py = pybind11;
 using namespace tempera;

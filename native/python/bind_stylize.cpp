@@ -10,11 +10,11 @@
 
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
-#include "tempera/contact_sheet.hpp"
-#include "tempera/process.hpp"
-#include "tempera/pyramid.hpp"
-#include "tempera/stylit.hpp"
-#include "tempera/stylize_job.hpp"
+#include "tempera/app/contact_sheet.hpp"
+#include "tempera/app/process.hpp"
+#include "tempera/engine/pyramid.hpp"
+#include "tempera/methods/stylit/stylit.hpp"
+#include "tempera/methods/stylit/stylize_job.hpp"
 
 namespace py = pybind11;
 using namespace tempera;

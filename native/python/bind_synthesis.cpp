@@ -11,8 +11,8 @@
 
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
-#include "tempera/patch_usage.hpp"
-#include "tempera/synthesis.hpp"
+#include "tempera/engine/patch_usage.hpp"
+#include "tempera/engine/synthesis.hpp"
 
 namespace py = pybind11;
 using namespace tempera;
@@ -180,7 +180,7 @@ void add_item_access(C& cls) {
 
 void bind_synthesis(py::module_& m) {
   py_bridge::bind_options_class<SynthesisOptions>(m, "SynthesisOptions", synthesis_option_table(),
-                                                  "Options of the synthesis engine (native/include/tempera/synthesis_options.hpp).")
+                                                  "Options of the synthesis engine (native/include/tempera/engine/synthesis_options.hpp).")
       .def("validate", [](const SynthesisOptions& o) { validate(o); }, "ValueError naming the first bad option.");
   py::class_<LevelStats> level(m, "LevelStats", "Statistics of one pyramid level.");
   level.def_readonly("level", &LevelStats::level)

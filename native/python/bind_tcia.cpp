@@ -7,9 +7,9 @@
 
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
-#include "tempera/tcia.hpp"
-#include "tempera/tcia_job.hpp"
-#include "tempera/tcia_layers.hpp"
+#include "tempera/methods/tcia/tcia.hpp"
+#include "tempera/methods/tcia/tcia_job.hpp"
+#include "tempera/methods/tcia/tcia_layers.hpp"
 
 namespace py = pybind11;
 using namespace tempera;
@@ -151,7 +151,7 @@ void bind_tcia(py::module_& m) {
           },
           py::arg("path"), py::arg("columns") = 0);
   py_bridge::bind_options_class<TciaOptions>(m, "TciaOptions", tcia_option_table(),
-                                             "Options of Bénard et al. 2013 (native/include/tempera/tcia.hpp).")
+                                             "Options of Bénard et al. 2013 (native/include/tempera/methods/tcia/tcia.hpp).")
       .def_readwrite("synthesis", &TciaOptions::synthesis, "engine options (defaults: tcia_defaults())");
   m.def("tcia_defaults", &tcia_defaults, "The engine options of the coherent method.");
   m.def(

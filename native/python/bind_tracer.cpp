@@ -6,8 +6,8 @@
 #include <pybind11/stl.h>
 
 #include "numpy_bridge.hpp"
-#include "tempera/embree_tracer.hpp"
-#include "tempera/lpe.hpp"
+#include "tempera/tracer/embree_tracer.hpp"
+#include "tempera/tracer/lpe.hpp"
 
 namespace py = pybind11;
 using namespace tempera;

@@ -4,7 +4,7 @@
 #include <pybind11/stl.h>
 
 #include "numpy_bridge.hpp"
-#include "tempera/image_io.hpp"
+#include "tempera/app/image_io.hpp"
 
 namespace py = pybind11;
 using namespace tempera;

@@ -8,8 +8,8 @@
 #include <memory>
 #include <string>
 
-#include "tempera/error.hpp"
-#include "tempera/image.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/engine/image.hpp"
 
 namespace tempera::py_bridge {
 

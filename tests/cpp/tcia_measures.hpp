@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <random>
 
-#include "tempera/image.hpp"
-#include "tempera/tcia.hpp"
+#include "tempera/engine/image.hpp"
+#include "tempera/methods/tcia/tcia.hpp"
 
 namespace tempera::test {
 

@@ -2,9 +2,9 @@
 
 #include <cmath>
 
-#include "tempera/alpha_segments.hpp"
-#include "tempera/error.hpp"
-#include "tempera/gaussian_blur.hpp"
+#include "tempera/methods/lazyfluids/alpha_segments.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/engine/gaussian_blur.hpp"
 
 using namespace tempera;
 

@@ -8,9 +8,9 @@
 #include <numeric>
 #include <random>
 
-#include "tempera/converged_pixels.hpp"
-#include "tempera/patchmatch.hpp"
-#include "tempera/synthesis.hpp"
+#include "tempera/engine/converged_pixels.hpp"
+#include "tempera/engine/patchmatch.hpp"
+#include "tempera/engine/synthesis.hpp"
 #include "test_inputs.hpp"
 
 using namespace tempera;

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <random>
 
-#include "tempera/distance_transform.hpp"
-#include "tempera/error.hpp"
+#include "tempera/engine/distance_transform.hpp"
+#include "tempera/engine/error.hpp"
 
 using namespace tempera;
 

@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "tempera/patch_distance.hpp"
+#include "tempera/engine/patch_distance.hpp"
 
 using namespace tempera;
 

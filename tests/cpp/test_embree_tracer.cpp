@@ -4,8 +4,8 @@
 #include <cmath>
 #include <cstring>
 
-#include "tempera/embree_tracer.hpp"
-#include "tempera/error.hpp"
+#include "tempera/tracer/embree_tracer.hpp"
+#include "tempera/engine/error.hpp"
 #include "test_inputs.hpp"
 
 using namespace tempera;

@@ -8,8 +8,8 @@
 #include <new>
 #include <random>
 
-#include "tempera/patch_distance.hpp"
-#include "tempera/solver.hpp"
+#include "tempera/engine/patch_distance.hpp"
+#include "tempera/engine/solver.hpp"
 
 using namespace tempera;
 

@@ -7,8 +7,8 @@
 #include <limits>
 #include <random>
 
-#include "tempera/patch_distance.hpp"
-#include "tempera/synthesis.hpp"
+#include "tempera/engine/patch_distance.hpp"
+#include "tempera/engine/synthesis.hpp"
 #include "test_inputs.hpp"
 
 using namespace tempera;

@@ -9,10 +9,10 @@
 #include <tuple>
 #include <vector>
 
-#include "tempera/fluidymation.hpp"
-#include "tempera/mask_flow.hpp"
-#include "tempera/motion_extent.hpp"
-#include "tempera/signed_distance.hpp"
+#include "tempera/methods/fluidymation/fluidymation.hpp"
+#include "tempera/methods/fluidymation/mask_flow.hpp"
+#include "tempera/methods/fluidymation/motion_extent.hpp"
+#include "tempera/methods/fluidymation/signed_distance.hpp"
 
 using namespace tempera;
 

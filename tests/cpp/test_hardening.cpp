@@ -9,11 +9,11 @@
 #include <thread>
 #include <vector>
 
-#include "tempera/error.hpp"
-#include "tempera/lpe.hpp"
-#include "tempera/orientation.hpp"
-#include "tempera/parallel.hpp"
-#include "tempera/paths.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/tracer/lpe.hpp"
+#include "tempera/methods/tcia/orientation.hpp"
+#include "tempera/engine/parallel.hpp"
+#include "tempera/app/paths.hpp"
 
 using namespace tempera;
 

@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include "tempera/error.hpp"
-#include "tempera/guide_stack.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/engine/guide_stack.hpp"
 
 using namespace tempera;
 

@@ -3,8 +3,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "tempera/error.hpp"
-#include "tempera/image_io.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/app/image_io.hpp"
 
 namespace fs = std::filesystem;
 using namespace tempera;

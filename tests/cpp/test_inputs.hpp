@@ -4,8 +4,8 @@
 #include <cstdint>
 #include <random>
 
-#include "tempera/embree_tracer.hpp"
-#include "tempera/image.hpp"
+#include "tempera/tracer/embree_tracer.hpp"
+#include "tempera/engine/image.hpp"
 
 namespace tempera::test_inputs {
 

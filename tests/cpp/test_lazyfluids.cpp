@@ -5,9 +5,9 @@
 #include <map>
 #include <random>
 
-#include "tempera/error.hpp"
-#include "tempera/gaussian_blur.hpp"
-#include "tempera/lazyfluids.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/engine/gaussian_blur.hpp"
+#include "tempera/methods/lazyfluids/lazyfluids.hpp"
 
 using namespace tempera;
 

@@ -1,7 +1,7 @@
 #include <gtest/gtest.h>
 
-#include "tempera/error.hpp"
-#include "tempera/lpe.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/tracer/lpe.hpp"
 
 using namespace tempera;
 

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <random>
 
-#include "tempera/error.hpp"
-#include "tempera/motion.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/engine/motion.hpp"
 
 using namespace tempera;
 

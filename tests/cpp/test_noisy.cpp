@@ -5,8 +5,8 @@
 #include <cmath>
 #include <random>
 
-#include "tempera/error.hpp"
-#include "tempera/noisy.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/methods/noisy/noisy.hpp"
 
 using namespace tempera;
 

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <numbers>
 
-#include "tempera/error.hpp"
-#include "tempera/orientation.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/methods/tcia/orientation.hpp"
 
 using namespace tempera;
 

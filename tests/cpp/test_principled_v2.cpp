@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "tempera/embree_tracer.hpp"
+#include "tempera/tracer/embree_tracer.hpp"
 #include "test_inputs.hpp"
 
 using namespace tempera;

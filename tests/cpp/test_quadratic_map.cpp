@@ -7,11 +7,11 @@
 #include <cmath>
 #include <random>
 
-#include "tempera/error.hpp"
-#include "tempera/quadratic_fit.hpp"
-#include "tempera/quadratic_map.hpp"
-#include "tempera/silhouette.hpp"
-#include "tempera/stroke_raster.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/methods/rigid/quadratic_fit.hpp"
+#include "tempera/methods/rigid/quadratic_map.hpp"
+#include "tempera/methods/rigid/silhouette.hpp"
+#include "tempera/methods/rigid/stroke_raster.hpp"
 
 using namespace tempera;
 

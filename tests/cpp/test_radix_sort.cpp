@@ -6,8 +6,8 @@
 #include <limits>
 #include <random>
 
-#include "tempera/patch_usage.hpp"
-#include "tempera/radix_sort.hpp"
+#include "tempera/engine/patch_usage.hpp"
+#include "tempera/engine/radix_sort.hpp"
 
 using namespace tempera;
 

@@ -7,12 +7,12 @@
 #include <cmath>
 #include <numeric>
 
-#include "tempera/error.hpp"
-#include "tempera/quadratic_fit.hpp"
-#include "tempera/rigid.hpp"
-#include "tempera/rigid_exemplar.hpp"
-#include "tempera/rigid_frame.hpp"
-#include "tempera/silhouette.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/methods/rigid/quadratic_fit.hpp"
+#include "tempera/methods/rigid/rigid.hpp"
+#include "tempera/methods/rigid/rigid_exemplar.hpp"
+#include "tempera/methods/rigid/rigid_frame.hpp"
+#include "tempera/methods/rigid/silhouette.hpp"
 
 using namespace tempera;
 

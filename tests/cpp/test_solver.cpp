@@ -7,9 +7,9 @@
 #include <cmath>
 #include <random>
 
-#include "tempera/error.hpp"
-#include "tempera/solver.hpp"
-#include "tempera/synthesis.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/engine/solver.hpp"
+#include "tempera/engine/synthesis.hpp"
 
 using namespace tempera;
 

@@ -8,11 +8,11 @@
 #include <random>
 #include <thread>
 
-#include "tempera/contact_sheet.hpp"
-#include "tempera/error.hpp"
-#include "tempera/image_io.hpp"
-#include "tempera/stylit.hpp"
-#include "tempera/stylize_job.hpp"
+#include "tempera/app/contact_sheet.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/app/image_io.hpp"
+#include "tempera/methods/stylit/stylit.hpp"
+#include "tempera/methods/stylit/stylize_job.hpp"
 
 using namespace tempera;
 namespace fs = std::filesystem;

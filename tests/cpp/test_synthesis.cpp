@@ -5,8 +5,8 @@
 #include <map>
 #include <random>
 
-#include "tempera/error.hpp"
-#include "tempera/synthesis.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/engine/synthesis.hpp"
 #include "test_inputs.hpp"
 
 using namespace tempera;

@@ -5,10 +5,10 @@
 #include <cmath>
 #include <random>
 
-#include "tempera/error.hpp"
-#include "tempera/solver.hpp"
-#include "tempera/stylit.hpp"
-#include "tempera/tcia.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/engine/solver.hpp"
+#include "tempera/methods/stylit/stylit.hpp"
+#include "tempera/methods/tcia/tcia.hpp"
 #include "tcia_measures.hpp"
 
 using namespace tempera;

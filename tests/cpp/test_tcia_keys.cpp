@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "tempera/tcia.hpp"
-#include "tempera/tcia_derivative.hpp"
+#include "tempera/methods/tcia/tcia.hpp"
+#include "tempera/methods/tcia/tcia_derivative.hpp"
 #include "tcia_measures.hpp"
 
 using namespace tempera;

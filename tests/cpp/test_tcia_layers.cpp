@@ -10,11 +10,11 @@
 #include <set>
 #include <array>
 
-#include "tempera/distance_transform.hpp"
-#include "tempera/error.hpp"
-#include "tempera/motion.hpp"
-#include "tempera/stylit.hpp"
-#include "tempera/tcia_layers.hpp"
+#include "tempera/engine/distance_transform.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/engine/motion.hpp"
+#include "tempera/methods/stylit/stylit.hpp"
+#include "tempera/methods/tcia/tcia_layers.hpp"
 #include "tcia_measures.hpp"
 
 using namespace tempera;

@@ -6,8 +6,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "tempera/orientation.hpp"
-#include "tempera/tcia.hpp"
+#include "tempera/methods/tcia/orientation.hpp"
+#include "tempera/methods/tcia/tcia.hpp"
 #include "tcia_measures.hpp"
 
 using namespace tempera;

@@ -4,7 +4,7 @@
 
 #include <random>
 
-#include "tempera/voting.hpp"
+#include "tempera/engine/voting.hpp"
 #include "test_inputs.hpp"
 
 using namespace tempera;

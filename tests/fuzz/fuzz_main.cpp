@@ -26,11 +26,11 @@
 #include <vector>
 
 #include "../../native/cli/cli_args.hpp"
-#include "tempera/error.hpp"
-#include "tempera/image_io.hpp"
-#include "tempera/lpe.hpp"
-#include "tempera/stylit.hpp"
-#include "tempera/stylize_job.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/app/image_io.hpp"
+#include "tempera/tracer/lpe.hpp"
+#include "tempera/methods/stylit/stylit.hpp"
+#include "tempera/methods/stylit/stylize_job.hpp"
 
 namespace fs = std::filesystem;
 using namespace tempera;

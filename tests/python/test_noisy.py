@@ -1,4 +1,4 @@
-"""Color Me Noisy (tempera.noisy, native/src/noisy.cpp): the amount of
+"""Color Me Noisy (tempera.noisy, native/src/methods/noisy/noisy.cpp): the amount of
 temporal noise follows the low-pass width f, the noise is white, R's large
 shapes stay, the MLS pre-deformation and the low-frequency term matter."""
 import numpy as np

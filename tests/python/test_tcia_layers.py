@@ -1,4 +1,4 @@
-"""tempera.tcia.stylize_layers and composite (Bénard 2013 layers, native/src/tcia_layers.cpp)."""
+"""tempera.tcia.stylize_layers and composite (Bénard 2013 layers, native/src/methods/tcia/tcia_layers.cpp)."""
 import numpy as np
 import pytest
 

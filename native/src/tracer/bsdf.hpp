@@ -7,9 +7,9 @@
 #include <array>
 
 #include "sampling.hpp"
-#include "tempera/lpe.hpp"
-#include "tempera/rng.hpp"
-#include "tempera/scene.hpp"
+#include "tempera/tracer/lpe.hpp"
+#include "tempera/engine/rng.hpp"
+#include "tempera/tracer/scene.hpp"
 
 namespace tempera::tracer {
 

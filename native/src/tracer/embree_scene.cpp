@@ -5,8 +5,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "tempera/error.hpp"
-#include "tempera/parallel.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/engine/parallel.hpp"
 
 namespace tempera::tracer {
 namespace {

@@ -6,7 +6,7 @@
 
 #include <cstdint>
 
-#include "tempera/scene.hpp"
+#include "tempera/tracer/scene.hpp"
 
 namespace tempera::tracer {
 

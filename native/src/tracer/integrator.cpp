@@ -22,11 +22,11 @@
 #include "embree_scene.hpp"
 #include "lights.hpp"
 #include "sampling.hpp"
-#include "tempera/embree_tracer.hpp"
-#include "tempera/error.hpp"
-#include "tempera/lpe.hpp"
-#include "tempera/parallel.hpp"
-#include "tempera/rng.hpp"
+#include "tempera/tracer/embree_tracer.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/tracer/lpe.hpp"
+#include "tempera/engine/parallel.hpp"
+#include "tempera/engine/rng.hpp"
 
 namespace tempera {
 namespace {

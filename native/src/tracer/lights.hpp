@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "sampling.hpp"
-#include "tempera/scene.hpp"
+#include "tempera/tracer/scene.hpp"
 
 namespace tempera::tracer {
 

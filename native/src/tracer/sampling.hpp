@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "tempera/scene.hpp"
+#include "tempera/tracer/scene.hpp"
 
 namespace tempera::tracer {
 

@@ -1,0 +1,55 @@
+#pragma once
+// Reading and writing images through OpenImageIO: PNG, JPEG, TIFF, EXR (and
+// whatever else OIIO knows). Multilayer EXR channels are selected by name.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "tempera/engine/image.hpp"
+
+namespace tempera {
+
+struct ImageFileInfo {
+  int width = 0;
+  int height = 0;
+  std::vector<std::string> channel_names;
+};
+
+// Images whose header declares more pixels than this are refused (IoError)
+// before any pixel memory is allocated: a 74-byte PNG can declare 12000².
+// 50 Mpix by default (8K UHD fits); TEMPERA_MAX_IMAGE_PIXELS or
+// set_max_image_pixels() (CLI --max-image-pixels) change it.
+constexpr std::int64_t kDefaultMaxImagePixels = 50'000'000;
+std::int64_t max_image_pixels();
+void set_max_image_pixels(std::int64_t pixels);
+
+// ".<stem>.tmp<pid>-<16 random hex digits><extension>": a temporary file name
+// no other process writing into the same folder picks (even one with the same
+// process ID, as in containers).
+std::string temporary_name(const std::string& stem, const std::string& extension);
+
+// Size and channel names of an image file without reading its pixels.
+ImageFileInfo inspect_image(const std::string& path);
+
+// Reads `path` as float. With `channels` empty all channels are read; otherwise
+// exactly the named channels, in the given order (FileNotFoundError / IoError /
+// ValueError naming the file and the missing channel on failure).
+Image read_image(const std::string& path, const std::vector<std::string>& channels = {});
+
+// The channels of one layer of `path`: the channel named `layer` itself, or
+// every channel named "<layer>.<component>" in file order (e.g. "FULL" gives
+// FULL.R, FULL.G, FULL.B of a guide cache frame). ValueError lists the layers
+// the file has when there is no such layer.
+Image read_image_layer(const std::string& path, const std::string& layer);
+
+// Writes atomically: a temporary file in the same folder, then a rename, so a
+// crash or cancel never leaves a half-written `path`. 8-bit formats (PNG, JPEG)
+// get values clamped to [0, 1]; EXR and TIFF keep float.
+void write_image(const std::string& path, const ImageView& image,
+                 const std::vector<std::string>& channel_names = {});
+
+// `image` resampled to width x height with OIIO's default filter for the
+// scale (a good downsampling filter, not point sampling). Any channel count.
+Image resize_image(const ImageView& image, int width, int height);
+
+}  // namespace tempera

@@ -1,0 +1,103 @@
+#pragma once
+// PatchMatch (Barnes et al. 2009) over offset fields: propagation, random
+// search, candidates injected by the method (Bénard's ribbons) and, for video
+// exemplars, the same match one frame earlier and later. Parallel over fixed
+// bands of rows; pixels outside a band are read from a snapshot taken at the
+// start of each iteration, so the result depends on the seed only, never on
+// the thread count or schedule.
+#include <cstdint>
+#include <vector>
+
+#include "tempera/engine/energy_term.hpp"
+#include "tempera/engine/offset_field.hpp"
+#include "tempera/engine/patch_distance.hpp"
+
+namespace tempera {
+
+// Which matches are allowed.
+struct SearchConstraints {
+  std::vector<std::uint8_t> source_valid;   // per source pixel: may be a patch center
+  std::vector<std::uint8_t> target_active;  // per target pixel: is synthesized
+  // Optional: target pixels whose matches neighbours may adopt (propagation,
+  // coherence): the active ones plus hard-constrained pixels with a fixed
+  // match. Empty = target_active.
+  std::vector<std::uint8_t> target_matched;
+  // Optional segment labels: a target pixel only matches sources with its label.
+  std::vector<std::int32_t> source_segment, target_segment;
+  // Extra cost per source center (usage terms); empty = none.
+  std::vector<float> source_cost;
+  // Valid source centers (indices), per segment label; filled by finalize().
+  std::vector<std::vector<std::int32_t>> valid_by_segment;
+  const SourceLayout* layout = nullptr;  // for the frame links of video exemplars
+
+  // Builds valid_by_segment; throws ValueError if a target segment has no source.
+  void finalize();
+  int segment_of_target(std::size_t i) const { return target_segment.empty() ? 0 : target_segment[i]; }
+  int segment_of_source(std::size_t i) const { return source_segment.empty() ? 0 : source_segment[i]; }
+  bool allowed(std::size_t source_index, int segment) const {
+    return source_valid[source_index] && segment_of_source(source_index) == segment;
+  }
+  const std::vector<std::uint8_t>& matched() const { return target_matched.empty() ? target_active : target_matched; }
+  float cost(std::size_t source_index) const { return source_cost.empty() ? 0.0f : source_cost[source_index]; }
+};
+
+// Extra candidates per target pixel (compressed rows: the candidates of
+// target i are [begin[i], begin[i + 1])), tried after propagation.
+struct CandidateList {
+  std::vector<std::uint32_t> begin;  // target pixels + 1 entries
+  std::vector<std::int32_t> x, y;    // atlas positions
+  bool empty() const { return x.empty(); }
+};
+
+struct PatchMatchParams {
+  int iterations = 4;
+  std::uint64_t seed = 1;
+  int threads = 0;
+  int band_rows = 32;
+  int random_tries_per_scale = 1;
+  const CandidateList* candidates = nullptr;
+  // Terms that read the field (EnergyTerm::reads_field), with their context.
+  std::vector<const EnergyTerm*> field_terms;
+  const LevelContext* context = nullptr;
+  // Index of the first iteration (scan direction and random stream): a search
+  // split into single iterations, e.g. to refresh usage costs in between,
+  // equals the unsplit one.
+  int first_iteration = 0;
+  // Optional: the active target pixels to improve (converged_pixels.hpp);
+  // the others keep their match and still propagate it. Null = all.
+  const std::vector<std::uint8_t>* searched = nullptr;
+};
+
+// Random valid source for every active target pixel, with distances.
+void random_field(const PatchSpace& space, const SearchConstraints& constraints, OffsetField& field,
+                  std::uint64_t seed, int threads);
+
+// Recomputes field.dist for the current features (e.g. after voting changed B').
+void refresh_distances(const PatchSpace& space, const SearchConstraints& constraints, OffsetField& field,
+                       int threads);
+
+// Moves matches that the constraints forbid (masked out, another segment)
+// to a valid source chosen deterministically from the position, and zeroes
+// inactive targets.
+void legalize_field(const PatchSpace& space, const SearchConstraints& constraints, OffsetField& field);
+
+// Improves `field` in place; only ever accepts cheaper matches.
+void patchmatch(const PatchSpace& space, const SearchConstraints& constraints, OffsetField& field,
+                const PatchMatchParams& params, std::uint64_t stream);
+
+// Source position proposed for target q by a neighbour q + d whose match is
+// (nx, ny): the neighbour's source shifted back by d, rotated into source space.
+inline void propagate_candidate(const PatchSpace& space, int nx, int ny, int ntx, int nty, int dx, int dy,
+                                int& cx, int& cy) {
+  if (!space.rotated()) {
+    cx = nx - dx;
+    cy = ny - dy;
+    return;
+  }
+  float ox, oy;
+  rotate_offset(space.rotation(nx, ny, ntx, nty), float(dx), float(dy), ox, oy);
+  cx = int(std::lround(nx - ox));
+  cy = int(std::lround(ny - oy));
+}
+
+}  // namespace tempera

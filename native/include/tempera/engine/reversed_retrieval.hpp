@@ -1,0 +1,296 @@
+#pragma once
+// Reversed NNF retrieval (Rosenberger et al. 2009; thesis §5.4.1), shared by
+// uniform usage (uniform_usage.cpp) and StyLit's error budget
+// (error_budget.cpp): each eligible source patch looks for its best target
+// patch among those not yet assigned.
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <vector>
+
+#include "tempera/engine/energy_term.hpp"
+#include "tempera/engine/parallel.hpp"
+#include "tempera/engine/patchmatch.hpp"
+#include "tempera/engine/rng.hpp"
+
+namespace tempera {
+
+struct ReversedRetrievalParams {
+  int pm_iterations = 1;          // PatchMatch sweeps (in source space) per round; candidates persist across rounds
+  double coverage_goal = 0.95;    // budget: stop once this fraction of targets is covered
+  int max_rounds = 16;            // budget: at most this many rounds
+  std::uint64_t seed = 1;
+  int threads = 0;
+};
+
+constexpr std::int32_t kNoTarget = -1;
+inline constexpr float kNoDistance = std::numeric_limits<float>::infinity();
+
+struct Assignment {
+  float dist;
+  std::int32_t target;
+  std::int32_t source;
+  bool operator<(const Assignment& o) const {
+    return dist < o.dist || (dist == o.dist && target < o.target);
+  }
+};
+
+// Reversed NNF retrieval (Rosenberger et al. 2009; thesis §5.4.1): each
+// eligible source patch looks for its best target patch among those not yet
+// assigned. PatchMatch runs in source space: neighbours propagate their target
+// candidates, random search explores around them, and a random unassigned
+// target is tried too (it keeps the search alive when few targets remain).
+class ReversedRetrieval {
+ public:
+  ReversedRetrieval(const PatchSpace& space, const SearchConstraints& cons, OffsetField& nnf,
+                    const ReversedRetrievalParams& params, std::uint64_t stream)
+      : space_(space), cons_(cons), nnf_(nnf), params_(params), stream_(stream),
+        sw_(space.source->width), sh_(space.source->height), tw_(nnf.width), th_(nnf.height),
+        open_(cons.target_active), eligible_(std::size_t(sw_) * sh_, 0),
+        wide_search_(std::size_t(sw_) * sh_, 0),
+        candidate_(std::size_t(sw_) * sh_, kNoTarget), candidate_dist_(std::size_t(sw_) * sh_, kNoDistance),
+        best_source_(std::size_t(tw_) * th_) {
+    for (std::uint8_t a : open_) active_ += a != 0;
+  }
+
+  std::vector<std::uint8_t>& eligible() { return eligible_; }
+  std::size_t active() const { return active_; }
+  std::size_t assigned_count() const { return assigned_count_; }
+  const std::vector<std::int32_t>& candidate() const { return candidate_; }
+  const std::vector<float>& candidate_dist() const { return candidate_dist_; }
+  // Sources seeded with a random target so far (each searched over the whole
+  // frame: the costly part of a round).
+  std::size_t wide_searches() const { return wide_searches_; }
+
+  // One round of retrieval: fills candidates for eligible sources and returns
+  // the collision-free (best source per target) assignments, in target order.
+  std::vector<Assignment> round(int round_index) {
+    collect_unassigned();
+    seed_candidates(round_index);
+    for (int it = 0; it < params_.pm_iterations; ++it) sweep(round_index, it);
+    return resolve_collisions();
+  }
+
+  void assign(const Assignment& a) {
+    nnf_.x[a.target] = a.source % sw_;
+    nnf_.y[a.target] = a.source / sw_;
+    nnf_.dist[a.target] = a.dist / border_scale(a.target % tw_, a.target / tw_);
+    open_[a.target] = 0;
+    candidate_[a.source] = kNoTarget;
+    candidate_dist_[a.source] = kNoDistance;
+    ++assigned_count_;
+  }
+
+ private:
+  // Target patches at the frame border are clipped, so their raw distances
+  // sum fewer pixels and would look like bargains to every source patch.
+  // Reversed retrieval compares distances across targets, so it scales them
+  // to a whole patch.
+  float border_scale(int qx, int qy) const {
+    const int r = space_.radius;
+    const int w = std::min(r, tw_ - 1 - qx) + std::min(r, qx) + 1;
+    const int h = std::min(r, th_ - 1 - qy) + std::min(r, qy) + 1;
+    return float((2 * r + 1) * (2 * r + 1)) / float(w * h);
+  }
+
+  float scaled_distance(int sx, int sy, int qx, int qy, float cutoff) const {
+    const float scale = border_scale(qx, qy);
+    return scale * patch_distance(space_, sx, sy, qx, qy, cutoff / scale);
+  }
+
+  bool open_target(int qx, int qy, int segment) const {
+    if (qx < 0 || qy < 0 || qx >= tw_ || qy >= th_) return false;
+    const std::size_t q = std::size_t(qy) * tw_ + qx;
+    return open_[q] && cons_.segment_of_target(q) == segment;
+  }
+
+  void collect_unassigned() {
+    unassigned_.resize(cons_.valid_by_segment.size());
+    for (auto& list : unassigned_) list.clear();  // keeps the capacity for the next round
+    for (std::size_t q = 0; q < open_.size(); ++q)
+      if (open_[q]) unassigned_[cons_.segment_of_target(q)].push_back(std::int32_t(q));
+  }
+
+  // Keeps still-open candidates, adopts targets whose forward match is this
+  // source (the forward NNF already knows good pairs), else picks at random.
+  // Only the random picks need the wide random search of the sweep; the
+  // others are refined by propagation alone (half the cost of a round).
+  void seed_candidates(int round_index) {
+    parallel_for(sh_, params_.threads, [&](int sy) {
+      for (std::size_t p = std::size_t(sy) * sw_, end = p + sw_; p < end; ++p) {
+        if (!eligible_[p] || (candidate_[p] != kNoTarget && !open_[candidate_[p]])) {
+          candidate_[p] = kNoTarget;
+          candidate_dist_[p] = kNoDistance;
+        }
+        wide_search_[p] = 0;
+      }
+    });
+    for (const auto& list : unassigned_) {
+      for (std::int32_t q : list) {
+        const std::size_t p = std::size_t(nnf_.y[q]) * sw_ + nnf_.x[q];
+        const float d = nnf_.dist[q] * border_scale(q % tw_, q / tw_);
+        if (eligible_[p] && d < candidate_dist_[p]) {
+          candidate_[p] = q;
+          candidate_dist_[p] = d;
+        }
+      }
+    }
+    parallel_for(sh_, params_.threads, [&](int sy) {
+      for (int sx = 0; sx < sw_; ++sx) {
+        const std::size_t p = std::size_t(sy) * sw_ + sx;
+        if (!eligible_[p] || candidate_[p] != kNoTarget) continue;
+        const auto& list = unassigned_[cons_.segment_of_source(p)];
+        if (list.empty()) continue;
+        Rng rng(params_.seed, mix64(stream_ * 7919 + round_index) ^ p);
+        const std::int32_t q = list[rng.below(int(list.size()))];
+        candidate_[p] = q;
+        candidate_dist_[p] = scaled_distance(sx, sy, q % tw_, q / tw_, kNoDistance);
+        wide_search_[p] = 1;
+      }
+    });
+    wide_searches_ += std::size_t(std::count(wide_search_.begin(), wide_search_.end(), std::uint8_t(1)));
+  }
+
+  void prefetch_target(int qx, int qy) const {
+    if (qx < 0 || qy < 0 || qx >= tw_ || qy >= th_) return;
+    __builtin_prefetch(&open_[std::size_t(qy) * tw_ + qx]);
+    const int r = space_.radius;
+    const int x0 = std::max(0, qx - r), bytes = (2 * r + 1) * space_.target->bytes_per_pixel();
+    for (int dy = -r; dy <= std::min(r, 1 - r); ++dy) {
+      if (qy + dy < 0 || qy + dy >= th_) continue;
+      const char* row = space_.target->pixel_bytes(x0, qy + dy);
+      for (int off = 0; off < bytes; off += 64) __builtin_prefetch(row + off);
+    }
+  }
+
+  void try_target(int sx, int sy, int qx, int qy, int segment, std::int32_t& best, float& best_dist) const {
+    if (!open_target(qx, qy, segment)) return;
+    const std::int32_t q = qy * tw_ + qx;
+    if (q == best) return;
+    const float d = scaled_distance(sx, sy, qx, qy, best_dist);
+    if (d < best_dist) {
+      best = q;
+      best_dist = d;
+    }
+  }
+
+  void sweep(int round_index, int iteration) {
+    const int band_rows = 32, bands = (sh_ + band_rows - 1) / band_rows;
+    const bool forward = iteration % 2 == 0;
+    const int step = forward ? 1 : -1;
+    const int max_radius = std::max(tw_, th_);
+    // A band propagates from the row before it (in sweep order) as it was
+    // before the sweep, so that no band reads another's progress.
+    std::vector<std::int32_t> edge(std::size_t(bands) * sw_, kNoTarget);
+    for (int band = 0; band < bands; ++band) {
+      const int ey = forward ? band * band_rows - 1 : std::min(sh_, (band + 1) * band_rows);
+      if (ey >= 0 && ey < sh_)
+        std::copy_n(candidate_.begin() + std::ptrdiff_t(ey) * sw_, sw_, edge.begin() + std::ptrdiff_t(band) * sw_);
+    }
+    parallel_for(bands, params_.threads, [&](int band) {
+      const int y0 = band * band_rows, y1 = std::min(sh_, y0 + band_rows);
+      Rng rng(params_.seed, mix64(stream_ * 104729 + round_index * 131 + iteration) ^ std::uint64_t(band));
+      for (int row = 0; row < y1 - y0; ++row) {
+        const int sy = forward ? y0 + row : y1 - 1 - row;
+        for (int col = 0; col < sw_; ++col) {
+          const int sx = forward ? col : sw_ - 1 - col;
+          const std::size_t p = std::size_t(sy) * sw_ + sx;
+          if (!eligible_[p] || candidate_[p] == kNoTarget) continue;
+          const int segment = cons_.segment_of_source(p);
+          // The random draws do not depend on the search, so they come first:
+          // the offsets of the random search (around the propagated best)
+          // and a random open target, whose list slot is then fetched while
+          // propagation runs.
+          int off[64], n = 0;
+          for (int r = wide_search_[p] ? max_radius : 0; r >= 1 && n < 64; r /= 2, n += 2) {
+            off[n] = rng.between(-r, r);
+            off[n + 1] = rng.between(-r, r);
+          }
+          const auto& list = unassigned_[segment];
+          const std::int32_t* open_pick = list.empty() ? nullptr : &list[rng.below(int(list.size()))];
+          if (open_pick) __builtin_prefetch(open_pick);
+          std::int32_t best = candidate_[p];
+          float best_dist = candidate_dist_[p];
+          const int nbr[2][2] = {{-step, 0}, {0, -step}};
+          for (const auto& d : nbr) {
+            const int nx = sx + d[0], ny = sy + d[1];
+            if (nx < 0 || ny < 0 || nx >= sw_ || ny >= sh_) continue;
+            const std::size_t np = std::size_t(ny) * sw_ + nx;
+            const std::int32_t nq = (ny >= y0 && ny < y1) ? candidate_[np] : edge[std::size_t(band) * sw_ + nx];
+            if (nq == kNoTarget) continue;
+            // The neighbour's target shifted back by d, with d rotated from
+            // source into target space.
+            float ox = float(d[0]), oy = float(d[1]);
+            if (space_.rotated()) rotate_offset(-space_.rotation(nx, ny, nq % tw_, nq / tw_), ox, oy, ox, oy);
+            try_target(sx, sy, nq % tw_ - int(std::lround(ox)), nq / tw_ - int(std::lround(oy)), segment, best,
+                       best_dist);
+          }
+          // Random search around the propagated best, then the random open
+          // target; all are prefetched before the first is tested (see
+          // patchmatch.cpp).
+          const std::int32_t pick = open_pick ? *open_pick : kNoTarget;
+          if (open_pick) prefetch_target(pick % tw_, pick / tw_);
+          const int bx = best % tw_, by = best / tw_;
+          for (int k = 0; k < n; k += 2) prefetch_target(bx + off[k], by + off[k + 1]);
+          for (int k = 0; k < n; k += 2) try_target(sx, sy, bx + off[k], by + off[k + 1], segment, best, best_dist);
+          if (open_pick) try_target(sx, sy, pick % tw_, pick / tw_, segment, best, best_dist);
+          candidate_[p] = best;
+          candidate_dist_[p] = best_dist;
+        }
+      }
+    });
+  }
+
+  // Best source per target, in parallel: an atomic minimum over (distance
+  // bits, source index), so the winner does not depend on thread timing.
+  std::vector<Assignment> resolve_collisions() {
+    auto& best = best_source_;
+    parallel_for(th_, params_.threads, [&](int qy) {
+      for (std::size_t q = std::size_t(qy) * tw_, end = q + tw_; q < end; ++q) best[q].store(~0ull, std::memory_order_relaxed);
+    });
+    parallel_for(sh_, params_.threads, [&](int sy) {
+      for (std::size_t p = std::size_t(sy) * sw_, end = p + sw_; p < end; ++p) {
+        const std::int32_t q = candidate_[p];
+        if (!eligible_[p] || q == kNoTarget || !open_[q]) continue;
+        std::uint32_t bits;
+        std::memcpy(&bits, &candidate_dist_[p], sizeof bits);  // >= 0: bits order like values
+        const std::uint64_t key = (std::uint64_t(bits) << 32) | std::uint64_t(p);
+        std::uint64_t cur = best[q].load(std::memory_order_relaxed);
+        while (key < cur && !best[q].compare_exchange_weak(cur, key, std::memory_order_relaxed)) {
+        }
+      }
+    });
+    // Sized once: a growing vector holds its old and new buffers at once,
+    // and a round's winners are up to 12 bytes per target.
+    std::vector<Assignment> out;
+    out.reserve(std::size_t(std::count_if(best.begin(), best.end(), [](const auto& b) {
+      return b.load(std::memory_order_relaxed) != ~0ull;
+    })));
+    for (std::size_t q = 0; q < best.size(); ++q) {
+      const std::uint64_t key = best[q].load(std::memory_order_relaxed);
+      if (key == ~0ull) continue;
+      const std::int32_t p = std::int32_t(key & 0xFFFFFFFFull);
+      out.push_back({candidate_dist_[p], std::int32_t(q), p});
+    }
+    return out;
+  }
+
+  const PatchSpace& space_;
+  const SearchConstraints& cons_;
+  OffsetField& nnf_;
+  const ReversedRetrievalParams& params_;
+  std::uint64_t stream_;
+  int sw_, sh_, tw_, th_;
+  // open_: active and not yet assigned, one byte a target, so that testing a
+  // random candidate costs one cache miss, not two.
+  std::vector<std::uint8_t> open_, eligible_, wide_search_;
+  std::vector<std::int32_t> candidate_;
+  std::vector<float> candidate_dist_;
+  std::vector<std::vector<std::int32_t>> unassigned_;
+  std::vector<std::atomic<std::uint64_t>> best_source_;  // resolve_collisions' per-target minimum, kept across rounds
+  std::size_t active_ = 0, assigned_count_ = 0, wide_searches_ = 0;
+};
+
+}  // namespace tempera

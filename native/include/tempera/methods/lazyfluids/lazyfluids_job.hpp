@@ -1,0 +1,66 @@
+#pragma once
+// LazyFluids (lazyfluids.hpp) as a job over a guide cache: `tempera stylize
+// --method lazyfluids` and the Python FluidJob. The target alpha of frame f
+// is the cache's `alpha`, its flow `fluid_velocity` (falling back to
+// `velocity_forward`, else zero, with a warning). The exemplar is an RGBA
+// image or a folder of RGBA frames (a video exemplar, looped). Frames run
+// forwards and each depends on the one before, so the unit of resume is the
+// frame: its output and its exact float state (OUT/tempera_lazyfluids/
+// frame_0001.exr, what the next frame advects) are written atomically, then a
+// record with the frame's key (settings, exemplar, guide files, the previous
+// state's checksum) and the files' checksums; a rerun skips frames whose
+// record still matches, and a resumed run equals an uninterrupted one.
+#include <string>
+#include <vector>
+
+#include "tempera/methods/lazyfluids/lazyfluids.hpp"
+#include "tempera/methods/stylit/stylize_job.hpp"  // FrameResult
+
+namespace tempera {
+
+struct LazyFluidsJobConfig {
+  std::string exemplar;      // RGBA image, or a folder of RGBA frames (sorted by name)
+  std::string guides;        // guide cache folder (frame_####.exr)
+  std::vector<int> frames;   // consecutive
+  std::string out;           // output folder: OUT/frame_0001.png ...
+  std::string format = "png";  // png | exr
+  bool resume = true;
+  LazyFluidsOptions options = default_lazyfluids_options();
+};
+
+class LazyFluidsJob {
+ public:
+  // Validates everything up front (files, guides, sizes, options).
+  explicit LazyFluidsJob(LazyFluidsJobConfig config);
+
+  const std::vector<int>& frames() const { return config_.frames; }
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  const std::vector<Image>& exemplar() const { return exemplar_; }
+  std::string output_path(int frame) const;
+  std::string state_path(int frame) const;
+  std::string record_path(int frame) const;
+  std::string field_path(int frame) const;  // warm start: the frame's final matches
+
+  // Stylizes frames()[index] (or skips it when its record is current); the
+  // frame before must be done. `progress` returning false cancels:
+  // CancelledError, nothing written.
+  FrameResult run_frame(std::size_t index, const ProgressCallback& progress = {});
+
+  // The exemplar followed by the frames written so far.
+  void write_contact_sheet(const std::string& path, int columns = 0) const;
+
+ private:
+  std::string guide_path(int frame) const;
+  std::string frame_key(std::size_t index) const;
+  bool is_current(std::size_t index) const;
+  Image read_flow(int frame) const;
+  void write_frame(std::size_t index, const FluidFrameResult& frame) const;
+
+  LazyFluidsJobConfig config_;
+  std::vector<std::string> warnings_, exemplar_files_;
+  std::vector<Image> exemplar_;
+  std::vector<std::string> flow_guide_;  // per frame index: the guide read as flow ("" = zero)
+  std::string settings_;
+};
+
+}  // namespace tempera

@@ -1,0 +1,77 @@
+#pragma once
+// Color Me Noisy over a sequence: a folder of coherent frames R (Tempera's
+// own coherent result, or frames from elsewhere) in, one noisy frame each
+// out. Shared by `tempera noisy`, `tempera stylize --noise` and the Blender
+// add-on, which calls run_frame() once per modal step. Frames are
+// independent, so a farm may split the range anywhere; each output is
+// written atomically with a key beside it (OUT/.tempera_noisy/0001.key), and
+// a rerun skips frames whose key still matches.
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "tempera/engine/image.hpp"
+#include "tempera/methods/noisy/noisy.hpp"
+#include "tempera/methods/stylit/stylit.hpp"
+
+namespace tempera {
+
+struct NoisySequenceConfig {
+  std::string exemplar;           // the medium S: the painting, or a scan of the paper
+  std::string reference;          // folder of the coherent frames R: <prefix>0001.png ...
+  std::vector<int> frames;        // frames to make, in order
+  std::string out;                // output folder (created): <prefix>0001.png ...
+  std::string prefix = "frame_";  // of the reference and the output frames
+  // Optional local noise map (§3.3), f_p = noise * map: an image file (R's
+  // size), or the name of a guide in the guide cache `guides` ("alpha",
+  // "mask.OB_Cube", an AOV), read per frame. 0 keeps R, 1 is the full amount.
+  std::string noise_map;
+  std::string guides;             // guide cache folder, for a guide noise map and guided noise
+  // Guided noise (options.noise_guides > 0): the exemplar render's guide
+  // cache (its frame as in StylizeJobConfig) and StyLit's guide weights.
+  std::string exemplar_guides;
+  std::optional<int> exemplar_frame;
+  std::vector<std::pair<std::string, float>> guide_weights = default_guide_weights();
+  NoisyOptions options = default_noisy_options();
+  bool resume = true;
+};
+
+struct NoisyFrameResult {
+  int frame = 0;
+  std::string path;
+  std::string status;  // "made" | "skipped"
+  double seconds = 0;
+};
+
+class NoisySequence {
+ public:
+  // Validates up front: options, folders, the exemplar, every reference
+  // frame, the noise map (file or guide); ValueError / FileNotFoundError.
+  explicit NoisySequence(NoisySequenceConfig config);
+  const std::vector<int>& frames() const { return config_.frames; }
+  std::string output_path(int frame) const;
+  // Makes frames()[index] (or skips it when its output is current).
+  // `progress` returning false cancels: CancelledError, nothing written.
+  NoisyFrameResult run_frame(std::size_t index, const ProgressCallback& progress = {});
+
+ private:
+  std::string reference_path(int frame) const;
+  std::string guide_path(int frame) const;
+  bool map_is_guide() const { return !config_.noise_map.empty() && !map_file_; }
+  Image noise_map(int frame) const;
+  bool guided() const { return config_.options.noise_guides > 0; }
+  void read_exemplar_guides();
+  std::vector<Image> frame_guides(int frame) const;  // tone-mapped, in light_path_ order
+  std::string key(int frame) const;
+
+  NoisySequenceConfig config_;
+  Image medium_;
+  bool map_file_ = false;
+  Image file_map_;
+  std::string settings_;
+  std::vector<std::pair<std::string, float>> light_path_;  // guided noise: the active guides
+  std::vector<Image> exemplar_guides_;                      // their exemplar side, tone-mapped
+};
+
+}  // namespace tempera

@@ -1,0 +1,84 @@
+#pragma once
+// A stylization job over an animation: the painting, the exemplar's guide
+// cache frame and the target guide cache in, one stylized image per frame
+// out. Shared by `tempera stylize` and the Blender add-on, which calls
+// run_frame() once per modal step. Frames are resumable: each output is
+// written atomically and recorded with a key in OUT/tempera_stylize.json, and
+// a rerun skips frames whose key still matches.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tempera/engine/image.hpp"
+#include "tempera/methods/stylit/stylit.hpp"
+
+namespace tempera {
+
+struct StylizeJobConfig {
+  std::string style;                  // the painting (PNG, EXR, ...)
+  std::string exemplar_guides;        // guide cache folder of the exemplar render
+  std::optional<int> exemplar_frame;  // default: the folder's only frame_*.exr
+  std::string guides;                 // guide cache folder of the animation
+  std::vector<int> frames;            // frames to stylize, in order
+  std::string out;                    // output folder (created)
+  std::string format = "png";         // png | exr
+  std::string prefix = "frame_";      // OUT/<prefix>0001.<format>
+  StylitOptions stylit;
+  bool resume = true;
+};
+
+// The exemplar's guide cache frame: `frame` if given, else the folder's only
+// frame_*.exr (FileNotFoundError if none, ValueError if several).
+int exemplar_guide_frame(const std::string& folder, std::optional<int> frame);
+
+struct FrameResult {
+  int frame = 0;
+  std::string path;
+  std::string status;     // "stylized" | "skipped"
+  double seconds = 0;
+  double flicker = 0;     // NaN without a previous frame (or without motion guides)
+  double source_coverage = 0;
+};
+
+class StylizeJob {
+ public:
+  // Validates everything up front (files, guides, sizes); see docs/cli.md.
+  explicit StylizeJob(StylizeJobConfig config);
+
+  const std::vector<int>& frames() const { return config_.frames; }
+  // What was fixed on the way: a resampled painting, a damaged resume record set aside.
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  std::string output_path(int frame) const;
+  std::string report_path() const;
+  // The painting at the exemplar guides' size, the exemplar's guides and their
+  // file: what the coherent job (tcia_job.hpp) takes from this one.
+  const Image& style() const { return style_; }
+  const GuideFrame& exemplar() const { return exemplar_; }
+  const std::string& exemplar_path() const { return exemplar_path_; }
+  std::string target_guides_path(int frame) const { return target_path(frame); }
+
+  // Stylizes frames()[index] (or skips it when its output is current).
+  // `progress` returning false cancels: CancelledError, nothing written.
+  FrameResult run_frame(std::size_t index, const ProgressCallback& progress = {});
+
+  // The painting followed by the stylized frames written so far, downscaled
+  // so that the sheet stays within about 2000 pixels wide. columns 0 = auto.
+  void write_contact_sheet(const std::string& path, int columns = 0) const;
+
+ private:
+  std::string target_path(int frame) const;
+  std::string lock_path() const;  // guards the report's read-merge-write
+  bool has_temporal_predecessor(std::size_t index) const;
+  void check_target_guides(const std::vector<std::string>& names);
+
+  StylizeJobConfig config_;
+  std::vector<std::string> warnings_;
+  Image style_;  // the painting at the exemplar guides' size
+  GuideFrame exemplar_;
+  std::string exemplar_path_;
+  std::string settings_;           // canonical text of the stylization settings
+  std::vector<std::string> keys_;  // resume key per frame index
+  std::vector<bool> has_motion_;   // target frame has velocity_backward and occlusion_backward
+};
+
+}  // namespace tempera

@@ -1,0 +1,50 @@
+#include "tempera/engine/synthesis.hpp"
+
+#include <chrono>
+
+#include "tempera/engine/error.hpp"
+#include "tempera/engine/patch_usage.hpp"
+#include "tempera/engine/solver.hpp"
+
+namespace tempera {
+
+// The whole solve: coarse to fine, each level started from the coarser
+// level's field (the cold start at the coarsest).
+SynthesisResult synthesize(const SynthesisInput& in, const SynthesisOptions& opt, const ProgressCallback& progress) {
+  const auto t_start = std::chrono::steady_clock::now();
+  const Solver solver(in, opt);
+  double total_work = 0, done_work = 0;
+  for (int l = 0; l < solver.levels(); ++l)
+    total_work += double(solver.target_width(l)) * solver.target_height(l) * solver.em_iterations(l);
+  SynthesisResult result;
+  LevelResult level;
+  for (int l = solver.coarsest(); l >= 0; --l) {
+    const double work = double(solver.target_width(l)) * solver.target_height(l) * solver.em_iterations(l);
+    auto report = [&](double fraction) {
+      return !progress || progress(std::min(1.0, (done_work + fraction * work) / total_work));
+    };
+    // Each level is solved once: its plan is freed as it starts, the coarser
+    // result before it, and the start field is handed over, not copied.
+    LevelStart start;
+    start.last_use = true;
+    OffsetField up;
+    if (l != solver.coarsest()) {
+      up = solver.resample(level.field, l + 1, l);
+      level = LevelResult();
+      start.take_field = &up;
+    }
+    level = solver.solve_level(l, start, report);
+    done_work += work;
+    result.levels.push_back(level.stats);
+  }
+  result.image = std::move(level.image);
+  result.field = std::move(level.field);
+  result.layout = solver.layout(0);
+  result.source_coverage = result.levels.back().source_coverage;
+  result.guide_channels = solver.guide_channels();
+  result.kept_guide_variance = solver.kept_guide_variance();
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  return result;
+}
+
+}  // namespace tempera

@@ -1,0 +1,244 @@
+#include "tempera/methods/fluidymation/fluidymation_job.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "tempera/app/contact_sheet.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/app/file_keys.hpp"
+#include "tempera/app/image_io.hpp"
+#include "tempera/app/paths.hpp"
+#include "tempera/app/text_file.hpp"
+
+namespace fs = std::filesystem;
+
+namespace tempera {
+namespace {
+
+// 2: frames made since flows from masks keep a symmetric window at the shot's ends and
+// fractional exemplar times vote blended (earlier records are recomputed once).
+constexpr const char* kRecordFormat = "tempera-fluidymation-frame 2";
+
+bool is_image_file(const fs::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext == ".png" || ext == ".exr" || ext == ".jpg" || ext == ".jpeg" || ext == ".tif" || ext == ".tiff";
+}
+
+std::vector<std::string> image_files(const std::string& folder, const char* what) {
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) throw FileNotFoundError(concat(what, " folder not found: '", folder, "'"));
+  std::vector<std::string> out;
+  for (const auto& entry : fs::directory_iterator(folder))
+    if (entry.is_regular_file() && is_image_file(entry.path()) && entry.path().filename().string()[0] != '.')
+      out.push_back(entry.path().string());
+  std::sort(out.begin(), out.end());
+  if (out.size() < 2) throw ValueError(concat(what, " folder '", folder, "' needs at least 2 frames, has ", out.size()));
+  return out;
+}
+
+Image channel(const Image& image, int c) { return extract_channels(image.view(), c, 1); }
+
+std::string guide_frame(const std::string& folder, int frame) {
+  return (fs::path(folder) / frame_file("frame_", frame, "exr")).string();
+}
+
+bool has_layer(const ImageFileInfo& info, const std::string& layer) {
+  return std::any_of(info.channel_names.begin(), info.channel_names.end(),
+                     [&](const std::string& n) { return n == layer || n.rfind(layer + ".", 0) == 0; });
+}
+
+std::string read_record(const std::string& path) {
+  std::ifstream in(path);
+  std::string format, key;
+  if (!std::getline(in, format) || format != kRecordFormat || !std::getline(in, key)) return "";
+  return key;
+}
+
+}  // namespace
+
+FluidymationJob::~FluidymationJob() = default;
+
+namespace {
+
+// The guide of `flow` in the frame `path` described by `info`; "" = from the
+// masks. Auto prefers fluid_velocity: on smoke velocity_forward is zero.
+std::string pick_flow_guide(FlowSource flow, const ImageFileInfo& info, const std::string& path) {
+  const auto required = [&](const char* guide, const char* choice) {
+    if (!has_layer(info, guide))
+      throw ValueError(concat("--flow ", choice, " needs ", guide, " in the guide cache ('", path, "' has none)"));
+    return std::string(guide);
+  };
+  switch (flow) {
+    case FlowSource::Fluid: return required("fluid_velocity", "fluid");
+    case FlowSource::Guides: return required("velocity_forward", "guides");
+    case FlowSource::Masks: return "";
+    case FlowSource::Auto: break;
+  }
+  for (const char* guide : {"fluid_velocity", "velocity_forward"})
+    if (has_layer(info, guide)) return guide;
+  return "";
+}
+
+}  // namespace
+
+FluidymationJob::FluidymationJob(FluidymationJobConfig c) : config_(std::move(c)) {
+  validate(config_.options);
+  if (config_.format != "png" && config_.format != "exr")
+    throw ValueError(concat("unknown format '", config_.format, "' (choose png or exr)"));
+  if (config_.frames.size() < 2) throw ValueError("Fluidymation needs at least 2 consecutive frames");
+  for (std::size_t i = 1; i < config_.frames.size(); ++i)
+    if (config_.frames[i] != config_.frames[i - 1] + 1)
+      throw ValueError(concat("Fluidymation needs consecutive frames (each starts from the one before); frame ",
+                              config_.frames[i - 1], " is followed by ", config_.frames[i]));
+  if (config_.target_mask != "alpha" && config_.target_mask.rfind("mask.OB_", 0) != 0 &&
+      config_.target_mask.rfind("mask.CO_", 0) != 0)
+    throw ValueError(concat("target mask '", config_.target_mask, "' must be alpha, mask.OB_<object> or mask.CO_<collection>"));
+  // The exemplar.
+  const std::vector<std::string> files = image_files(config_.exemplar, "exemplar");
+  std::vector<std::string> mask_files;
+  if (!config_.exemplar_masks.empty()) {
+    mask_files = image_files(config_.exemplar_masks, "exemplar mask");
+    if (mask_files.size() != files.size())
+      throw ValueError(concat("the exemplar has ", files.size(), " frames but ", mask_files.size(), " masks"));
+  }
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    const Image frame = read_image(files[i]);
+    if (frame.channels() < 3) throw ValueError(concat("exemplar frame '", files[i], "' must be RGB or RGBA"));
+    if (mask_files.empty() && frame.channels() < 4)
+      throw ValueError(concat("exemplar frame '", files[i], "' has no alpha; give its masks (--exemplar-masks)"));
+    Image mask = mask_files.empty() ? channel(frame, 3) : channel(read_image(mask_files[i]), 0);
+    require_same_size(mask.view(), "exemplar mask", frame.view(), files[i]);
+    if (!exemplar_.empty()) require_same_size(frame.view(), files[i], exemplar_[0].view(), files[0]);
+    exemplar_.push_back(extract_channels(frame.view(), 0, 3));
+    exemplar_masks_.push_back(std::move(mask));
+  }
+  // The target.
+  std::vector<std::string> inputs = files;
+  inputs.insert(inputs.end(), mask_files.begin(), mask_files.end());
+  for (int f : config_.frames) {
+    const std::string path = guide_frame(config_.guides, f);
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) throw FileNotFoundError(concat("guide cache frame not found: '", path, "'"));
+    const ImageFileInfo info = inspect_image(path);
+    if (!has_layer(info, config_.target_mask))
+      throw ValueError(concat("guide cache frame '", path, "' has no '", config_.target_mask, "' guide"));
+    if (f == config_.frames.front()) flow_guide_ = pick_flow_guide(config_.flow, info, path);
+    target_masks_.push_back(channel(read_image_layer(path, config_.target_mask), 0));
+    if (!flow_guide_.empty()) target_flows_.push_back(read_image_layer(path, flow_guide_));
+    inputs.push_back(path);
+  }
+  fs::create_directories(fs::path(config_.out) / "tempera_fluidymation");
+  refuse_output_on_inputs(output_path(config_.frames.front()), inputs, "output");
+  std::ostringstream base;
+  base << settings_text(config_.options, fluidymation_option_table())
+       << settings_text(config_.options.synthesis, synthesis_option_table()) << "format=" << config_.format
+       << ";mask=" << config_.target_mask << ";flow=" << (flow_guide_.empty() ? "masks" : flow_guide_) << ";frames="
+       << config_.frames.front() << "-" << config_.frames.back();
+  for (const std::string& in : inputs) base << "\n" << file_stamp(in);
+  std::string previous = hash_hex(base.str());
+  for (int f : config_.frames) keys_.push_back(previous = hash_hex(concat(previous, "\n", f)));
+}
+
+std::string FluidymationJob::output_path(int frame) const {
+  return (fs::path(config_.out) / frame_file("frame_", frame, config_.format)).string();
+}
+std::string FluidymationJob::state_path(int frame) const {
+  return (fs::path(config_.out) / "tempera_fluidymation" / frame_file("nnf_", frame, "exr")).string();
+}
+std::string FluidymationJob::record_path(int frame) const {
+  return (fs::path(config_.out) / "tempera_fluidymation" / frame_file("frame_", frame, "txt")).string();
+}
+
+bool FluidymationJob::is_current(std::size_t index) const {
+  const int f = config_.frames[index];
+  std::error_code ec;
+  return config_.resume && fs::is_regular_file(output_path(f), ec) && fs::is_regular_file(state_path(f), ec) &&
+         read_record(record_path(f)) == keys_[index];
+}
+
+const Fluidymation& FluidymationJob::method() {
+  if (!method_) {
+    FluidSequence seq;
+    for (const Image& i : exemplar_) seq.exemplar.push_back(i.view());
+    for (const Image& i : exemplar_masks_) seq.exemplar_masks.push_back(i.view());
+    for (const Image& i : target_masks_) seq.target_masks.push_back(i.view());
+    for (const Image& i : target_flows_) seq.target_flows.push_back(i.view());
+    method_ = std::make_unique<Fluidymation>(seq, config_.options);
+  }
+  return *method_;
+}
+
+void FluidymationJob::write_frame(std::size_t index, const FluidFrame& r) {
+  const int f = config_.frames[index];
+  const Image& mask = target_masks_[index];
+  Image rgba(r.image.width(), r.image.height(), 4);
+  for (std::size_t q = 0; q < rgba.pixel_count(); ++q) {
+    std::copy_n(r.image.data() + 3 * q, 3, rgba.data() + 4 * q);
+    rgba.data()[4 * q + 3] = std::clamp(mask.data()[q], 0.0f, 1.0f);
+  }
+  write_image(output_path(f), rgba.view(), {"R", "G", "B", "A"});
+  write_image(state_path(f), r.nnf.view(), {"i", "x", "y", "phi"});
+  write_text_atomically(record_path(f), concat(kRecordFormat, "\n", keys_[index], "\n"), "Fluidymation frame record");
+}
+
+FluidJobFrame FluidymationJob::run_frame(std::size_t index, const ProgressCallback& progress) {
+  if (index >= config_.frames.size())
+    throw ValueError(concat("frame index ", index, " is outside the job's ", config_.frames.size(), " frames"));
+  const auto t0 = std::chrono::steady_clock::now();
+  if (is_current(index)) return {"skipped", 0.0};
+  if (config_.options.bidirectional) {
+    if (both_ways_.empty()) {
+      FluidSequence seq;
+      for (const Image& i : exemplar_) seq.exemplar.push_back(i.view());
+      for (const Image& i : exemplar_masks_) seq.exemplar_masks.push_back(i.view());
+      for (const Image& i : target_masks_) seq.target_masks.push_back(i.view());
+      for (const Image& i : target_flows_) seq.target_flows.push_back(i.view());
+      both_ways_ = stylize_fluid_sequence(seq, config_.options, progress);
+    }
+    write_frame(index, both_ways_[index]);
+  } else {
+    const FluidNnf* previous = nullptr;
+    FluidNnf loaded;
+    if (index > 0) {
+      if (last_index_ == index - 1) {
+        previous = &last_nnf_;
+      } else if (is_current(index - 1)) {
+        loaded = read_image(state_path(config_.frames[index - 1]), {"i", "x", "y", "phi"});
+        previous = &loaded;
+      } else {
+        run_frame(index - 1, progress);  // the frames before, in order; cancelling there cancels this one too
+        previous = &last_nnf_;
+      }
+    }
+    FluidFrame r = method().solve_frame(int(index), previous, progress);
+    write_frame(index, r);
+    last_nnf_ = std::move(r.nnf);
+    last_index_ = index;
+  }
+  return {"stylized", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()};
+}
+
+void FluidymationJob::write_contact_sheet(const std::string& path, int columns) const {
+  std::vector<Image> images;
+  Image first(exemplar_[0].width(), exemplar_[0].height(), 4);
+  for (std::size_t q = 0; q < first.pixel_count(); ++q) {
+    std::copy_n(exemplar_[0].data() + 3 * q, 3, first.data() + 4 * q);
+    first.data()[4 * q + 3] = exemplar_masks_[0].data()[q] > 0.5f ? 1.0f : 0.0f;
+  }
+  images.push_back(std::move(first));
+  std::error_code ec;
+  for (int f : config_.frames)
+    if (fs::is_regular_file(output_path(f), ec)) images.push_back(read_image(output_path(f), {"R", "G", "B", "A"}));
+  std::vector<ImageView> views;
+  for (const Image& i : images) views.push_back(i.view());
+  ContactSheetLayout layout;
+  layout.columns = columns;
+  layout.background = {1.0f, 1.0f, 1.0f, 0.0f};
+  write_image(path, contact_sheet(views, layout).view());
+}
+
+}  // namespace tempera

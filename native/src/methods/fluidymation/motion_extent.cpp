@@ -1,0 +1,48 @@
+#include "tempera/methods/fluidymation/motion_extent.hpp"
+
+#include <cmath>
+
+#include "tempera/engine/error.hpp"
+
+namespace tempera {
+namespace {
+
+// |acc| per frame, accumulating in the order of `order` (frame indices):
+// acc(order[k]) = acc(order[k-1]) + flows[from(k)], zeroed outside the mask.
+std::vector<Image> accumulate(const std::vector<ImageView>& flows, const std::vector<ImageView>& masks, bool forward) {
+  const std::size_t n = flows.size();
+  const std::size_t px = masks[0].pixel_count();
+  std::vector<Image> out(n);
+  std::vector<float> acc(2 * px, 0.0f);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = forward ? k : n - 1 - k;
+    if (k > 0) {
+      const ImageView& f = flows[forward ? i - 1 : i];  // acc+ adds the flow that led here, acc- the one leaving
+      for (std::size_t p = 0; p < 2 * px; ++p) acc[p] += f.data[p];
+    }
+    out[i] = Image(masks[i].width, masks[i].height, 1);
+    for (std::size_t p = 0; p < px; ++p) {
+      if (masks[i].data[p] <= 0.5f) acc[2 * p] = acc[2 * p + 1] = 0.0f;
+      out[i].data()[p] = std::hypot(acc[2 * p], acc[2 * p + 1]);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+MotionExtent motion_extent(const std::vector<ImageView>& flows, const std::vector<ImageView>& masks) {
+  if (flows.empty() || flows.size() != masks.size())
+    throw ValueError(concat("motion extent needs one flow per mask, got ", flows.size(), " flows and ", masks.size(),
+                            " masks"));
+  for (std::size_t i = 0; i < flows.size(); ++i) {
+    if (flows[i].channels != 2) throw ValueError(concat("flow ", i, " must have 2 channels, got ", flows[i].channels));
+    if (masks[i].channels != 1) throw ValueError(concat("mask ", i, " must have 1 channel, got ", masks[i].channels));
+    require_same_size(flows[i], concat("flow ", i), masks[0], "mask 0");
+    require_same_size(masks[i], concat("mask ", i), masks[0], "mask 0");
+    require_finite(flows[i], concat("flow ", i));
+  }
+  return {accumulate(flows, masks, true), accumulate(flows, masks, false)};
+}
+
+}  // namespace tempera

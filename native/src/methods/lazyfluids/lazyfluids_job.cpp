@@ -1,0 +1,273 @@
+#include "tempera/methods/lazyfluids/lazyfluids_job.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "tempera/app/contact_sheet.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/app/file_keys.hpp"
+#include "tempera/app/image_io.hpp"
+#include "tempera/app/paths.hpp"
+#include "tempera/app/text_file.hpp"
+
+namespace fs = std::filesystem;
+
+namespace tempera {
+namespace {
+
+constexpr const char* kRecordFormat = "tempera-lazyfluids-frame 1";
+constexpr const char* kStateFolder = "tempera_lazyfluids";
+const char* const kFlowGuides[] = {"fluid_velocity", "velocity_forward"};
+
+bool is_image_file(const fs::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext == ".png" || ext == ".exr" || ext == ".tif" || ext == ".tiff" || ext == ".jpg" || ext == ".jpeg";
+}
+
+// The exemplar's files: the image itself, or a folder's images sorted by name.
+std::vector<std::string> exemplar_files(const std::string& path) {
+  std::error_code ec;
+  if (fs::is_regular_file(path, ec)) return {path};
+  if (!fs::is_directory(path, ec)) throw FileNotFoundError(concat("exemplar not found: '", path, "'"));
+  std::vector<std::string> files;
+  for (const auto& entry : fs::directory_iterator(path, ec))
+    if (entry.is_regular_file() && is_image_file(entry.path()) && entry.path().filename().string()[0] != '.')
+      files.push_back(entry.path().string());
+  std::sort(files.begin(), files.end());
+  if (files.empty()) throw ValueError(concat("the exemplar folder '", path, "' has no image files (PNG, EXR, TIFF)"));
+  return files;
+}
+
+Image read_rgba(const std::string& file) {
+  Image image = read_image(file);
+  if (image.channels() != 4)
+    throw ValueError(concat("the exemplar '", file, "' has ", image.channels(),
+                            " channel(s); LazyFluids needs RGBA (the alpha is the fluid's shape)"));
+  require_finite(image.view(), concat("the exemplar '", file, "'"));
+  return image;
+}
+
+bool has_guide(const ImageFileInfo& info, const std::string& guide) {
+  return std::any_of(info.channel_names.begin(), info.channel_names.end(),
+                     [&](const std::string& c) { return c.rfind(guide + ".", 0) == 0; });
+}
+
+std::string frame_list(const std::vector<int>& frames) {
+  std::string out;
+  for (int f : frames) out += concat(out.empty() ? "" : ", ", f);
+  return out;
+}
+
+// A field's source positions (x + rx, y + ry) as a 2-channel float image,
+// and back: what a warm start of the next frame needs, exactly.
+Image field_positions(const OffsetField& field) {
+  Image out(field.width, field.height, 2);
+  for (std::size_t i = 0; i < out.pixel_count(); ++i)
+    out.data()[2 * i] = field.position_x(i), out.data()[2 * i + 1] = field.position_y(i);
+  return out;
+}
+
+OffsetField field_from_positions(const Image& positions) {
+  OffsetField field(positions.width(), positions.height());
+  for (std::size_t i = 0; i < positions.pixel_count(); ++i)
+    field.set_position(i, positions.data()[2 * i], positions.data()[2 * i + 1]);
+  return field;
+}
+
+void check_config(const LazyFluidsJobConfig& c) {
+  validate(c.options);
+  if (c.format != "png" && c.format != "exr") throw ValueError(concat("format must be png or exr, got '", c.format, "'"));
+  if (c.frames.empty()) throw ValueError("no frames to stylize");
+  for (std::size_t i = 1; i < c.frames.size(); ++i)
+    if (c.frames[i] != c.frames[i - 1] + 1)
+      throw ValueError(concat("LazyFluids needs consecutive frames (each is advected from the one before); frame ",
+                              c.frames[i - 1], " is followed by ", c.frames[i]));
+  if (c.out.empty()) throw ValueError("the output folder is required");
+  std::error_code ec;
+  if (!fs::is_directory(c.guides, ec)) throw FileNotFoundError(concat("guide cache folder not found: '", c.guides, "'"));
+}
+
+}  // namespace
+
+LazyFluidsJob::LazyFluidsJob(LazyFluidsJobConfig config) : config_(std::move(config)) {
+  check_config(config_);
+  exemplar_files_ = exemplar_files(config_.exemplar);
+  for (const std::string& file : exemplar_files_) {
+    exemplar_.push_back(read_rgba(file));
+    require_same_size(exemplar_.back().view(), concat("exemplar frame '", file, "'"), exemplar_.front().view(),
+                      "the first exemplar frame");
+  }
+  std::vector<int> fallback, zero;
+  int width = 0, height = 0;
+  for (int f : config_.frames) {
+    const std::string path = guide_path(f);
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec))
+      throw FileNotFoundError(concat("the guide cache '", config_.guides, "' has no frame_####.exr for frame ", f));
+    const ImageFileInfo info = inspect_image(path);
+    if (!has_guide(info, "alpha")) throw ValueError(concat("LazyFluids needs the 'alpha' guide in '", path, "'"));
+    if (f != config_.frames.front() && (info.width != width || info.height != height))
+      throw ValueError(concat("frame ", f, "'s guides are ", info.width, "x", info.height, " but frame ",
+                              config_.frames.front(), "'s are ", width, "x", height));
+    width = info.width, height = info.height;
+    const auto guide = std::find_if(std::begin(kFlowGuides), std::end(kFlowGuides),
+                                    [&](const char* g) { return has_guide(info, g); });
+    flow_guide_.push_back(guide == std::end(kFlowGuides) ? "" : *guide);
+    if (flow_guide_.back().empty()) zero.push_back(f);
+    else if (flow_guide_.back() != kFlowGuides[0]) fallback.push_back(f);
+  }
+  if (!fallback.empty())
+    warnings_.push_back(concat("no fluid_velocity guide in frame(s) ", frame_list(fallback),
+                               ": using velocity_forward as the flow"));
+  if (!zero.empty())
+    warnings_.push_back(concat("no fluid_velocity or velocity_forward guide in frame(s) ", frame_list(zero),
+                               ": the flow is zero there (nothing moves)"));
+  std::ostringstream s;
+  s << kRecordFormat << ";" << settings_text(config_.options, lazyfluids_option_table())
+    << settings_text(config_.options.synthesis, synthesis_option_table()) << "format=" << config_.format << ";";
+  for (const std::string& file : exemplar_files_) s << file_stamp(file) << ";";
+  settings_ = s.str();
+  std::error_code ec;
+  fs::create_directories(fs::path(config_.out) / kStateFolder, ec);
+  if (!fs::is_directory(fs::path(config_.out) / kStateFolder, ec))
+    throw IoError(concat("cannot create the output folder '", config_.out, "'"));
+}
+
+std::string LazyFluidsJob::guide_path(int frame) const {
+  return (fs::path(config_.guides) / frame_file("frame_", frame, "exr")).string();
+}
+
+std::string LazyFluidsJob::output_path(int frame) const {
+  return (fs::path(config_.out) / frame_file("frame_", frame, config_.format)).string();
+}
+
+std::string LazyFluidsJob::state_path(int frame) const {
+  return (fs::path(config_.out) / kStateFolder / frame_file("frame_", frame, "exr")).string();
+}
+
+std::string LazyFluidsJob::field_path(int frame) const {
+  return (fs::path(config_.out) / kStateFolder / frame_file("field_", frame, "exr")).string();
+}
+
+std::string LazyFluidsJob::record_path(int frame) const {
+  return (fs::path(config_.out) / kStateFolder / frame_file("frame_", frame, "txt")).string();
+}
+
+// Everything frame `index` depends on: the settings and exemplar, its own and
+// the previous frame's guide files, its index (the video exemplar's frame)
+// and the exact previous state.
+std::string LazyFluidsJob::frame_key(std::size_t index) const {
+  const int f = config_.frames[index];
+  std::string text = concat(settings_, "\nframe ", f, " index ", index, "\n", file_stamp(guide_path(f)));
+  if (index > 0) {
+    const FileDigest previous = file_digest(state_path(f - 1));
+    text += concat("\n", file_stamp(guide_path(f - 1)), "\nprevious ", previous.size, " ", previous.checksum);
+    if (config_.options.warm_start) {
+      const FileDigest field = file_digest(field_path(f - 1));
+      text += concat("\nprevious field ", field.size, " ", field.checksum);
+    }
+  }
+  return hash_hex(text);
+}
+
+bool LazyFluidsJob::is_current(std::size_t index) const {
+  const int f = config_.frames[index];
+  std::ifstream in(record_path(f));
+  std::string line;
+  if (!in || !std::getline(in, line) || line != kRecordFormat) return false;
+  if (!std::getline(in, line) || line != frame_key(index)) return false;
+  for (const std::string& path : {output_path(f), state_path(f)}) {
+    FileDigest recorded;
+    if (!(in >> recorded.size >> recorded.checksum) || !(file_digest(path) == recorded)) return false;
+  }
+  return true;
+}
+
+Image LazyFluidsJob::read_flow(int frame) const {
+  const std::size_t index = std::size_t(frame - config_.frames.front());
+  const std::string& guide = flow_guide_[index];
+  if (guide.empty()) {
+    const ImageFileInfo info = inspect_image(guide_path(frame));
+    return Image(info.width, info.height, 2, 0.0f);
+  }
+  return Image::copy_of(GuideFrame::read(guide_path(frame), {guide}).get(guide).view());
+}
+
+FrameResult LazyFluidsJob::run_frame(std::size_t index, const ProgressCallback& progress) {
+  if (index >= config_.frames.size())
+    throw ValueError(concat("frame index ", index, " is out of range (", config_.frames.size(), " frames)"));
+  const int f = config_.frames[index];
+  FrameResult result;
+  result.frame = f;
+  result.path = output_path(f);
+  result.flicker = std::numeric_limits<double>::quiet_NaN();
+  if (index > 0 && !is_current(index - 1))
+    throw ValueError(concat("frame ", f, " continues frame ", f - 1, ", which is not done yet: run it first"));
+  if (config_.resume && is_current(index)) {
+    result.status = "skipped";
+    return result;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const Image alpha = Image::copy_of(GuideFrame::read(guide_path(f), {"alpha"}).get("alpha").view());
+  // The exact float state, never the 8-bit output: resumed == uninterrupted.
+  const Image flow_previous = index == 0 ? Image() : read_flow(f - 1);
+  const Image advected = index == 0 ? Image() : advect_output(read_image(state_path(f - 1)).view(), flow_previous.view());
+  const std::size_t m = exemplar_.size();
+  FluidFrameInput in;
+  in.style = exemplar_[index % m].view();
+  in.previous_style = exemplar_[index == 0 ? 0 : (index - 1) % m].view();
+  in.target_alpha = alpha.view();
+  if (index > 0) in.advected = advected.view();
+  OffsetField previous_field;
+  std::error_code ec;
+  if (index > 0 && config_.options.warm_start && fs::is_regular_file(field_path(f - 1), ec)) {
+    previous_field = field_from_positions(read_image(field_path(f - 1)));
+    in.previous_field = &previous_field;
+    in.flow_previous = flow_previous.view();
+  }
+  const FluidFrameResult frame = stylize_fluid_frame(in, config_.options, progress);
+  write_frame(index, frame);
+  result.status = "stylized";
+  result.source_coverage = frame.synthesis.source_coverage;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return result;
+}
+
+// The state, the output (motion-blurred when asked) and then the record,
+// each atomically: a crash leaves either no record or a matching one.
+void LazyFluidsJob::write_frame(std::size_t index, const FluidFrameResult& frame) const {
+  const int f = config_.frames[index];
+  const Image& state = frame.image;
+  std::error_code ec;
+  if (config_.options.warm_start && !frame.synthesis.field.x.empty())
+    write_image(field_path(f), field_positions(frame.synthesis.field).view());
+  else
+    fs::remove(field_path(f), ec);  // an empty frame: the next one starts cold
+  const float blur = config_.options.motion_blur;
+  const Image output = blur > 0 ? motion_blur_along_flow(state.view(), read_flow(f).view(), blur) : Image();
+  write_image(state_path(f), state.view());
+  write_image(output_path(f), blur > 0 ? output.view() : state.view());
+  std::ostringstream record;
+  record << kRecordFormat << "\n" << frame_key(index) << "\n";
+  for (const std::string& path : {output_path(f), state_path(f)}) {
+    const FileDigest d = file_digest(path);
+    record << d.size << " " << d.checksum << "\n";
+  }
+  write_text_atomically(record_path(f), record.str(), "the frame record");
+}
+
+void LazyFluidsJob::write_contact_sheet(const std::string& path, int columns) const {
+  for (const std::string& file : exemplar_files_)
+    if (same_path(path, file)) throw ValueError(concat("the contact sheet '", path, "' would overwrite the exemplar"));
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (int frame : config_.frames)
+    if (fs::is_regular_file(output_path(frame), ec)) files.push_back(output_path(frame));
+  write_frames_contact_sheet(path, exemplar_.front().view(), files, columns);
+}
+
+}  // namespace tempera

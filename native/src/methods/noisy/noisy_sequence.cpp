@@ -1,0 +1,160 @@
+#include "tempera/methods/noisy/noisy_sequence.hpp"
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "tempera/engine/error.hpp"
+#include "tempera/app/file_keys.hpp"
+#include "tempera/app/image_io.hpp"
+#include "tempera/methods/stylit/stylit.hpp"
+#include "tempera/methods/stylit/stylize_job.hpp"
+#include "tempera/app/text_file.hpp"
+
+namespace fs = std::filesystem;
+
+namespace tempera {
+namespace {
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+fs::path key_path(const std::string& out, int frame) {
+  return fs::path(out) / ".tempera_noisy" / frame_file("", frame, "key");
+}
+
+}  // namespace
+
+NoisySequence::NoisySequence(NoisySequenceConfig config) : config_(std::move(config)) {
+  const NoisySequenceConfig& c = config_;
+  validate_fields(c.options, noisy_option_table());
+  validate(c.options.synthesis);
+  if (c.frames.empty()) throw ValueError("no frames to make (give a frame range)");
+  if (c.exemplar.empty()) throw ValueError("the exemplar (a sample of the medium) is required");
+  if (c.reference.empty()) throw ValueError("the folder of coherent reference frames is required");
+  if (c.out.empty()) throw ValueError("the output folder is required");
+  if (!fs::is_directory(c.reference))
+    throw FileNotFoundError(concat("the reference folder '", c.reference, "' does not exist"));
+  if (fs::weakly_canonical(c.out) == fs::weakly_canonical(c.reference))
+    throw ValueError("the output folder must not be the reference folder (the frames would be overwritten)");
+  for (int frame : c.frames)
+    if (!fs::is_regular_file(reference_path(frame)))
+      throw FileNotFoundError(concat("reference frame not found: '", reference_path(frame), "'"));
+  medium_ = read_image(c.exemplar);
+  settings_ = settings_text(c.options, noisy_option_table()) + settings_text(c.options.synthesis, synthesis_option_table()) +
+              file_stamp(c.exemplar);
+  if (guided()) read_exemplar_guides();
+  if (!c.noise_map.empty()) {
+    map_file_ = fs::is_regular_file(c.noise_map);
+    if (map_file_) {
+      file_map_ = extract_channels(read_image(c.noise_map).view(), 0, 1);
+      settings_ += "|map " + file_stamp(c.noise_map);
+    } else if (c.guides.empty()) {
+      throw ValueError(concat("the noise map '", c.noise_map,
+                              "' is neither an image file nor a guide (a guide needs the guide cache folder)"));
+    } else {
+      settings_ += "|guide map " + c.noise_map;
+      noise_map(c.frames.front());  // names a missing guide now, not after hours
+    }
+  }
+}
+
+// Guided noise: the active light-path guides and the exemplar's side, read
+// once; the frame's side is read per frame (and its file is in the key).
+void NoisySequence::read_exemplar_guides() {
+  const NoisySequenceConfig& c = config_;
+  if (c.guides.empty()) throw ValueError("guided noise (noise_guides > 0) needs the frames' guide cache (--guides)");
+  if (c.exemplar_guides.empty())
+    throw ValueError("guided noise (noise_guides > 0) needs the exemplar's guide cache (--exemplar-guides)");
+  if (!fs::is_directory(c.exemplar_guides))
+    throw FileNotFoundError(concat("the exemplar guide folder '", c.exemplar_guides, "' does not exist"));
+  StylitOptions weights;
+  weights.weights = c.guide_weights;
+  light_path_ = active_guides(weights);
+  std::vector<std::string> names;
+  for (const auto& [name, weight] : light_path_) names.push_back(name);
+  const std::string path =
+      (fs::path(c.exemplar_guides) / frame_file("frame_", exemplar_guide_frame(c.exemplar_guides, c.exemplar_frame), "exr"))
+          .string();
+  const GuideFrame exemplar = GuideFrame::read(path, names);
+  for (const auto& [name, weight] : light_path_) {
+    const Image& g = exemplar.get(name);
+    if (g.width() != medium_.width() || g.height() != medium_.height())
+      throw ValueError(concat("the exemplar guide '", name, "' of '", path, "' is ", g.width(), "x", g.height(),
+                              " but the exemplar '", c.exemplar, "' is ", medium_.width(), "x", medium_.height()));
+    exemplar_guides_.push_back(tonemap_guide(g.view()));
+    settings_ += concat("|guide ", name, "=", weight);
+  }
+  settings_ += "|exemplar guides " + file_stamp(path);
+  frame_guides(c.frames.front());  // names a missing guide frame now, not after hours
+}
+
+std::vector<Image> NoisySequence::frame_guides(int frame) const {
+  std::vector<std::string> names;
+  for (const auto& [name, weight] : light_path_) names.push_back(name);
+  const GuideFrame g = GuideFrame::read(guide_path(frame), names);
+  std::vector<Image> out;
+  for (const std::string& name : names) out.push_back(tonemap_guide(g.get(name).view()));
+  return out;
+}
+
+std::string NoisySequence::reference_path(int frame) const {
+  return (fs::path(config_.reference) / frame_file(config_.prefix, frame, "png")).string();
+}
+
+std::string NoisySequence::guide_path(int frame) const {
+  return (fs::path(config_.guides) / frame_file("frame_", frame, "exr")).string();
+}
+
+std::string NoisySequence::output_path(int frame) const {
+  return (fs::path(config_.out) / frame_file(config_.prefix, frame, "png")).string();
+}
+
+Image NoisySequence::noise_map(int frame) const {
+  if (config_.noise_map.empty()) return {};
+  if (map_file_) return Image::copy_of(file_map_.view());
+  const GuideFrame g = GuideFrame::read(guide_path(frame), {config_.noise_map});
+  return extract_channels(g.get(config_.noise_map).view(), 0, 1);
+}
+
+std::string NoisySequence::key(int frame) const {
+  std::string text = concat(settings_, "|", frame, "|", file_stamp(reference_path(frame)));
+  if (map_is_guide() || guided()) text += "|" + file_stamp(guide_path(frame));
+  return hash_hex(text);
+}
+
+NoisyFrameResult NoisySequence::run_frame(std::size_t index, const ProgressCallback& progress) {
+  if (index >= config_.frames.size())
+    throw ValueError(concat("frame index ", index, " out of range (", config_.frames.size(), " frames)"));
+  const int frame = config_.frames[index];
+  NoisyFrameResult result{frame, output_path(frame), "skipped", 0};
+  const fs::path key_file = key_path(config_.out, frame);
+  const std::string k = key(frame);
+  if (config_.resume && fs::is_regular_file(result.path) && fs::is_regular_file(key_file) && read_text(key_file) == k)
+    return result;
+  const auto t0 = std::chrono::steady_clock::now();
+  const Image r = read_image(reference_path(frame));
+  const Image map = noise_map(frame);
+  std::vector<Image> targets;
+  std::vector<NoisyGuide> guides;
+  if (guided()) {
+    targets = frame_guides(frame);
+    for (std::size_t i = 0; i < targets.size(); ++i)
+      guides.push_back({light_path_[i].first, exemplar_guides_[i].view(), targets[i].view(), light_path_[i].second});
+  }
+  const Image out = noisy_frame(medium_.view(), r.view(), frame, config_.options, map.empty() ? ImageView{} : map.view(),
+                                progress, guides);
+  fs::create_directories(key_file.parent_path());
+  write_image(result.path, out.view());  // atomic
+  write_text_atomically(key_file.string(), k, "the resume key");
+  result.status = "made";
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return result;
+}
+
+}  // namespace tempera

@@ -1,0 +1,212 @@
+#include "tempera/methods/stylit/stylit.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "tempera/engine/error.hpp"
+#include "tempera/app/image_io.hpp"
+#include "tempera/engine/motion.hpp"
+#include "tempera/engine/option_table.hpp"
+#include "tempera/engine/parallel.hpp"
+
+namespace tempera {
+namespace {
+
+bool is_light_path_guide(const std::string& name) {
+  const auto& known = light_path_guides();
+  return std::any_of(known.begin(), known.end(), [&](const LightPathGuide& g) { return name == g.name; });
+}
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
+// The guide a channel name belongs to: "FULL.R" -> "FULL", "mask.OB_a.V" -> "mask.OB_a".
+std::string guide_of_channel(const std::string& channel) {
+  const std::size_t dot = channel.rfind('.');
+  return dot == std::string::npos ? channel : channel.substr(0, dot);
+}
+
+double srgb_encode(double x) {
+  x = std::clamp(x, 0.0, 1.0);
+  return x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055;
+}
+
+void require_channels(const ImageView& image, int channels, const char* what) {
+  if (image.channels != channels)
+    throw ValueError(concat(what, " must have ", channels, " channel(s), got ", image.channels));
+}
+
+}  // namespace
+
+std::string light_path_guide_names() {
+  std::string out;
+  for (const auto& g : light_path_guides()) out += (out.empty() ? "" : ", ") + std::string(g.name);
+  return out;
+}
+
+void parse_guide_weights(const std::string& text, std::vector<std::pair<std::string, float>>& weights) {
+  std::size_t start = 0;
+  while (start < text.size()) {
+    const std::size_t end = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, end - start);
+    const std::size_t eq = item.find('=');
+    if (eq == std::string::npos) throw ValueError(concat("--weights expects NAME=W items, got '", item, "'"));
+    const std::string name = item.substr(0, eq);
+    auto it = std::find_if(weights.begin(), weights.end(), [&](auto& w) { return w.first == name; });
+    if (it == weights.end())
+      throw ValueError(concat("unknown guide '", name, "' in --weights (", light_path_guide_names(), ")"));
+    it->second = parse_number<float>(item.substr(eq + 1), concat("--weights '", item, "'"));
+    start = end + 1;
+  }
+}
+
+const Image& GuideFrame::get(const std::string& name) const {
+  auto it = guides.find(name);
+  if (it == guides.end()) {
+    std::vector<std::string> have;
+    for (const auto& [n, image] : guides) have.push_back(n);
+    throw ValueError(concat("guide '", name, "' missing from '", origin, "' (it has: ", joined(have), ")"));
+  }
+  return it->second;
+}
+
+GuideFrame GuideFrame::read(const std::string& path, const std::vector<std::string>& names) {
+  const ImageFileInfo info = inspect_image(path);
+  std::vector<std::string> channels;
+  std::vector<int> counts;
+  for (const auto& name : names) {
+    int count = 0;
+    for (const auto& channel : info.channel_names)
+      if (guide_of_channel(channel) == name) channels.push_back(channel), ++count;
+    if (count == 0) {
+      std::vector<std::string> have;
+      for (const auto& channel : info.channel_names)
+        if (std::find(have.begin(), have.end(), guide_of_channel(channel)) == have.end())
+          have.push_back(guide_of_channel(channel));
+      throw ValueError(concat("guide '", name, "' missing from '", path, "' (it has: ", joined(have), ")"));
+    }
+    counts.push_back(count);
+  }
+  GuideFrame frame;
+  frame.origin = path;
+  if (names.empty()) return frame;
+  // One read of the file, then split: cache frames hold dozens of channels.
+  const Image all = read_image(path, channels);
+  int first = 0;
+  for (std::size_t i = 0; i < names.size(); first += counts[i++])
+    frame.guides[names[i]] = extract_channels(all.view(), first, counts[i]);
+  return frame;
+}
+
+Image tonemap_guide(const ImageView& linear) {
+  require_nonempty(linear, "light-path guide");
+  Image out(linear.width, linear.height, linear.channels);
+  const std::size_t n = linear.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    double x = linear.data[i];
+    if (std::isnan(x) || x < 0) x = 0;
+    if (std::isinf(x)) x = 1e6;
+    out.data()[i] = float(srgb_encode(x / (1.0 + x)));
+  }
+  return out;
+}
+
+Quality parse_quality(const std::string& name) {
+  if (name == "final") return Quality::Final;
+  if (name == "preview") return Quality::Preview;
+  throw ValueError(concat("unknown quality '", name, "' (choose preview or final)"));
+}
+
+const char* quality_name(Quality quality) { return quality == Quality::Preview ? "preview" : "final"; }
+
+std::vector<std::pair<std::string, float>> active_guides(const StylitOptions& options) {
+  std::vector<std::pair<std::string, float>> out;
+  std::vector<std::string> seen;
+  for (const auto& [name, weight] : options.weights) {
+    if (!is_light_path_guide(name))
+      throw ValueError(concat("unknown guide '", name, "' (StyLit guides: ", light_path_guide_names(), ")"));
+    if (std::find(seen.begin(), seen.end(), name) != seen.end())
+      throw ValueError(concat("guide '", name, "' is weighted twice"));
+    if (!std::isfinite(weight)) throw ValueError(concat("weight of guide '", name, "' is not finite"));
+    seen.push_back(name);
+    if (weight > 0) out.emplace_back(name, weight);
+  }
+  if (out.empty()) throw ValueError("every guide weight is <= 0; at least one light-path guide must be used");
+  if (!std::isfinite(options.temporal_weight) || options.temporal_weight < 0)
+    throw ValueError(concat("temporal weight must be finite and >= 0, got ", options.temporal_weight));
+  return out;
+}
+
+SynthesisOptions engine_options(const StylitOptions& options) {
+  SynthesisOptions opt = options.synthesis;
+  if (options.quality == Quality::Preview) {
+    // Measured at 320x240 (docs/engine.md): about 5x faster than final; the
+    // coarse levels settle with few iterations and the finest level gets the
+    // error-budget rounds that matter most for the look.
+    opt.em_iterations = 2;
+    opt.pm_iterations = 1;
+    opt.budget_max_rounds = 4;
+  }
+  return opt;
+}
+
+SynthesisResult stylize_frame(const ImageView& style, const GuideFrame& exemplar, const GuideFrame& target,
+                              const TemporalInput* temporal, const StylitOptions& options,
+                              const ProgressCallback& progress) {
+  require_nonempty(style, "style");
+  const auto guides = active_guides(options);
+  // Tone-mapped copies must outlive the engine call: the stack holds views.
+  std::vector<Image> tonemapped;
+  tonemapped.reserve(2 * guides.size() + 1);
+  SynthesisInput in;
+  in.style = style;
+  for (const auto& [name, weight] : guides) {
+    const Image& src = exemplar.get(name);
+    const Image& tgt = target.get(name);
+    if (src.width() != style.width || src.height() != style.height)
+      throw ValueError(concat("exemplar guide '", name, "' of '", exemplar.origin, "' is ", src.width(), "x",
+                              src.height(), " but the style is ", style.width, "x", style.height));
+    tonemapped.push_back(tonemap_guide(src.view()));
+    tonemapped.push_back(tonemap_guide(tgt.view()));
+    in.guides.add(name, tonemapped[tonemapped.size() - 2].view(), tonemapped.back().view(), weight);
+  }
+  if (temporal && options.temporal_weight > 0) {
+    const ImageView tgt = in.guides.layers().front().target;
+    require_channels(temporal->previous, style.channels, "previous stylized frame");
+    require_same_size(temporal->previous, "previous stylized frame", tgt, "the target guides");
+    require_channels(temporal->occlusion_backward, 1, "occlusion_backward");
+    require_same_size(temporal->occlusion_backward, "occlusion_backward", tgt, "the target guides");
+    tonemapped.push_back(warp_backward(temporal->previous, temporal->velocity_backward));
+    // Source side is the painting itself: a target pixel is pulled towards the
+    // paint it showed in the previous frame, carried along with the surface.
+    in.guides.add("temporal", style, tonemapped.back().view(), options.temporal_weight);
+    in.target_weight_maps.assign(guides.size(), ImageView{});
+    in.target_weight_maps.push_back(temporal->occlusion_backward);  // disoccluded: no pull
+  }
+  return synthesize(in, engine_options(options), progress);
+}
+
+double flicker(const ImageView& previous, const ImageView& current, const ImageView& velocity_backward,
+               const ImageView& visible) {
+  require_same_size(previous, "previous frame", current, "current frame");
+  if (previous.channels != current.channels)
+    throw ValueError(concat("previous frame has ", previous.channels, " channels, current frame ",
+                            current.channels));
+  require_channels(visible, 1, "visibility");
+  require_same_size(visible, "visibility", current, "current frame");
+  const Image advected = warp_backward(previous, velocity_backward);
+  double sum = 0;
+  std::size_t count = 0;
+  for (int y = 0; y < current.height; ++y)
+    for (int x = 0; x < current.width; ++x) {
+      if (visible.at(x, y, 0) == 0.0f) continue;
+      for (int c = 0; c < current.channels; ++c) sum += std::abs(double(current.at(x, y, c)) - advected.at(x, y, c));
+      count += std::size_t(current.channels);
+    }
+  return count ? sum / double(count) : 0.0;
+}
+
+}  // namespace tempera

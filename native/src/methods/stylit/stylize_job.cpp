@@ -1,0 +1,453 @@
+#include "tempera/methods/stylit/stylize_job.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include "tempera/app/contact_sheet.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/app/file_keys.hpp"
+#include "tempera/app/image_io.hpp"
+#include "tempera/app/paths.hpp"
+#include "tempera/app/text_file.hpp"
+
+namespace fs = std::filesystem;
+
+namespace tempera {
+namespace {
+
+constexpr const char* kReportName = "tempera_stylize.json";
+constexpr const char* kReportFormat = "tempera-stylize 2";
+
+void require_file(const std::string& path, const std::string& what) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) throw FileNotFoundError(concat(what, " not found: '", path, "'"));
+}
+
+void require_folder(const std::string& path, const std::string& what) {
+  std::error_code ec;
+  if (!fs::is_directory(path, ec)) throw FileNotFoundError(concat(what, " folder not found: '", path, "'"));
+}
+
+// The frame numbers of the frame_####.exr files in a guide cache folder.
+std::vector<int> cached_frames(const std::string& folder) {
+  std::vector<int> frames;
+  for (const auto& entry : fs::directory_iterator(folder)) {
+    const std::string name = entry.path().filename().string();
+    if (name.size() <= 10 || name.rfind("frame_", 0) != 0 || entry.path().extension() != ".exr") continue;
+    const std::string digits = name.substr(6, name.size() - 10);
+    if (digits.empty() || !std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c); }))
+      continue;
+    int frame = 0;
+    const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), frame);
+    // A number no frame can have (beyond Blender's last frame) is not a cache frame.
+    if (ec == std::errc() && end == digits.data() + digits.size() && frame <= kMaxFrame) frames.push_back(frame);
+  }
+  std::sort(frames.begin(), frames.end());
+  return frames;
+}
+
+std::string guide_cache_frame(const std::string& folder, int frame) {
+  return (fs::path(folder) / frame_file("frame_", frame, "exr")).string();
+}
+
+// Canonical text of everything that changes a stylized frame but the files.
+// Threads are left out: the engine's result does not depend on them.
+std::string settings_text(const StylizeJobConfig& c) {
+  const SynthesisOptions o = engine_options(c.stylit);
+  std::ostringstream s;
+  s << "weights=";
+  for (const auto& [name, weight] : active_guides(c.stylit)) s << name << ":" << weight << ",";
+  s << ";temporal=" << c.stylit.temporal_weight << ";quality=" << quality_name(c.stylit.quality) << ";"
+    << settings_text(o, synthesis_option_table()) << "format=" << c.format;
+  return s.str();
+}
+
+std::string json_string(const std::string& text) {
+  std::ostringstream out;
+  out << '"';
+  for (unsigned char c : text) {
+    if (c == '"' || c == '\\') out << '\\' << c;
+    else if (c < 0x20) out << "\\u" << std::hex << std::setw(4) << std::setfill('0') << int(c) << std::dec;
+    else out << c;
+  }
+  out << '"';
+  return out.str();
+}
+
+std::string json_number(double value) {
+  if (!std::isfinite(value)) return "null";
+  std::ostringstream out;
+  out << std::setprecision(9) << value;
+  return out.str();
+}
+
+// Reads one report line as write_report() writes it, left to right:
+//   "12": {"key": "...", "file": "...", "flicker": 0.01, "source_coverage": 0.9},
+class LineReader {
+ public:
+  explicit LineReader(const std::string& line) : line_(line) {}
+  void expect(const std::string& text) {
+    skip_spaces();
+    if (line_.compare(pos_, text.size(), text) != 0) throw ValueError("unexpected report text");
+    pos_ += text.size();
+  }
+  std::string string() {
+    expect("\"");
+    std::string out;
+    while (pos_ < line_.size() && line_[pos_] != '"') {
+      char c = line_[pos_++];
+      if (c == '\\' && pos_ < line_.size()) {
+        c = line_[pos_++];
+        if (c == 'u') {  // only control characters are written this way
+          c = char(std::stoi(line_.substr(pos_, 4), nullptr, 16));
+          pos_ += 4;
+        }
+      }
+      out += c;
+    }
+    expect("\"");
+    return out;
+  }
+  double number() {
+    skip_spaces();
+    if (line_.compare(pos_, 4, "null") == 0) {
+      pos_ += 4;
+      return std::numeric_limits<double>::quiet_NaN();
+    }
+    std::size_t used = 0;
+    const double value = std::stod(line_.substr(pos_), &used);
+    pos_ += used;
+    return value;
+  }
+
+ private:
+  void skip_spaces() {
+    while (pos_ < line_.size() && line_[pos_] == ' ') ++pos_;
+  }
+  const std::string& line_;
+  std::size_t pos_ = 0;
+};
+
+struct ReportEntry {
+  std::string key, file;
+  double flicker = 0, source_coverage = 0;
+  FileDigest digest;  // of the output file as written: a changed or damaged file is redone
+};
+
+// Reads exactly the format write_report() writes: one frame per line. A file
+// that is not such a report (damaged, or from another Tempera version) is
+// renamed aside with a warning and counts as "no frames done": its frames
+// are redone, never wrongly skipped, and nothing of it is lost.
+std::map<int, ReportEntry> read_report(const std::string& path, std::vector<std::string>& warnings) {
+  std::map<int, ReportEntry> entries;
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return entries;
+  std::ifstream in(path);
+  std::string line;
+  bool ok = in && std::getline(in, line) && line == "{" && std::getline(in, line) &&
+            line == concat("  \"format\": ", json_string(kReportFormat), ",");
+  bool closed = false;  // the final "}": a truncated record is damaged, not short
+  try {
+    while (ok && std::getline(in, line)) {
+      if (closed) ok = false;  // text after the end
+      if (line == "}") closed = true;
+      if (line.find("{\"key\": ") == std::string::npos) {
+        if (line.find("\"key\"") != std::string::npos) ok = false;
+        continue;
+      }
+      LineReader r(line);
+      const std::string number = r.string();
+      int frame = -1;
+      const auto [end, error] = std::from_chars(number.data(), number.data() + number.size(), frame);
+      if (error != std::errc() || end != number.data() + number.size() || frame < 0 || frame > kMaxFrame)
+        throw ValueError("bad frame number");
+      ReportEntry e;
+      r.expect(": {\"key\":");
+      e.key = r.string();
+      r.expect(", \"file\":");
+      e.file = r.string();
+      r.expect(", \"flicker\":");
+      e.flicker = r.number();
+      r.expect(", \"source_coverage\":");
+      e.source_coverage = r.number();
+      r.expect(", \"size\":");
+      e.digest.size = std::int64_t(r.number());
+      r.expect(", \"checksum\":");
+      e.digest.checksum = r.string();
+      r.expect("}");
+      entries[frame] = e;
+    }
+  } catch (const std::exception&) {
+    ok = false;
+  }
+  if (ok && closed) return entries;
+  const std::string aside = concat(path, ".corrupt-", temporary_name("", "").substr(5));
+  fs::rename(path, aside, ec);
+  warnings.push_back(concat("the resume record '", path, "' is damaged or from another Tempera version; ",
+                            ec ? "it is ignored" : concat("set aside as '", aside, "'"),
+                            " and its frames are stylized again"));
+  return {};
+}
+
+
+void write_report(const std::string& path, const std::string& settings, const std::map<int, ReportEntry>& entries) {
+  std::ostringstream out;
+  out << "{\n  \"format\": " << json_string(kReportFormat) << ",\n  \"settings\": " << json_string(settings)
+      << ",\n  \"frames\": {";
+  std::size_t i = 0;
+  for (const auto& [frame, e] : entries)
+    out << (i++ ? ",\n" : "\n") << "    \"" << frame << "\": {\"key\": " << json_string(e.key)
+        << ", \"file\": " << json_string(e.file) << ", \"flicker\": " << json_number(e.flicker)
+        << ", \"source_coverage\": " << json_number(e.source_coverage) << ", \"size\": " << e.digest.size
+        << ", \"checksum\": " << json_string(e.digest.checksum) << "}";
+  out << "\n  }\n}\n";
+  write_text_atomically(path, out.str(), "the job report");
+}
+
+// Temporary files (".<name>.tmp<pid>-<random>...") of writers killed with -9.
+// A live writer holds one for the seconds an image takes to write, so one
+// older than an hour is dead; it is never read, only removed here.
+void remove_stale_temporaries(const std::string& folder) {
+  std::error_code ec;
+  const auto now = fs::file_time_type::clock::now();
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() < 2 || name[0] != '.' || name.find(".tmp") == std::string::npos) continue;
+    std::error_code stat_ec;
+    const auto written = fs::last_write_time(it->path(), stat_ec);
+    if (!stat_ec && now - written > std::chrono::hours(1) && fs::is_regular_file(it->path(), stat_ec))
+      fs::remove(it->path(), stat_ec);
+  }
+}
+
+void validate_config(const StylizeJobConfig& c) {
+  if (c.format != "png" && c.format != "exr")
+    throw ValueError(concat("unknown output format '", c.format, "' (choose png or exr)"));
+  if (c.prefix.find('/') != std::string::npos) throw ValueError(concat("prefix '", c.prefix, "' must not contain '/'"));
+  if (c.frames.empty()) throw ValueError("no frames to stylize");
+  for (int frame : c.frames)
+    if (frame < 0 || frame > kMaxFrame)
+      throw ValueError(concat("frame numbers must be from 0 to ", kMaxFrame, " (Blender's last frame), got ", frame));
+  std::vector<int> sorted = c.frames;  // n log n: a million frames are checked at once
+  std::sort(sorted.begin(), sorted.end());
+  const auto twice = std::adjacent_find(sorted.begin(), sorted.end());
+  if (twice != sorted.end()) throw ValueError(concat("frame ", *twice, " is listed twice"));
+  if (c.out.empty()) throw ValueError("no output folder given");
+  const SynthesisOptions& o = c.stylit.synthesis;
+  if (o.patch_size < 3 || o.patch_size % 2 == 0)
+    throw ValueError(concat("patch size must be odd and >= 3, got ", o.patch_size));
+  if (o.threads < 0) throw ValueError(concat("threads must be >= 0 (0 = all cores), got ", o.threads));
+  active_guides(c.stylit);
+}
+
+// The painting at the exemplar guides' size: same aspect within 1% is
+// resampled (a photo of the template rarely lands on the exact pixel size).
+Image fit_painting(Image painting, const std::string& path, int width, int height,
+                   std::vector<std::string>& warnings) {
+  if (painting.width() == width && painting.height() == height) return painting;
+  const double aspect = double(painting.width()) / painting.height(), target = double(width) / height;
+  if (std::abs(aspect / target - 1.0) > 0.01)
+    throw ValueError(concat("the painting '", path, "' is ", painting.width(), "x", painting.height(),
+                            " but the exemplar guides are ", width, "x", height,
+                            "; the aspect ratios differ (paint on the exemplar's template)"));
+  warnings.push_back(concat("the painting '", path, "' is ", painting.width(), "x", painting.height(),
+                            "; resampled to the exemplar guides' ", width, "x", height));
+  return resize_image(painting.view(), width, height);
+}
+
+}  // namespace
+
+int exemplar_guide_frame(const std::string& folder, std::optional<int> frame) {
+  if (frame) return *frame;
+  const std::vector<int> found = cached_frames(folder);
+  if (found.empty())
+    throw FileNotFoundError(concat("no frame_####.exr in the exemplar guide folder '", folder, "'"));
+  if (found.size() > 1) {
+    std::string list;
+    for (int f : found) list += concat(list.empty() ? "" : ", ", f);
+    throw ValueError(concat("the exemplar guide folder '", folder, "' holds ", found.size(),
+                            " frames (", list, "); choose one with Exemplar Frame (--exemplar-frame)"));
+  }
+  return found.front();
+}
+
+StylizeJob::StylizeJob(StylizeJobConfig config) : config_(std::move(config)) {
+  validate_config(config_);
+  const auto guides = active_guides(config_.stylit);
+  std::vector<std::string> names;
+  for (const auto& [name, weight] : guides) names.push_back(name);
+
+  require_file(config_.style, "painting");
+  require_folder(config_.exemplar_guides, "exemplar guide");
+  exemplar_path_ =
+      guide_cache_frame(config_.exemplar_guides, exemplar_guide_frame(config_.exemplar_guides, config_.exemplar_frame));
+  require_file(exemplar_path_, "exemplar guide frame");
+  exemplar_ = GuideFrame::read(exemplar_path_, names);
+  const Image& first = exemplar_.get(names.front());
+  Image painting = read_image(config_.style);
+  require_finite(painting.view(), concat("the painting '", config_.style, "'"));
+  style_ = fit_painting(std::move(painting), config_.style, first.width(), first.height(), warnings_);
+
+  require_folder(config_.guides, "guide cache");
+  std::string missing;
+  for (int frame : config_.frames) {
+    std::error_code ec;
+    if (!fs::is_regular_file(target_path(frame), ec)) missing += concat(missing.empty() ? "" : ", ", frame);
+  }
+  if (!missing.empty())
+    throw FileNotFoundError(concat("the guide cache '", config_.guides, "' has no frame_####.exr for frame(s) ",
+                                   missing, " (render them with tempera render-guides)"));
+  check_target_guides(names);
+
+  // The stylized frames would replace guide frames (frame_0001.exr) or
+  // the painting: refuse before anything is written.
+  for (const auto& [folder, what] : {std::pair{config_.guides, "guide cache"},
+                                     std::pair{config_.exemplar_guides, "exemplar guide cache"}})
+    if (same_path(config_.out, folder))
+      throw ValueError(concat("the output folder '", config_.out, "' is the ", what, " folder: the stylized frames "
+                              "would overwrite the guides; choose another output folder"));
+  for (int frame : config_.frames)
+    if (same_path(output_path(frame), config_.style))
+      throw ValueError(concat("the stylized frame '", output_path(frame), "' would overwrite the painting '",
+                              config_.style, "'; choose another output folder"));
+  std::error_code ec;
+  fs::create_directories(config_.out, ec);
+  if (!fs::is_directory(config_.out, ec))
+    throw IoError(concat("cannot create the output folder '", config_.out, "'", ec ? ": " + ec.message() : ""));
+  remove_stale_temporaries(config_.out);
+  settings_ = settings_text(config_);
+  const std::string base = hash_hex(settings_ + "\n" + file_stamp(config_.style) + "\n" + file_stamp(exemplar_path_));
+  // The predecessor's result is deliberately not part of a frame's key: frames
+  // made on several machines (each chain starting at its own first frame) stay
+  // current when one run over the whole range assembles the sheet and video.
+  for (int frame : config_.frames)
+    keys_.push_back(hash_hex(concat(base, "\n", frame, "\n", file_stamp(target_path(frame)))));
+}
+
+// Every target frame has the light-path guides; motion guides are needed for
+// the temporal guide and optional for the flicker figure.
+void StylizeJob::check_target_guides(const std::vector<std::string>& names) {
+  for (std::size_t i = 0; i < config_.frames.size(); ++i) {
+    const std::string path = target_path(config_.frames[i]);
+    const ImageFileInfo info = inspect_image(path);
+    auto has = [&](const std::string& guide) {
+      return std::any_of(info.channel_names.begin(), info.channel_names.end(),
+                         [&](const std::string& c) { return c.rfind(guide + ".", 0) == 0; });
+    };
+    for (const auto& name : names)
+      if (!has(name)) throw ValueError(concat("guide '", name, "' missing from '", path, "'"));
+    const bool motion = has("velocity_backward") && has("occlusion_backward");
+    if (!motion && config_.stylit.temporal_weight > 0 && has_temporal_predecessor(i))
+      throw ValueError(concat("the temporal guide needs velocity_backward and occlusion_backward, missing from '",
+                              path, "'"));
+    has_motion_.push_back(motion);
+  }
+}
+
+std::string StylizeJob::output_path(int frame) const {
+  return (fs::path(config_.out) / frame_file(config_.prefix, frame, config_.format)).string();
+}
+
+std::string StylizeJob::report_path() const { return (fs::path(config_.out) / kReportName).string(); }
+
+std::string StylizeJob::lock_path() const { return config_.out; }  // the folder itself: no lock file
+
+std::string StylizeJob::target_path(int frame) const { return guide_cache_frame(config_.guides, frame); }
+
+// Velocities of frame f point to frame f - 1, so only that frame can be chained.
+bool StylizeJob::has_temporal_predecessor(std::size_t index) const {
+  return index > 0 && config_.frames[index - 1] == config_.frames[index] - 1;
+}
+
+FrameResult StylizeJob::run_frame(std::size_t index, const ProgressCallback& progress) {
+  if (index >= config_.frames.size())
+    throw ValueError(concat("frame index ", index, " out of range (the job has ", config_.frames.size(), " frames)"));
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  FrameResult result;
+  result.frame = config_.frames[index];
+  result.path = output_path(result.frame);
+  std::error_code ec;
+  if (config_.resume) {
+    std::map<int, ReportEntry> done;
+    {
+      FileLock lock(lock_path());
+      done = read_report(report_path(), warnings_);
+    }
+    const auto it = done.find(result.frame);
+    // Current: same key, and the file is the one written (size and checksum),
+    // so a truncated or overwritten output is made again.
+    if (it != done.end() && it->second.key == keys_[index] && fs::is_regular_file(result.path, ec) &&
+        file_digest(result.path) == it->second.digest) {
+      result.status = "skipped";
+      result.flicker = it->second.flicker;
+      result.source_coverage = it->second.source_coverage;
+      return result;
+    }
+  }
+  std::vector<std::string> names;
+  for (const auto& [name, weight] : active_guides(config_.stylit)) names.push_back(name);
+  if (has_motion_[index]) names.insert(names.end(), {"velocity_backward", "occlusion_backward"});
+  const GuideFrame target = GuideFrame::read(target_path(result.frame), names);
+
+  // The predecessor as written to disk, whether made now or in an earlier run:
+  // a resumed sequence then continues exactly like an uninterrupted one.
+  Image previous;
+  const std::string previous_path = index > 0 ? output_path(config_.frames[index - 1]) : "";
+  if (has_temporal_predecessor(index) && has_motion_[index] && fs::is_regular_file(previous_path, ec))
+    previous = read_image(previous_path);
+  TemporalInput temporal;
+  if (!previous.empty())
+    temporal = {previous.view(), target.get("velocity_backward").view(), target.get("occlusion_backward").view()};
+
+  SynthesisResult synth = stylize_frame(style_.view(), exemplar_, target, previous.empty() ? nullptr : &temporal,
+                                        config_.stylit, progress);
+  write_image(result.path, synth.image.view());
+  result.status = "stylized";
+  result.source_coverage = synth.source_coverage;
+  result.flicker = previous.empty() || previous.channels() != synth.image.channels()
+                       ? std::numeric_limits<double>::quiet_NaN()
+                       : flicker(previous.view(), synth.image.view(), temporal.velocity_backward,
+                                 temporal.occlusion_backward);
+  // Merge into what is on disk under the folder's lock: other processes and
+  // machines may share this folder, and each adds its own frames.
+  const FileDigest digest = file_digest(result.path);
+  {
+    FileLock lock(lock_path());
+    auto entries = read_report(report_path(), warnings_);
+    entries[result.frame] = {keys_[index], fs::path(result.path).filename().string(), result.flicker,
+                             result.source_coverage, digest};
+    write_report(report_path(), settings_, entries);
+  }
+  result.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  return result;
+}
+
+// The sheet is laid out from the files' headers, then each frame is read,
+// downscaled and pasted in turn: memory holds the sheet and one frame, not
+// every frame at full float resolution.
+void StylizeJob::write_contact_sheet(const std::string& path, int columns) const {
+  if (same_path(path, config_.style)) throw ValueError(concat("the contact sheet '", path, "' would overwrite the painting"));
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (int frame : config_.frames)
+    if (fs::is_regular_file(output_path(frame), ec)) files.push_back(output_path(frame));
+  write_frames_contact_sheet(path, style_.view(), files, columns);
+}
+
+}  // namespace tempera

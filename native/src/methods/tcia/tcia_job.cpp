@@ -1,0 +1,380 @@
+#include "tempera/methods/tcia/tcia_job.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "tempera/engine/distance_transform.hpp"
+#include "tempera/engine/error.hpp"
+#include "tempera/app/file_keys.hpp"
+#include "tempera/app/image_io.hpp"
+#include "tempera/engine/option_table.hpp"
+#include "tempera/methods/tcia/orientation.hpp"
+#include "tempera/app/paths.hpp"
+#include "tempera/app/text_file.hpp"
+
+namespace fs = std::filesystem;
+
+namespace tempera {
+namespace {
+
+constexpr const char* kRecordFormat = "tempera-tcia-segment 1";
+const char* const kMotion[] = {"velocity_backward", "occlusion_backward", "velocity_forward", "occlusion_forward"};
+
+std::vector<int> segment_bounds(const std::vector<int>& frames, const std::vector<KeyFile>& keys) {
+  std::vector<int> bounds = {frames.front()};
+  for (const KeyFile& k : keys)
+    if (k.frame > frames.front() && k.frame < frames.back()) bounds.push_back(k.frame);
+  if (frames.back() != frames.front()) bounds.push_back(frames.back());
+  return bounds;
+}
+
+// The shot's keys and the layers' own, sorted by frame (one per frame): the segments' bounds.
+std::vector<KeyFile> all_keys(const TciaJobConfig& c) {
+  std::vector<KeyFile> keys = c.keys;
+  for (const LayerFile& l : c.layers) keys.insert(keys.end(), l.keys.begin(), l.keys.end());
+  std::sort(keys.begin(), keys.end(), [](const KeyFile& a, const KeyFile& b) { return a.frame < b.frame; });
+  keys.erase(std::unique(keys.begin(), keys.end(), [](const KeyFile& a, const KeyFile& b) { return a.frame == b.frame; }),
+             keys.end());
+  return keys;
+}
+
+std::vector<TciaSegment> make_segments(const std::vector<int>& frames, const std::vector<KeyFile>& keys) {
+  const std::vector<int> bounds = segment_bounds(frames, keys);
+  std::vector<TciaSegment> out;
+  if (bounds.size() == 1) return {TciaSegment{bounds[0], bounds[0], {bounds[0]}}};
+  for (std::size_t i = 0; i + 1 < bounds.size(); ++i) {
+    TciaSegment s{bounds[i], bounds[i + 1], {}};
+    const int end = i + 2 == bounds.size() ? s.last : s.last - 1;
+    for (int f = s.first; f <= end; ++f) s.writes.push_back(f);
+    out.push_back(s);
+  }
+  return out;
+}
+
+// The segments to run: all, or the one of `segment`.
+std::vector<std::size_t> select(const std::vector<TciaSegment>& segments,
+                                const std::optional<std::pair<int, int>>& segment) {
+  std::vector<std::size_t> out;
+  std::string list;
+  for (std::size_t i = 0; i < segments.size(); ++i) {
+    if (!segment || (segments[i].first == segment->first && segments[i].last == segment->second)) out.push_back(i);
+    list += concat(i ? ", " : "", segments[i].first, "-", segments[i].last);
+  }
+  if (out.empty())
+    throw ValueError(concat("segment ", segment->first, "-", segment->second, " is not one of the shot's segments (",
+                            list, "; they run from key to key)"));
+  return out;
+}
+
+void check_frames(const std::vector<int>& frames) {
+  if (frames.empty()) throw ValueError("no frames to stylize");
+  for (std::size_t i = 1; i < frames.size(); ++i)
+    if (frames[i] != frames[i - 1] + 1)
+      throw ValueError(concat("the coherent method needs consecutive frames (the motion links frame f to f - 1 and "
+                              "f + 1); frame ", frames[i - 1], " is followed by ", frames[i]));
+}
+
+std::vector<KeyFile> sorted_keys(std::vector<KeyFile> keys, const std::vector<int>& frames) {
+  std::sort(keys.begin(), keys.end(), [](const KeyFile& a, const KeyFile& b) { return a.frame < b.frame; });
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    const KeyFile& k = keys[i];
+    if (i > 0 && keys[i - 1].frame == k.frame) throw ValueError(concat("keyframe ", k.frame, " is given twice"));
+    if (k.frame < frames.front() || k.frame > frames.back())
+      throw ValueError(concat("keyframe ", k.frame, " is outside the frames ", frames.front(), "-", frames.back()));
+    for (const std::string* path : {&k.painting, &k.mask}) {
+      std::error_code ec;
+      if (!path->empty() && !fs::is_regular_file(*path, ec))
+        throw FileNotFoundError(concat(path == &k.painting ? "painting" : "mask", " of keyframe ", k.frame,
+                                       " not found: '", *path, "'"));
+    }
+  }
+  return keys;
+}
+
+// A key painting with the style's channels (an RGBA PNG of an RGB style
+// drops its alpha), at its frame's size.
+Image read_key_painting(const KeyFile& k, int channels, int width, int height) {
+  Image p = read_image(k.painting);
+  require_finite(p.view(), concat("the painting of keyframe ", k.frame));
+  if (p.channels() < channels)
+    throw ValueError(concat("the painting of keyframe ", k.frame, " '", k.painting, "' has ", p.channels(),
+                            " channel(s), the style ", channels));
+  if (p.width() != width || p.height() != height)
+    throw ValueError(concat("the painting of keyframe ", k.frame, " '", k.painting, "' is ", p.width(), "x",
+                            p.height(), " but frame ", k.frame, "'s guides are ", width, "x", height));
+  return p.channels() == channels ? p : extract_channels(p.view(), 0, channels);
+}
+
+Image read_key_mask(const KeyFile& k, int width, int height) {
+  if (k.mask.empty()) return {};
+  Image m = read_image(k.mask);
+  if (m.width() != width || m.height() != height)
+    throw ValueError(concat("the mask of keyframe ", k.frame, " '", k.mask, "' is ", m.width(), "x", m.height(),
+                            " but frame ", k.frame, "'s guides are ", width, "x", height));
+  Image out = extract_channels(m.view(), 0, 1);
+  for (std::size_t i = 0; i < out.pixel_count(); ++i) out.data()[i] = out.data()[i] > 0.5f ? 1.0f : 0.0f;
+  return out;
+}
+
+bool has_guide(const ImageFileInfo& info, const std::string& guide) {
+  return std::any_of(info.channel_names.begin(), info.channel_names.end(),
+                     [&](const std::string& c) { return c.rfind(guide + ".", 0) == 0; });
+}
+
+// O(I) of a guide frame: the angle of its structure tensor (orientation.hpp).
+Image tensor_angle(const GuideFrame& g) {
+  return extract_channels(orientation_from_tensor(g.get("tensor").view()).view(), 0, 1);
+}
+
+// D(S): the bounded distance to the painting's ink (eq. 9).
+Image ink_distance(const ImageView& style, const TciaLineOptions& o) {
+  Image ink(style.width, style.height, 1);
+  for (int y = 0; y < style.height; ++y)
+    for (int x = 0; x < style.width; ++x) {
+      const float* p = style.pixel(x, y);
+      const float lum = style.channels >= 3 ? 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2] : p[0];
+      ink.at(x, y, 0) = lum < o.ink ? 1.0f : 0.0f;
+    }
+  return line_distance(ink.view(), o.d_max);
+}
+
+}  // namespace
+
+// The per-frame job checks the files and sizes of the frames to solve; its
+// temporal guide is StyLit's, not this method's, so it is off there.
+StylizeJobConfig per_frame(const TciaJobConfig& c) {
+  StylizeJobConfig out = c.frames;
+  out.stylit.temporal_weight = 0;
+  if (c.segment) {
+    out.frames.clear();
+    for (int f = c.segment->first; f <= c.segment->second; ++f) out.frames.push_back(f);
+  }
+  return out;
+}
+
+KeyFile parse_key(const std::string& text) {
+  const std::size_t eq = text.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == text.size())
+    throw ValueError(concat("--key expects FRAME=PAINTING[,MASK], got '", text, "'"));
+  KeyFile k;
+  k.frame = parse_number<int>(text.substr(0, eq), concat("the frame of --key '", text, "'"));
+  const std::string files = text.substr(eq + 1);
+  const std::size_t comma = files.find(',');
+  k.painting = files.substr(0, comma);
+  if (comma != std::string::npos) k.mask = files.substr(comma + 1);
+  if (k.painting.empty() || (comma != std::string::npos && k.mask.empty()))
+    throw ValueError(concat("--key expects FRAME=PAINTING[,MASK], got '", text, "'"));
+  return k;
+}
+
+// Options, keys and segments are checked before the per-frame job reads any file.
+TciaJob::TciaJob(TciaJobConfig config)
+    : config_(checked(std::move(config))),
+      segments_(make_segments(config_.frames.frames, all_keys(config_))),
+      selected_(select(segments_, config_.segment)),
+      frames_(per_frame(config_)) {
+  // Motion: a segment's frames link to their neighbours inside it; its first
+  // frame needs no V-, its last no V+.
+  for (std::size_t i : selected_) {
+    const TciaSegment& s = segments_[i];
+    for (int f = s.first; f <= s.last; ++f) {
+      const std::string path = frames_.target_guides_path(f);
+      const ImageFileInfo info = inspect_image(path);
+      if (config_.lines.weight > 0 && !has_guide(info, "line_distance"))
+        throw ValueError(concat("the line term (--lines) needs 'line_distance' in '", path, "'"));
+      if (config_.orientation.from_cache && !has_guide(info, "tensor"))
+        throw ValueError(concat("--orientation needs the structure tensor 'tensor' in '", path, "'"));
+      for (int m = f == s.first ? 2 : 0; m < (f == s.last ? 2 : 4); ++m)
+        if (!has_guide(info, kMotion[m]))
+          throw ValueError(concat("the coherent method needs '", kMotion[m], "' in '", path,
+                                  "' (render the guides with motion)"));
+    }
+  }
+  if (config_.orientation.from_cache && !has_guide(inspect_image(frames_.exemplar_path()), "tensor"))
+    throw ValueError(concat("--orientation needs the structure tensor 'tensor' in the exemplar's guides '",
+                            frames_.exemplar_path(), "'"));
+  read_keys(config_.keys, paintings_, masks_);
+  for (const LayerFile& l : config_.layers)
+    read_keys(l.keys, layer_key_paintings_.emplace_back(), layer_key_masks_.emplace_back());
+  std::ostringstream s;
+  s << kRecordFormat << ";weights=";
+  for (const auto& [name, weight] : active_guides(config_.frames.stylit)) s << name << ":" << weight << ",";
+  s << ";" << settings_text(config_.tcia, tcia_option_table())
+    << settings_text(config_.tcia.synthesis, synthesis_option_table())
+    << settings_text(config_.lines, tcia_line_option_table())
+    << settings_text(config_.orientation, tcia_orientation_option_table()) << "format=" << config_.frames.format << ";"
+    << file_stamp(config_.frames.style) << ";" << file_stamp(frames_.exemplar_path());
+  settings_ = s.str();
+  check_layers();
+  std::error_code ec;
+  fs::create_directories(fs::path(config_.frames.out) / "tempera_tcia", ec);
+}
+
+TciaJobConfig TciaJob::checked(TciaJobConfig c) {
+  check_frames(c.frames.frames);
+  validate_fields(c.tcia, tcia_option_table());
+  validate_fields(c.lines, tcia_line_option_table());
+  validate_fields(c.orientation, tcia_orientation_option_table());
+  validate(c.tcia.synthesis);
+  if (c.layer_order != "depth" && c.layer_order != "given")
+    throw ValueError(concat("the layer order must be 'depth' or 'given', got '", c.layer_order, "'"));
+  c.keys = sorted_keys(std::move(c.keys), c.frames.frames);
+  for (LayerFile& l : c.layers) l.keys = sorted_keys(std::move(l.keys), c.frames.frames);
+  return c;
+}
+
+void TciaJob::read_keys(const std::vector<KeyFile>& keys, std::vector<Image>& paintings,
+                        std::vector<Image>& masks) const {
+  for (const KeyFile& k : keys) {
+    paintings.emplace_back(), masks.emplace_back();
+    if (!is_read(k.frame)) continue;  // outside the one segment run
+    const ImageFileInfo info = inspect_image(frames_.target_guides_path(k.frame));
+    paintings.back() = read_key_painting(k, frames_.style().channels(), info.width, info.height);
+    masks.back() = read_key_mask(k, info.width, info.height);
+  }
+}
+
+bool TciaJob::is_read(int frame) const {
+  return !config_.segment || (frame >= config_.segment->first && frame <= config_.segment->second);
+}
+
+std::string TciaJob::record_path(std::size_t index) const {
+  const TciaSegment& s = segments_.at(index);
+  return (fs::path(config_.frames.out) / "tempera_tcia" / concat("segment_", s.first, "-", s.last, ".txt")).string();
+}
+
+// Everything the segment's frames depend on: the settings, the painting and
+// exemplar, its own guide frames and its bounding keys; nothing of the
+// other segments.
+std::string TciaJob::segment_key(const TciaSegment& segment) const {
+  std::string text = concat(settings_, "\nsegment ", segment.first, "-", segment.last);
+  for (int f = segment.first; f <= segment.last; ++f) text += "\n" + file_stamp(frames_.target_guides_path(f));
+  for (const KeyFile& k : config_.keys)
+    if (k.frame == segment.first || k.frame == segment.last)
+      text += concat("\nkey ", k.frame, " ", file_stamp(k.painting), " ", k.mask.empty() ? "" : file_stamp(k.mask));
+  return hash_hex(text);
+}
+
+bool TciaJob::record_current(const std::string& record, const std::string& key, const std::vector<std::string>& files) {
+  std::ifstream in(record);
+  std::string line;
+  if (!in || !std::getline(in, line) || line != kRecordFormat) return false;
+  if (!std::getline(in, line) || line != key) return false;
+  for (const std::string& path : files) {
+    const FileDigest digest = file_digest(path);
+    std::string name;
+    FileDigest recorded;
+    if (!(in >> name >> recorded.size >> recorded.checksum)) return false;
+    if (name != fs::path(path).filename().string() || !(digest == recorded)) return false;
+  }
+  return true;
+}
+
+void TciaJob::write_record(const std::string& record, const std::string& key, const std::vector<std::string>& files) {
+  std::ostringstream text;
+  text << kRecordFormat << "\n" << key << "\n";
+  for (const std::string& path : files) {
+    const FileDigest d = file_digest(path);
+    text << fs::path(path).filename().string() << " " << d.size << " " << d.checksum << "\n";
+  }
+  write_text_atomically(record, text.str(), "the segment record");
+}
+
+std::string TciaJob::composite_key(const TciaSegment& segment) const {
+  if (config_.layers.empty()) return segment_key(segment);
+  std::string text = concat(segment_key(segment), "\nlayer order ", config_.layer_order);
+  for (std::size_t l = 0; l < config_.layers.size(); ++l) text += "\n" + layer_key(segment, l);
+  return hash_hex(text);
+}
+
+bool TciaJob::is_current(std::size_t index) const {
+  std::vector<std::string> files;
+  for (int f : segments_[index].writes) files.push_back(frames_.output_path(f));
+  return record_current(record_path(index), composite_key(segments_[index]), files);
+}
+
+Shot TciaJob::load_shot(const TciaSegment& segment, std::deque<Image>& keep) const {
+  std::vector<std::string> names;
+  for (const auto& [name, weight] : active_guides(config_.frames.stylit)) names.push_back(name);
+  Shot shot;
+  shot.style = frames_.style().view();
+  for (const auto& [name, weight] : active_guides(config_.frames.stylit)) {
+    shot.guide_names.push_back(name);
+    shot.style_guides.push_back(keep.emplace_back(tonemap_guide(frames_.exemplar().get(name).view())).view());
+    shot.guide_weights.push_back(weight);
+  }
+  const bool lines = config_.lines.weight > 0;
+  if (lines) {
+    shot.guide_names.push_back("line_distance");
+    shot.style_guides.push_back(keep.emplace_back(ink_distance(frames_.style().view(), config_.lines)).view());
+    shot.guide_weights.push_back(config_.lines.weight);
+  }
+  const bool oriented = config_.orientation.from_cache;
+  if (oriented)
+    shot.style_orientation = keep.emplace_back(tensor_angle(GuideFrame::read(frames_.exemplar_path(), {"tensor"}))).view();
+  for (int f = segment.first; f <= segment.last; ++f) {
+    std::vector<std::string> wanted = names;
+    if (lines) wanted.push_back("line_distance");
+    if (oriented) wanted.push_back("tensor");
+    const int from = f == segment.first ? 2 : 0, to = f == segment.last ? 2 : 4;
+    for (int m = from; m < to; ++m) wanted.push_back(kMotion[m]);
+    const GuideFrame g = GuideFrame::read(frames_.target_guides_path(f), wanted);
+    ShotFrame frame;
+    for (const auto& name : names) frame.guides.push_back(keep.emplace_back(tonemap_guide(g.get(name).view())).view());
+    if (lines) frame.guides.push_back(keep.emplace_back(Image::copy_of(g.get("line_distance").view())).view());
+    if (oriented) frame.orientation = keep.emplace_back(tensor_angle(g)).view();
+    const Image& first = g.get(names.front());
+    ImageView* motion[] = {&frame.velocity_backward, &frame.occlusion_backward, &frame.velocity_forward,
+                           &frame.occlusion_forward};
+    for (int m = 0; m < 4; ++m) {
+      // Unused at the segment's ends (no neighbour there): zero motion, nothing visible.
+      Image image = m >= from && m < to ? Image::copy_of(g.get(kMotion[m]).view())
+                                        : Image(first.width(), first.height(), m % 2 == 0 ? 2 : 1, 0.0f);
+      *motion[m] = keep.emplace_back(std::move(image)).view();
+    }
+    shot.frames.push_back(std::move(frame));
+  }
+  for (std::size_t k = 0; k < config_.keys.size(); ++k) {
+    const int f = config_.keys[k].frame;
+    if (f != segment.first && f != segment.last) continue;
+    shot.keys.push_back(ShotKey{f - segment.first, paintings_[k].view(), masks_[k].view()});
+  }
+  return shot;
+}
+
+SegmentResult TciaJob::run_segment(std::size_t index, const SegmentProgress& progress) {
+  if (std::find(selected_.begin(), selected_.end(), index) == selected_.end())
+    throw ValueError(concat("segment ", index, " is not one this job runs"));
+  const TciaSegment& segment = segments_[index];
+  SegmentResult result;
+  if (config_.frames.resume && is_current(index)) {
+    result.status = "skipped";
+    return result;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  std::deque<Image> keep;
+  const Shot shot = load_shot(segment, keep);
+  SweepCallback sweeps;
+  if (progress)
+    sweeps = [&](const SweepProgress& p) {
+      SweepProgress here = p;
+      here.frame += segment.first;
+      return progress(here);
+    };
+  const std::vector<Image> images =
+      config_.layers.empty() ? stylize_shot_sweeps(shot, config_.tcia, sweeps) : run_layers(index, shot, sweeps);
+  std::vector<std::string> files;
+  for (int f : segment.writes) {
+    files.push_back(frames_.output_path(f));
+    write_image(files.back(), images[std::size_t(f - segment.first)].view());  // atomic
+  }
+  write_record(record_path(index), composite_key(segment), files);
+  result.status = "stylized";
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return result;
+}
+
+}  // namespace tempera
