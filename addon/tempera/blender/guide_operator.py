@@ -22,7 +22,8 @@ from bpy.props import StringProperty
 from bpy.types import Operator
 
 from .. import guide_cache
-from .guide_render import GuideRenderError, check_lpe_expressions, check_scene, render_guides, scene_fingerprint
+from .guide_render import (LPE_PROBLEMS, GuideRenderError, check_lpe_expressions, check_scene, render_guides,
+                           scene_fingerprint)
 from .job_operator import JobOperator
 from .properties import GUIDE_MASK_MODES
 
@@ -232,25 +233,6 @@ def _current_frames(folder, manifest_mtime_ns, params_json, fingerprint_json, fr
         if guide_cache.is_frame_current(folder, manifest, frame, key, verify=False):  # size only: draw() is no place to hash files
             current += 1
     return current
-
-
-# Light Path Expressions field text -> what is wrong with it (None: fine),
-# filled by the field's update callback (properties.py), never by draw():
-# compiling an expression may take a while, and draw() runs on every redraw.
-LPE_PROBLEMS = {}
-
-
-def check_lpe_field(text):
-    """Checks the field's expressions once per text (the update callback)."""
-    if text not in LPE_PROBLEMS:
-        if len(LPE_PROBLEMS) > 64:
-            LPE_PROBLEMS.clear()
-        try:
-            check_lpe_expressions(guide_cache.split_expressions(text))
-            LPE_PROBLEMS[text] = None
-        except GuideRenderError as exc:
-            LPE_PROBLEMS[text] = str(exc)
-    return LPE_PROBLEMS[text]
 
 
 def cache_status(scene):

@@ -160,6 +160,25 @@ def check_lpe_expressions(expressions):
         seen[name] = i
 
 
+# Light Path Expressions field text -> what is wrong with it (None: fine),
+# filled by the field's update callback (properties.py), never by draw():
+# compiling an expression may take a while, and draw() runs on every redraw.
+LPE_PROBLEMS = {}
+
+
+def check_lpe_field(text):
+    """Checks the field's expressions once per text (the update callback)."""
+    if text not in LPE_PROBLEMS:
+        if len(LPE_PROBLEMS) > 64:
+            LPE_PROBLEMS.clear()
+        try:
+            check_lpe_expressions(guide_cache.split_expressions(text))
+            LPE_PROBLEMS[text] = None
+        except GuideRenderError as exc:
+            LPE_PROBLEMS[text] = str(exc)
+    return LPE_PROBLEMS[text]
+
+
 # Valid ranges of the numeric guide parameters: (low, high, what it is);
 # checked before anything is rendered, so no value can crash the renderer.
 PARAM_RANGES = {

@@ -19,6 +19,7 @@ from bpy.types import Operator, UIList
 from . import compat, results
 from .guide_operator import resolve_guide_dir
 from .kit_operators import ImageFileChooser
+from .setting_paths import FRAMES_DIR, output_dir, resolve_path
 
 LOW_CONTRAST = 0.4  # the render's tones squeezed around mid grey: a ground to paint on, not a picture
 
@@ -34,7 +35,6 @@ def keyframe_ground(scene, frame):
     from tempera import guide_cache
     from tempera.stylize import tonemap
 
-    from .stylize_operator import FRAMES_DIR, output_dir
 
     settings = scene.tempera
     for ext in ("png", "exr"):
@@ -66,7 +66,6 @@ def key_list(settings, layer=None):
     """[(frame, painting path, mask path or None), ...] in frame order, for
     tempera.tcia.ShotJob: the keys of the whole frame, or those of the
     layer `layer` (a collection). Keys painted in Blender are saved first."""
-    from .stylize_operator import resolve_path
 
     keys = []
     for key in settings.keyframes:
@@ -119,7 +118,6 @@ class TEMPERA_OT_add_keyframe(Operator):
     def execute(self, context):
         import tempera
 
-        from .stylize_operator import resolve_path
 
         scene = context.scene
         settings, frame = scene.tempera, scene.frame_current

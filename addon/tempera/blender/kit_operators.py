@@ -10,6 +10,7 @@ from bpy.props import BoolProperty, StringProperty
 from bpy.types import Operator
 
 from .. import read_image, write_image
+from .setting_paths import exemplar_paths, output_dir
 
 KIT_FOLDER = "painting_kit"  # inside the Output Folder: template.pdf, template.png, kit.json, painting.png
 IMAGE_GLOB = "*.png;*.jpg;*.jpeg;*.tif;*.tiff;*.exr;*.bmp;*.tga"
@@ -46,7 +47,6 @@ def painting_preview(path):
 
 
 def _kit_folder(settings):
-    from .stylize_operator import output_dir
 
     return os.path.join(output_dir(settings), KIT_FOLDER)
 
@@ -100,7 +100,6 @@ class TEMPERA_OT_painting_template(Operator):
         from .. import guide_cache
         from ..painting_template import make_template, write_kit_json, write_pdf
         from ..stylize import tonemap
-        from .stylize_operator import exemplar_paths
 
         settings = context.scene.tempera
         try:

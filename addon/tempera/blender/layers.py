@@ -1,7 +1,7 @@
 """Layers of the coherent method (Scene.tempera.tcia_layers): collections
 painted and synthesized separately (Bénard 2013 §4, Figs. 9 and 10), each
 with its motion extrapolated into its background, then composited by depth
-or in list order (native/src/tcia_layers.cpp). The list in the panel and its
+or in list order (native/src/methods/tcia/tcia_layers.cpp). The list in the panel and its
 operators."""
 import re
 
@@ -9,6 +9,7 @@ from bpy.types import Operator, UIList
 
 from .. import guide_cache
 from .keyframes import remove_selected
+from .setting_paths import resolve_path
 
 
 def layer_name(collection_name):
@@ -21,7 +22,6 @@ def layer_list(settings, frames=None):
     tempera.tcia.ShotJob, in list order (the first at the back when the
     order is 'given'); keys only of `frames` (first, last) when given."""
     from .keyframes import key_list
-    from .stylize_operator import resolve_path
 
     listed = {layer.collection for layer in settings.tcia_layers}
     for key in settings.keyframes:

@@ -15,7 +15,8 @@ from .kit_operators import (TEMPERA_OT_choose_painting, TEMPERA_OT_painting_temp
                             painting_preview)
 from .properties import WEIGHT_PROPERTIES
 from .results import is_result_scene
-from .stylize_operator import TEMPERA_OT_stylize, exemplar_paths
+from .setting_paths import exemplar_paths
+from .stylize_operator import TEMPERA_OT_stylize
 
 THUMBNAIL_SCALE = 6.0
 # Labels shortened in the panel to fit its default width (the tooltip keeps the full name).

@@ -91,7 +91,7 @@ def _keep_patch_size_odd(self, _context):
 
 
 def _check_lpe_field(self, _context):
-    from .guide_operator import check_lpe_field  # compiled here, once per text, never in draw()
+    from .guide_render import check_lpe_field  # compiled here, once per text, never in draw()
 
     check_lpe_field(self.guide_lpe)
 

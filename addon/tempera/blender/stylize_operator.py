@@ -36,53 +36,24 @@ import bpy
 from bpy.types import Operator
 from bpy.props import EnumProperty, StringProperty
 
-from .. import kit, settings as limits
+from .. import settings as limits
 from .guide_operator import (ETA_AFTER_FRAMES, GuideJob, estimate_guide_seconds, format_duration, guide_frames,
-                             long_run_question, resolve_guide_dir)
+                             long_run_question)
 from .guide_render import GuideRenderError
 from .job_operator import JobOperator
 from .properties import MEDIA_EXEMPLAR_KINDS, WEIGHT_PROPERTIES
+from .setting_paths import FRAMES_DIR, exemplar_paths, output_dir, resolve_path
 from . import results
 
 # Rough stylizing cost per megapixel on a 2-core machine (docs/benchmarks.md).
 STYLIZE_SECONDS_PER_MPIX = {"final": 40.0, "preview": 8.0}
 RIGID_SECONDS_PER_FRAME = 0.2  # per object and frame at 640 x 360, loaded machine (docs/benchmarks.md)
-FRAMES_DIR = "frames"
 CONTACT_SHEET = "contact_sheet.png"
 VIDEO = "stylized.mp4"
 NOISY_DIR = "noisy"  # the Temporal Noise pass (Color Me Noisy) writes here
 
 
 # --------------------------------------------------------------------------- settings -> job
-
-def resolve_path(setting, what, blend_filepath=None):
-    """Absolute path of a path setting ('//' relative to the .blend file)."""
-    path = setting.strip()
-    if not path:
-        raise ValueError(f"Set the {what} in Output Properties > Tempera.")
-    if path.startswith("//"):
-        blend_filepath = bpy.data.filepath if blend_filepath is None else blend_filepath
-        if not blend_filepath:
-            raise ValueError(f"Save the .blend file first: the {what} '{setting}' is relative to it ('//'). "
-                             "Or choose an absolute path.")
-        path = bpy.path.abspath(path, start=os.path.dirname(blend_filepath))
-    return os.path.normpath(path)
-
-
-def exemplar_paths(settings):
-    """(painting, exemplar guide cache, exemplar frame or None) of the Exemplar setting."""
-    if settings.exemplar_source == "KIT":
-        style, guides = kit.kit_exemplar()
-        return str(style), str(guides), None
-    style = resolve_path(settings.exemplar_style, "exemplar Painting")
-    guides = resolve_path(settings.exemplar_guide_dir, "Exemplar Guides folder")
-    if not os.path.isfile(style):
-        raise FileNotFoundError(f"The exemplar painting '{style}' does not exist.")
-    if not os.path.isdir(guides):
-        raise FileNotFoundError(f"The exemplar guide folder '{guides}' does not exist "
-                                "(render the exemplar scene's guides first).")
-    return style, guides, settings.exemplar_frame or None
-
 
 def stylize_options(settings):
     """The StylizeJob options of Scene.tempera (everything but paths and frames)."""
@@ -118,10 +89,6 @@ def noise_config(settings, out, config):
         args.update(exemplar_guides=config["exemplar_guides"], exemplar_frame=config.get("exemplar_frame"),
                     guide_weights=config["weights"], noise_guides=limits.PANEL_NOISE_GUIDES)
     return args
-
-
-def output_dir(settings):
-    return resolve_path(settings.output_dir, "Output Folder")
 
 
 def megapixels(scene):
