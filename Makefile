@@ -35,7 +35,7 @@ KIT_SOURCES := scenes/exemplar_kit.py scenes/scene_kit.py addon/tempera/exemplar
                addon/tempera/blender/guide_render.py addon/tempera/guide_cache.py
 DEMO_OUT ?= out/demo
 
-.PHONY: all deps build kit addon-zip wheel extension test demo demo-rigid demo-fluids bench bench-tracer sanitize fuzz clean
+.PHONY: all deps build kit addon-zip wheel extension test demo demo-rigid demo-fluids demo-fluids-stylize bench bench-tracer sanitize fuzz clean
 
 all: build
 
@@ -110,16 +110,22 @@ demo-fluids: build
 	    --out $(DEMO_FLUIDS_OUT)/ink
 	$(TEMPERA_PY) exemplar smoke --out $(DEMO_FLUIDS_OUT)/exemplars/smoke --size 128x128 --frames 24
 	$(TEMPERA_PY) exemplar ink --out $(DEMO_FLUIDS_OUT)/exemplars/ink --size 160x160 --frames 24 --speed 2
-	$(BUILD)/bin/tempera stylize --method lazyfluids --guides $(DEMO_FLUIDS_OUT)/chimney/guides \
-	    --exemplar $(DEMO_FLUIDS_OUT)/exemplars/smoke --frames 13-36 --out $(DEMO_FLUIDS_OUT)/chimney/lazyfluids
+	$(MAKE) demo-fluids-stylize
+
+# The fluid demos' stylization from their renders, guides and exemplars in DEMO_FLUIDS_IN (the same
+# folder by default): tools/demo_guard.py reruns it on a reference's renders.
+DEMO_FLUIDS_IN ?= $(DEMO_FLUIDS_OUT)
+demo-fluids-stylize: build
+	$(BUILD)/bin/tempera stylize --method lazyfluids --guides $(DEMO_FLUIDS_IN)/chimney/guides \
+	    --exemplar $(DEMO_FLUIDS_IN)/exemplars/smoke --frames 13-36 --out $(DEMO_FLUIDS_OUT)/chimney/lazyfluids
 	$(PYTHON) tools/composite_over.py --over $(DEMO_FLUIDS_OUT)/chimney/lazyfluids/frames \
-	    --under $(DEMO_FLUIDS_OUT)/chimney/plate --frames 13-36 --out $(DEMO_FLUIDS_OUT)/chimney/composite \
+	    --under $(DEMO_FLUIDS_IN)/chimney/plate --frames 13-36 --out $(DEMO_FLUIDS_OUT)/chimney/composite \
 	    --video $(DEMO_FLUIDS_OUT)/chimney/chimney_smoke.mp4
-	$(BUILD)/bin/tempera stylize --method fluidymation --guides $(DEMO_FLUIDS_OUT)/ink/guides \
-	    --exemplar $(DEMO_FLUIDS_OUT)/exemplars/ink --exemplar-masks $(DEMO_FLUIDS_OUT)/exemplars/ink/masks \
+	$(BUILD)/bin/tempera stylize --method fluidymation --guides $(DEMO_FLUIDS_IN)/ink/guides \
+	    --exemplar $(DEMO_FLUIDS_IN)/exemplars/ink --exemplar-masks $(DEMO_FLUIDS_IN)/exemplars/ink/masks \
 	    --target-mask mask.OB_Ink --frames 1-24 --out $(DEMO_FLUIDS_OUT)/ink/fluidymation
 	$(PYTHON) tools/composite_over.py --over $(DEMO_FLUIDS_OUT)/ink/fluidymation \
-	    --under $(DEMO_FLUIDS_OUT)/ink/paper.png --frames 1-24 --out $(DEMO_FLUIDS_OUT)/ink/composite \
+	    --under $(DEMO_FLUIDS_IN)/ink/paper.png --frames 1-24 --out $(DEMO_FLUIDS_OUT)/ink/composite \
 	    --video $(DEMO_FLUIDS_OUT)/ink/growing_ink.mp4
 
 # The 1 Mpix run, the 0.25/1/4 Mpix sweep and, with COMPARE=REV (e.g. main), REV side by side.
