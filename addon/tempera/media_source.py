@@ -101,8 +101,11 @@ def decode_movie(movie, cache_dir, ffmpeg=None):
     build = tempfile.mkdtemp(prefix=".decoding-", dir=cache_dir)
     try:
         # RGBA keeps a movie's alpha channel where it has one (ProRes 4444, PNG, WebM).
-        done = subprocess.run([ffmpeg, "-v", "error", "-nostdin", "-i", movie, "-pix_fmt", "rgba",
-                               os.path.join(build, "frame_%04d.png")], capture_output=True, text=True)
+        # Absolute paths: ffmpeg reads a relative '-y' as an option and 'shot:01' as a URL;
+        # '%' in the folder is doubled, or ffmpeg takes it for a frame number.
+        pattern = os.path.join(os.path.abspath(build).replace("%", "%%"), "frame_%04d.png")
+        done = subprocess.run([ffmpeg, "-v", "error", "-nostdin", "-i", os.path.abspath(movie), "-pix_fmt", "rgba",
+                               pattern], capture_output=True, text=True)
         if done.returncode != 0 or not image_files(build):
             raise MediaError(f"ffmpeg could not decode '{movie}': {done.stderr.strip() or 'no frames'}")
         _publish(build, folder, stamp)

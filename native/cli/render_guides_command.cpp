@@ -78,7 +78,10 @@ int render_guides_in_blender(const BlenderSetup& setup, const std::string& scene
       "import sys; sys.path.insert(0, sys.argv[sys.argv.index('--') + 1]); "
       "del sys.argv[sys.argv.index('--') + 1]; "
       "from tempera.blender.render_guides_main import main; main()";
-  std::vector<std::string> argv = {setup.blender, "-b", "--factory-startup", scene, "--python-exit-code", "1",
+  // Absolute, so that Blender cannot read the scene as one of its options: a file
+  // named '-P' would make it run the next argument as Python, '-a' start its player.
+  const std::string scene_path = fs::absolute(scene).string();
+  std::vector<std::string> argv = {setup.blender, "-b", "--factory-startup", scene_path, "--python-exit-code", "1",
                                    "--python-expr", bootstrap, "--", setup.addon};
   argv.insert(argv.end(), options.begin(), options.end());
   const int status = run_process(argv, false, &g_interrupted);

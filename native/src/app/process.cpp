@@ -71,10 +71,15 @@ bool encode_video(const std::string& pattern, int first_frame, double fps, const
   if (ffmpeg.empty()) return false;
   const fs::path target(out_path);
   // Same folder, so the final rename is atomic; .mp4 so ffmpeg picks the muxer.
-  const fs::path temp = target.parent_path() / temporary_name(target.stem().string(), ".mp4");
+  // Both paths absolute: ffmpeg reads a relative '-y' or '-dash/...' as an option
+  // and 'shot:01/...' or 'http:h/...' as a URL; from '/' on it is a file.
+  const fs::path temp = fs::absolute(target.parent_path() / temporary_name(target.stem().string(), ".mp4"));
+  const std::string input = fs::path(pattern).is_absolute()
+                                ? pattern
+                                : printf_escaped(fs::current_path().string()) + "/" + pattern;
   const std::vector<std::string> argv = {
       ffmpeg, "-y", "-nostdin", "-loglevel", "error", "-framerate", concat(fps), "-start_number",
-      std::to_string(first_frame), "-i", pattern,
+      std::to_string(first_frame), "-i", input,
       // libx264 with yuv420p needs even sizes: drop at most one row / column.
       "-vf", "scale=trunc(iw/2)*2:trunc(ih/2)*2", "-c:v", "libx264", "-pix_fmt", "yuv420p", temp.string()};
   const int status = run_process(argv, true);

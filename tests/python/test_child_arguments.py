@@ -1,0 +1,108 @@
+"""Paths that Tempera hands to Blender and ffmpeg are never read as their
+options or URLs (issue 31, items 7 and 8): a scene named '-P' would make
+Blender run the next argument as Python, '-a' start its player; ffmpeg reads
+a relative '-y' or '-dash/…' as an option and 'shot:01/…' as a URL."""
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import tempera
+from tempera import media_source
+from tempera.stylize import encode_video
+
+FFMPEG = shutil.which("ffmpeg")
+needs_ffmpeg = pytest.mark.skipif(FFMPEG is None, reason="ffmpeg is not on PATH")
+# What Tempera itself passes to Blender before '--' (render_guides_command.cpp).
+BLENDER_OPTIONS = {"-b", "--factory-startup", "--python-exit-code", "--python-expr"}
+
+
+def fake_blender(tmp_path):
+    """A stand-in for Blender that appends its arguments, one call a line, to calls.txt."""
+    calls = tmp_path / "calls.txt"
+    script = tmp_path / "blender"
+    script.write_text(f"#!{sys.executable}\nimport sys\n"
+                      f"open({str(calls)!r}, 'a').write(repr(sys.argv[1:]) + '\\n')\n")
+    script.chmod(0o755)
+    return script, calls
+
+
+def blender_calls(calls):
+    return [eval(line) for line in calls.read_text().splitlines()] if calls.is_file() else []
+
+
+def options_before_double_dash(argv):
+    """Every argument before '--' that Blender would take as an option, minus Tempera's own."""
+    head = argv[:argv.index("--")] if "--" in argv else argv
+    values_of = {"--python-exit-code", "--python-expr"}  # their values are Tempera's, not options
+    skip, found = False, []
+    for arg in head:
+        if skip:
+            skip = False
+        elif arg in values_of:
+            skip = True
+        elif arg.startswith("-") and arg not in BLENDER_OPTIONS:
+            found.append(arg)
+    return found
+
+
+@pytest.mark.parametrize("name", ["-P", "-a"])
+def test_render_guides_passes_the_scene_as_a_path(cli_path, tmp_path, name):
+    blender, calls = fake_blender(tmp_path)
+    work = tmp_path / "work"
+    work.mkdir()
+    (work / name).write_bytes(b"BLENDER")  # the user's scene, named like an option
+    subprocess.run([str(cli_path), "render-guides", name, "--out", "cache", "--frames", "1-1",
+                    "--blender", str(blender)], cwd=work, capture_output=True, text=True, timeout=60)
+    (argv,) = blender_calls(calls)
+    assert options_before_double_dash(argv) == [], argv
+    assert str(work / name) in argv[:argv.index("--")]
+
+
+def test_stylize_passes_the_exemplar_scene_as_a_path(cli_path, tmp_path):
+    blender, calls = fake_blender(tmp_path)
+    work = tmp_path / "work"
+    work.mkdir()
+    for name in ("-P", "-a"):
+        (work / name).write_bytes(b"BLENDER")
+    tempera.write_image(str(work / "style.png"), np.full((8, 8, 3), 0.5, np.float32))
+    subprocess.run([str(cli_path), "stylize", "-a", "--exemplar", "style.png", "--exemplar-scene", "-P",
+                    "--frames", "1-1", "--out", "out", "--blender", str(blender)],
+                   cwd=work, capture_output=True, text=True, timeout=60)
+    argvs = blender_calls(calls)
+    assert argvs, "Blender was never started"
+    for argv in argvs:
+        assert options_before_double_dash(argv) == [], argv
+
+
+def _frames(folder, n=3):
+    folder.mkdir(parents=True)
+    for i in range(n):
+        image = np.zeros((16, 24, 3), np.float32)
+        image[4:12, 2 + 4 * i:10 + 4 * i] = (1.0, 0.6, 0.2)
+        tempera.write_image(str(folder / f"frame_{i + 1:04d}.png"), image)
+
+
+@needs_ffmpeg
+@pytest.mark.parametrize("folder", ["-y", "-dash", "shot:01", "http:h"])
+def test_video_of_a_relative_folder_ffmpeg_would_misread(tmp_path, monkeypatch, folder):
+    monkeypatch.chdir(tmp_path)
+    _frames(tmp_path / folder)
+    assert encode_video(f"{folder}/frame_%04d.png", 1, f"{folder}/video.mp4")
+    assert (tmp_path / folder / "video.mp4").stat().st_size > 0
+    assert sorted(os.listdir(tmp_path / folder))[-1] == "video.mp4"  # no temporary file left
+
+
+@needs_ffmpeg
+def test_movie_exemplar_named_like_a_url_and_cache_like_an_option(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    _frames(tmp_path / "src")
+    subprocess.run([FFMPEG, "-y", "-v", "error", "-framerate", "10", "-i", str(tmp_path / "src" / "frame_%04d.png"),
+                    "-c:v", "png", str(tmp_path / "http:h.mov")], check=True)
+    (tmp_path / "-y").mkdir()
+    folder = media_source.decode_movie("http:h.mov", "-y")
+    assert len(media_source.image_files(folder)) == 3
