@@ -1,6 +1,7 @@
 #pragma once
 // Small command-line reader shared by the `tempera` subcommands.
 #include <charconv>
+#include <csignal>
 #include <string>
 #include <vector>
 
@@ -69,8 +70,9 @@ BlenderSetup default_blender_setup();
 // Renders `scene`'s guide cache in background Blender with the add-on's
 // renderer; `options` are render-guides options (--frames, --out, ...).
 // Returns the exit status: 0, 2 (bad values), 1 (any other failure, said on stderr), 130. FileNotFoundError for a missing scene,
-// Blender or package.
-int render_guides_in_blender(const BlenderSetup& setup, const std::string& scene, const Args& options);
+// Blender or package. Once the caller's signal handler sets *interrupted (SIGINT, SIGTERM), Blender is stopped too.
+int render_guides_in_blender(const BlenderSetup& setup, const std::string& scene, const Args& options,
+                             const volatile std::sig_atomic_t* interrupted);
 
 // Sorted unique frames of "1-24" or "1-10,15" (ValueError naming the bad part).
 std::vector<int> parse_frames(const std::string& text);

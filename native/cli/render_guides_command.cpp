@@ -63,7 +63,8 @@ BlenderSetup default_blender_setup() {
           env_or("TEMPERA_ADDON_PATH", fs::path(TEMPERA_PYTHON_PACKAGE_DIR).parent_path().string())};
 }
 
-int render_guides_in_blender(const BlenderSetup& setup, const std::string& scene, const Args& options) {
+int render_guides_in_blender(const BlenderSetup& setup, const std::string& scene, const Args& options,
+                             const volatile std::sig_atomic_t* interrupted) {
   std::error_code ec;
   if (!fs::is_regular_file(scene, ec)) throw FileNotFoundError(concat("scene file not found: '", scene, "'"));
   if (!fs::is_directory(fs::path(setup.addon) / "tempera", ec))
@@ -84,7 +85,7 @@ int render_guides_in_blender(const BlenderSetup& setup, const std::string& scene
   std::vector<std::string> argv = {setup.blender, "-b", "--factory-startup", scene_path, "--python-exit-code", "1",
                                    "--python-expr", bootstrap, "--", setup.addon};
   argv.insert(argv.end(), options.begin(), options.end());
-  const int status = run_process(argv, false, &g_interrupted);
+  const int status = run_process(argv, false, interrupted);
   // The renderer (render_guides_main.py) prints its own error line and exits
   // 2 (bad values), 3 (files) or 130 (interrupted); anything else means
   // Blender failed before or around it (or is not Blender) and said nothing.
@@ -97,7 +98,7 @@ int render_guides_in_blender(const BlenderSetup& setup, const std::string& scene
       std::cerr << "tempera: cannot run '" << setup.blender << "' (install Blender or pass --blender PATH)\n";
       return 1;
     default:
-      if (g_interrupted) return 130;  // Ctrl-C: Blender's own exit status says nothing more
+      if (*interrupted) return 130;  // Ctrl-C: Blender's own exit status says nothing more
       std::cerr << "tempera: Blender ('" << setup.blender << "') exited with status " << status
                 << " while rendering the guides of '" << scene << "'"
                 << (status > 128 ? " (killed by a signal)" : "") << "\n";
@@ -130,12 +131,14 @@ int run_render_guides(const Args& args) {
   if (!fs::is_regular_file(scene, ec)) throw FileNotFoundError(concat("scene file not found: '", scene, "'"));
   if (!has_frames) throw ValueError("--frames is required (e.g. --frames 1-24)");
   if (!has_out) throw ValueError("--out is required (the guide cache folder)");
-  // Ctrl-C reaches Blender too (same process group); this process waits for
-  // it to stop and says what is kept, instead of dying silently first.
+  // Ctrl-C reaches Blender too (same process group), a farm's SIGTERM only
+  // this process, which then stops Blender; either way it waits for Blender
+  // to stop and says what is kept, instead of dying silently first.
   struct sigaction action {};
   action.sa_handler = on_sigint;
   sigaction(SIGINT, &action, nullptr);
-  const int status = render_guides_in_blender(setup, scene, forwarded);
+  sigaction(SIGTERM, &action, nullptr);
+  const int status = render_guides_in_blender(setup, scene, forwarded, &g_interrupted);
   if (g_interrupted) {
     std::cerr << "tempera render-guides: interrupted; the frames finished so far are in the cache "
                  "(rerun the same command to render the rest)\n";

@@ -295,7 +295,7 @@ void render_guides(const Options& o, const std::string& scene, const std::string
   if (!o.samples.empty()) options.insert(options.end(), {"--samples", o.samples, "--ld12e-samples", o.samples});
   std::cerr << "tempera stylize: rendering the guides of " << scene << " (frames " << frames << ") into " << out
             << "\n";
-  const int status = render_guides_in_blender(o.blender, scene, options);
+  const int status = render_guides_in_blender(o.blender, scene, options, &g_interrupted);
   if (g_interrupted) throw CancelledError("interrupted while rendering guides");
   if (status == 2) throw ValueError(concat("rendering the guides of '", scene, "' failed: bad values (see above)"));
   if (status != 0) throw IoError(concat("rendering the guides of '", scene, "' failed (see above)"));

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -35,9 +36,15 @@ int run_process(const std::vector<std::string>& argv, bool quiet, const volatile
   std::vector<char*> raw;
   for (const auto& a : argv) raw.push_back(const_cast<char*>(a.c_str()));
   raw.push_back(nullptr);
+  const pid_t parent = getpid();
   const pid_t pid = fork();
   if (pid < 0) throw IoError(concat("cannot start '", argv[0], "': fork failed"));
   if (pid == 0) {
+    // The child (Blender, ffmpeg) must not outlive this process, even killed
+    // with SIGKILL: it would go on writing into the output. If the parent
+    // died before the request took effect, stop at once.
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent) _exit(127);
     if (quiet) {  // keep a child (ffmpeg) from reading the terminal or flooding stdout
       const int null = open("/dev/null", O_RDWR);
       dup2(null, STDIN_FILENO);

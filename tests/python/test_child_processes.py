@@ -1,11 +1,15 @@
-"""Paths that Tempera hands to Blender and ffmpeg are never read as their
-options or URLs (issue 31, items 7 and 8): a scene named '-P' would make
+"""The programs Tempera starts, Blender and ffmpeg (issue 31, items 7-9).
+
+Paths are never read as their options or URLs: a scene named '-P' would make
 Blender run the next argument as Python, '-a' start its player; ffmpeg reads
-a relative '-y' or '-dash/…' as an option and 'shot:01/…' as a URL."""
+a relative '-y' or '-dash/…' as an option and 'shot:01/…' as a URL. And
+Blender never outlives the command that started it."""
 import os
 import shutil
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -106,3 +110,59 @@ def test_movie_exemplar_named_like_a_url_and_cache_like_an_option(tmp_path, monk
     (tmp_path / "-y").mkdir()
     folder = media_source.decode_movie("http:h.mov", "-y")
     assert len(media_source.image_files(folder)) == 3
+
+
+def _sleeping_blender(tmp_path):
+    """A stand-in for Blender that writes its pid, then sleeps (a long render)."""
+    pid_file = tmp_path / "blender.pid"
+    script = tmp_path / "slow_blender"
+    script.write_text(f"#!{sys.executable}\nimport os, time\n"
+                      f"open({str(pid_file)!r}, 'w').write(str(os.getpid()))\ntime.sleep(120)\n")
+    script.chmod(0o755)
+    return script, pid_file
+
+
+def _alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    with open(f"/proc/{pid}/stat") as stat:  # a zombie has stopped; only its parent has not reaped it
+        return stat.read().split(")")[-1].split()[0] != "Z"
+
+
+def _wait(condition, seconds=20):
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        if condition():
+            return True
+        time.sleep(0.05)
+    return False
+
+
+@pytest.mark.parametrize("command", ["render-guides", "stylize"])
+@pytest.mark.parametrize("signal_name", ["SIGTERM", "SIGKILL"])
+def test_blender_does_not_outlive_the_command(cli_path, tmp_path, command, signal_name):
+    """A farm's cancel (SIGTERM) stops Blender with the CLI; so does the CLI's death (SIGKILL)."""
+    blender, pid_file = _sleeping_blender(tmp_path)
+    scene = tmp_path / "shot.blend"
+    scene.write_bytes(b"BLENDER")
+    args = ["--out", str(tmp_path / "cache"), "--frames", "1-1", "--blender", str(blender)]
+    if command == "stylize":
+        tempera.write_image(str(tmp_path / "style.png"), np.full((8, 8, 3), 0.5, np.float32))
+        args += ["--exemplar", str(tmp_path / "style.png"), "--exemplar-scene", str(scene)]
+    cli = subprocess.Popen([str(cli_path), command, str(scene), *args],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
+    try:
+        assert _wait(lambda: pid_file.is_file() and pid_file.read_text()), "Blender was never started"
+        child = int(pid_file.read_text())
+        cli.send_signal(getattr(signal, signal_name))
+        status = cli.wait(timeout=20)
+        assert _wait(lambda: not _alive(child)), f"Blender (pid {child}) outlived the CLI's {signal_name}"
+        if signal_name == "SIGTERM":
+            assert status == 130 and "interrupted" in cli.stderr.read().decode()
+    finally:
+        if cli.poll() is None:
+            cli.kill()
+        if pid_file.is_file() and pid_file.read_text() and _alive(int(pid_file.read_text())):
+            os.kill(int(pid_file.read_text()), signal.SIGKILL)
