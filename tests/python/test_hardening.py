@@ -333,6 +333,42 @@ def test_declared_image_size_is_capped_before_allocating(tmp_path):
         tempera.set_max_image_pixels(0)
 
 
+def _tiff_declaring(width, height, channels):
+    """A tiny 8-bit TIFF whose header declares width x height pixels of `channels` channels."""
+    entries = [(256, width), (257, height), (258, 8), (259, 1), (262, 1), (273, None), (277, channels),
+               (278, height), (279, 1), (284, 1)]
+    data_offset = 8 + 2 + 12 * len(entries) + 4
+    ifd = b"".join(struct.pack("<HHII", tag, 4, 1, data_offset if value is None else value) for tag, value in entries)
+    return b"II*\x00" + struct.pack("<IH", 8, len(entries)) + ifd + struct.pack("<I", 0) + b"\x00"
+
+
+def test_declared_channels_count_against_the_cap(tmp_path, cli_path):
+    """1000x500 pixels pass the 50 Mpix cap, but 1024 channels of them decode to 2 GB."""
+    bomb = tmp_path / "bomb.tif"
+    bomb.write_bytes(_tiff_declaring(1000, 500, 1024))
+    assert bomb.stat().st_size < 200
+    result = child(f"""
+        import tempera
+        for call in (tempera.read_image, tempera.image_info):
+            try:
+                call({str(bomb)!r})
+            except OSError as exc:
+                print("OSError:", exc)
+        """, memory_mb=1200)
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert result.stdout.count("1000x500 pixels of 1024 channels, 2048 MB decoded, more than the limit") == 2, \
+        result.stdout
+    style = tmp_path / "style.png"
+    tempera.write_image(str(style), np.full((8, 8, 3), 0.5, np.float32))
+    cli = subprocess.run([str(cli_path), "synth", "--style", str(bomb), "--guide", str(style), str(style),
+                          "--output", str(tmp_path / "out.png")], capture_output=True, text=True, timeout=60)
+    assert cli.returncode == 1 and "1024 channels" in cli.stderr, cli.stderr
+    # A guide frame's many channels fit: 64x48 pixels of 1024 channels are 12 MB.
+    small = tmp_path / "small.tif"
+    small.write_bytes(_tiff_declaring(64, 48, 1024))
+    assert len(tempera.image_info(str(small))["channels"]) == 1024
+
+
 def test_levels_have_an_upper_bound():
     style = np.zeros((16, 16, 3), np.float32)
     with pytest.raises(ValueError, match="levels"):

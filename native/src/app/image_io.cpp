@@ -45,11 +45,22 @@ void check_declared_size(const std::string& path, const OIIO::ImageSpec& spec) {
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
     throw IoError(concat("image '", path, "' declares an empty size ", spec.width, "x", spec.height, " with ",
                          spec.nchannels, " channels"));
-  if (std::int64_t(spec.width) * spec.height > cap || spec.nchannels > 4096)
+  const char* raise = "; raise it with TEMPERA_MAX_IMAGE_PIXELS, --max-image-pixels or "
+                      "tempera.set_max_image_pixels() if the file is real";
+  const std::int64_t pixels = std::int64_t(spec.width) * spec.height;
+  if (pixels > cap || spec.nchannels > 4096)
     throw IoError(concat("image '", path, "' declares ", spec.width, "x", spec.height, " pixels (", spec.nchannels,
-                         " channels), more than the limit of ", cap,
-                         " pixels; raise it with TEMPERA_MAX_IMAGE_PIXELS, --max-image-pixels or "
-                         "tempera.set_max_image_pixels() if the file is real"));
+                         " channels), more than the limit of ", cap, " pixels", raise));
+  // Reading decodes a whole part into floats: bytes, not pixels, are what a
+  // header with many channels costs (a 135-byte TIFF can declare 1000x500
+  // pixels of 1024 channels, 2 GB).
+  const auto bytes = static_cast<unsigned __int128>(pixels) * unsigned(spec.nchannels) * sizeof(float);
+  const auto budget = static_cast<unsigned __int128>(cap) * kMaxImageChannelsPerPixel * sizeof(float);
+  if (bytes > budget)
+    throw IoError(concat("image '", path, "' declares ", spec.width, "x", spec.height, " pixels of ", spec.nchannels,
+                         " channels, ", std::int64_t(bytes / 1'000'000), " MB decoded, more than the limit of ",
+                         std::int64_t(budget / 1'000'000), " MB (", cap, " pixels of up to ",
+                         kMaxImageChannelsPerPixel, " channels)", raise));
 }
 
 // A random part for temporary names: process IDs repeat across containers.

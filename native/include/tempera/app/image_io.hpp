@@ -20,6 +20,10 @@ struct ImageFileInfo {
 // 50 Mpix by default (8K UHD fits); TEMPERA_MAX_IMAGE_PIXELS or
 // set_max_image_pixels() (CLI --max-image-pixels) change it.
 constexpr std::int64_t kDefaultMaxImagePixels = 50'000'000;
+// Pixels count with up to this many channels: more channels spend the limit
+// faster (the decoded floats may take at most max_image_pixels() x 8 x 4 bytes,
+// 1.6 GB by default; a 4K guide frame with its 35 standard channels is 1.16 GB).
+constexpr int kMaxImageChannelsPerPixel = 8;
 std::int64_t max_image_pixels();
 void set_max_image_pixels(std::int64_t pixels);
 
