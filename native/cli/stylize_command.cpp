@@ -101,7 +101,8 @@ const char* kStylizeHelpText =
     "  its --temporal defaults to 3. Resume, Ctrl-C and SIGTERM work per segment.\n"
     "temporal noise (Color Me Noisy, after the coherent frames; docs/noisy.md):\n"
     "  --noise F               low-pass width f in pixels: the coherent frames boil by this amount\n"
-    "                          into OUT/noisy/frame_0001.png ... (1.3 calm .. 4.3 lively; 0 = off)\n"
+    "                          into OUT/noisy/frame_0001.png ... (1.3 calm .. 4.3 lively; 0 = off;\n"
+    "                          at most 11.4, less for a small exemplar: the error says how much)\n"
     "  --noise-map FILE|GUIDE  where the noise goes: an image of the frames' size, or a guide of the\n"
     "                          guide cache (alpha, mask.OB_Name, an AOV); 0 = coherent, 1 = --noise\n"
     "  --noise-reference DIR   boil these coherent frames (DIR/frame_0001.png ...) instead of\n"
@@ -263,7 +264,7 @@ Options parse(const Args& args) {
   add_layer_keys(o.layers, o.layer_keys);
   check_method(o);
   validate(o.stylit.synthesis);
-  validate_fields(o.noisy, noisy_option_table());
+  validate_noisy_options(o.noisy);
   const bool noise = o.noisy.noise > 0;
   if (!noise && !(o.noise_map.empty() && o.noise_reference.empty()))
     throw ValueError("--noise-map and --noise-reference need --noise F (the amount of temporal noise)");
@@ -277,6 +278,10 @@ Options parse(const Args& args) {
   if (o.exemplar.empty()) throw ValueError("--exemplar is required (the painting)");
   if (o.frames.empty()) throw ValueError("--frames is required (e.g. --frames 1-24)");
   if (o.out.empty()) throw ValueError("--out is required (the output folder)");
+  if (noise) {  // the noise pass runs last: its exemplar's size is checked now, not after the coherent pass
+    const ImageFileInfo exemplar = inspect_image(o.exemplar);
+    check_noisy_exemplar_size(o.noisy.noise, exemplar.width, exemplar.height, o.noisy.synthesis.patch_size);
+  }
   if (!o.noise_reference.empty()) {  // the coherent frames are given: no stylization
     if (o.guides.empty() && !o.scene.empty()) o.guides = (fs::path(o.out) / "guides").string();
     return o;

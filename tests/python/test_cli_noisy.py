@@ -128,6 +128,15 @@ def test_noise_errors_name_the_problem(cli_path, caches, inputs):
     assert bad.returncode == 2 and "mask.OB_Nothing" in bad.stderr
 
 
+def test_noise_beyond_what_works_is_refused_before_any_work(cli_path, caches):
+    """--noise 20 is beyond the engine's 16 levels; 8 is too coarse for the 64x48 painting. Both are
+    refused while parsing, not after the coherent pass, in the noise's words."""
+    for amount, words in (("20", "11.4"), ("8", "at most 5")):
+        bad = stylize(cli_path, *farm(caches, "--noise", amount))
+        assert bad.returncode == 2 and words in bad.stderr and "levels must be" not in bad.stderr, bad.stderr
+        assert not (caches / "out" / "frames").exists(), "the coherent pass ran first"
+
+
 def test_the_warp_error_of_a_stylized_moving_shot_rises_with_the_width(cli_path, tmp_path):
     """The issue's moving-shot test on the whole pipeline, small: a 128 x 96
     guide cache of a blob moving right 2 px a frame (synthetic, as the renderer

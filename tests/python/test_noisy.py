@@ -154,6 +154,22 @@ def test_bad_options_are_named(inputs):
         noisy.noisy_frame(style, reference, 1, noise=-2)
 
 
+def test_noise_is_bounded_by_what_works_and_says_so(inputs):
+    """f needs 1 + ceil(ln f / ln(1/0.85)) levels: at most 11.4 (16, the engine's most), and less for a
+    small exemplar, whose coarsest level must hold a patch. The errors speak of the noise, not of levels."""
+    style, reference = inputs
+    small = np.ascontiguousarray(style[:48, :64])  # 64x48: its coarsest level holds a patch up to f = 5.0
+    with pytest.raises(ValueError, match=r"11\.4") as too_coarse:
+        noisy.noisy_frame(style, reference, 1, noise=12)
+    assert "levels must be" not in str(too_coarse.value)
+    with pytest.raises(ValueError, match=r"64x48 exemplar.*at most 5") as too_small:
+        noisy.noisy_frame(small, reference, 1, noise=8)
+    assert "levels must be" not in str(too_small.value)
+    assert noisy.noisy_frame(small, reference, 1, noise=5.0).shape == reference.shape  # the largest that works
+    with pytest.raises(ValueError, match="at most 5"):
+        noisy.noisy_frame(small, reference, 1, noise=5.1)
+
+
 def test_the_warp_error_of_a_moving_shot_rises_with_the_width(inputs):
     """A moving R (the medium sliding right 2 px a frame, its Vector passes
     as Blender writes them): the warp error along the motion, the flicker

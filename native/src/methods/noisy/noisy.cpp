@@ -44,6 +44,42 @@ std::vector<float> noisy_box_widths(float noise) {
   return widths;
 }
 
+namespace {
+
+// The solver's rule (solver.cpp): the coarsest level keeps a patch and a pixel each side.
+bool holds_a_patch(int width, int height, int levels, int patch_size) {
+  const auto [w, h] = level_sizes(width, height, levels, kRatio).back();
+  return w >= patch_size + 2 && h >= patch_size + 2;
+}
+
+}  // namespace
+
+void validate_noisy_options(const NoisyOptions& o) {
+  if (!std::isfinite(o.noise) || o.noise < 0 || o.noise > kMaxNoise)
+    throw ValueError(concat("noise (the low-pass width f) must be in [0, ", kMaxNoise, "] pixels, got ", o.noise,
+                            ": f needs 1 + ceil(ln f / ln(1 / 0.85)) pyramid levels, and 16 are the engine's most"));
+  validate_fields(o, noisy_option_table());
+}
+
+float noisy_max_noise(int width, int height, int patch_size) {
+  if (!holds_a_patch(width, height, 1, patch_size)) return 0.0f;
+  // f to 0.1 px, downwards from the largest: noisy_levels grows with f.
+  for (int tenths = int(kMaxNoise * 10 + 0.5f); tenths > 10; --tenths) {
+    const float f = float(tenths) / 10.0f;
+    if (holds_a_patch(width, height, noisy_levels(f), patch_size)) return f;
+  }
+  return 1.0f;  // only f <= 1, which is no noise
+}
+
+void check_noisy_exemplar_size(float noise, int width, int height, int patch_size) {
+  if (!(noise > 1.0f) || holds_a_patch(width, height, noisy_levels(noise), patch_size)) return;
+  const auto [w, h] = level_sizes(width, height, noisy_levels(noise), kRatio).back();
+  throw ValueError(concat("noise ", noise, " is too coarse for the ", width, "x", height, " exemplar: it needs ",
+                          noisy_levels(noise), " pyramid levels (each 0.85 of the last), and the smallest, ", w, "x",
+                          h, " pixels, cannot hold a patch of ", patch_size, " pixels; use a noise of at most ",
+                          noisy_max_noise(width, height, patch_size), " with it, or a larger exemplar"));
+}
+
 std::uint64_t noisy_frame_seed(std::uint64_t seed, int frame) { return mix64(seed ^ mix64(std::uint64_t(std::int64_t(frame)) + 0x6E6F697379ull)); }
 
 Image exemplar_deformation(int width, int height, const NoisyOptions& o, int frame) {
@@ -130,10 +166,9 @@ void validate(const ImageView& style, const ImageView& reference, const NoisyOpt
   if (style.channels != reference.channels)
     throw ValueError(concat("the reference frame has ", reference.channels, " channels but the exemplar has ",
                             style.channels));
-  if (!std::isfinite(o.noise) || o.noise < 0 || o.noise > 64)
-    throw ValueError(concat("noise (the low-pass width f) must be in [0, 64] pixels, got ", o.noise));
   if (!std::isfinite(o.noise_guides) || o.noise_guides < 0)
     throw ValueError(concat("noise_guides (the guided-noise weight) must be >= 0, got ", o.noise_guides));
+  validate_noisy_options(o);
   if (!map.empty()) {
     if (map.channels != 1) throw ValueError("the noise map must have 1 channel");
     require_same_size(map, "noise map", reference, "reference frame");
@@ -200,6 +235,7 @@ Image noisy_frame(const ImageView& style, const ImageView& reference, int frame,
   // the slider's amount, 0 = R as it is).
   const float f = noise_map.empty() ? o.noise : o.noise * std::max(0.0f, *std::max_element(noise_map.data, noise_map.data + noise_map.size()));
   if (!(f > 1.0f)) return Image::copy_of(reference);  // no noise anywhere: R itself
+  check_noisy_exemplar_size(f, style.width, style.height, o.synthesis.patch_size);
   const Image deformation = exemplar_deformation(style.width, style.height, o, frame);
   const Image exemplar = warped(style, deformation);
   SynthesisInput in;

@@ -32,7 +32,7 @@ fs::path key_path(const std::string& out, int frame) {
 
 NoisySequence::NoisySequence(NoisySequenceConfig config) : config_(std::move(config)) {
   const NoisySequenceConfig& c = config_;
-  validate_fields(c.options, noisy_option_table());
+  validate_noisy_options(c.options);
   validate(c.options.synthesis);
   if (c.frames.empty()) throw ValueError("no frames to make (give a frame range)");
   if (c.exemplar.empty()) throw ValueError("the exemplar (a sample of the medium) is required");
@@ -46,6 +46,7 @@ NoisySequence::NoisySequence(NoisySequenceConfig config) : config_(std::move(con
     if (!fs::is_regular_file(reference_path(frame)))
       throw FileNotFoundError(concat("reference frame not found: '", reference_path(frame), "'"));
   medium_ = read_image(c.exemplar);
+  check_noisy_exemplar_size(c.options.noise, medium_.width(), medium_.height(), c.options.synthesis.patch_size);
   settings_ = settings_text(c.options, noisy_option_table()) + settings_text(c.options.synthesis, synthesis_option_table()) +
               file_stamp(c.exemplar);
   if (guided()) read_exemplar_guides();

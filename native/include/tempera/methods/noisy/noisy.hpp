@@ -38,6 +38,9 @@
 
 namespace tempera {
 
+// The largest f: its M = 1 + ceil(ln f / ln(1 / 0.85)) = 16 levels are the engine's most.
+constexpr double kMaxNoise = 11.4;
+
 struct NoisyOptions {
   float noise = 2.2f;          // f, the low-pass width in pixels; <= 1 = no noise (the output is R)
   float lattice_spacing = 50;  // MLS lattice at 1 Mpix (scaled with sqrt(pixels / 1 Mpix))
@@ -56,7 +59,9 @@ inline const auto& noisy_option_table() {
   using N = NoisyOptions;
   static const auto table = std::make_tuple(
       field(&N::noise, "noise", "noise",
-            "the low-pass width f in pixels: how coarse the boiling is (the paper tests 1.3 - 4.3; 0 = off)", 0, 64),
+            "the low-pass width f in pixels: how coarse the boiling is (the paper tests 1.3 - 4.3; 0 = off); "
+            "at most 11.4, whose 16 pyramid levels are the engine's most, and less for a small exemplar",
+            0, kMaxNoise),
       field(&N::lattice_spacing, "lattice_spacing", "lattice-spacing",
             "MLS lattice spacing in pixels at 1 Mpix (scaled with the frame's size); 50 in the paper", 1, 10000),
       field(&N::shift_min, "shift_min", "shift-min", "least move of an MLS lattice node, px at 1 Mpix (15)", 0, 10000),
@@ -82,8 +87,17 @@ inline NoisyOptions default_noisy_options() {
 
 // Levels of the noise pyramid for f: M = 1 + ceil(ln f / ln(1 / 0.85)).
 int noisy_levels(float noise);
+// ValueError for an option out of its range; noise's says why its range ends at kMaxNoise.
+void validate_noisy_options(const NoisyOptions& options);
 // f_bar(l) = f^(l / (M - 1)), l = 0 (finest) .. M - 1.
 std::vector<float> noisy_box_widths(float noise);
+// The largest f (to 0.1 px, at most kMaxNoise) whose coarsest level of a
+// width x height exemplar still holds a patch of patch_size with the solver's
+// margin; 0 when even one level does not.
+float noisy_max_noise(int width, int height, int patch_size);
+// ValueError naming the largest f that works when `noise` is too coarse for
+// an exemplar of width x height (checked before any work, in the noise's words).
+void check_noisy_exemplar_size(float noise, int width, int height, int patch_size);
 
 // The per-frame seed: mix(seed, frame).
 std::uint64_t noisy_frame_seed(std::uint64_t seed, int frame);
