@@ -148,10 +148,7 @@ def _frame_indices(text, start, count):
 def run(args):
     tracks = rigid_tracks.read_tracks(args.cache)
     name, target = _one_object(tracks, args.object, f"guide cache {args.cache}")
-    manifest = json.loads((Path(args.cache) / "manifest.json").read_text()) if (Path(args.cache) / "manifest.json").is_file() else {}
-    if "resolution" not in manifest:
-        raise ValueError(f"{args.cache}: no manifest.json with the frames' resolution")
-    width, height = (int(x) for x in manifest["resolution"])
+    width, height = rigid_tracks.frame_size(args.cache)
     rigid_values, fit_values = (_values(args, t) for t in OPTION_TABLES)
     rigid_values = {"symmetry": rigid.SYMMETRY[args.shape], **rigid_values}  # --symmetry overrides the shape's
     rigid.RigidOptions(**rigid_values), rigid.QuadraticFitOptions(**fit_values)  # named errors before any work

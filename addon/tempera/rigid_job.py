@@ -75,10 +75,7 @@ class RigidJob:
         if unknown or not self.objects:
             raise ValueError(f"no rigid-body track of {', '.join(unknown) or 'any target object'} in "
                              f"{self.cache / rigid_tracks.TRACKS_NAME} (it tracks {', '.join(names) or 'none'})")
-        manifest = self.cache / "manifest.json"
-        if not manifest.is_file() or "resolution" not in json.loads(manifest.read_text()):
-            raise ValueError(f"{self.cache}: no manifest.json with the frames' resolution")
-        self.width, self.height = (int(x) for x in json.loads(manifest.read_text())["resolution"])
+        self.width, self.height = rigid_tracks.frame_size(self.cache)
         start, count = self.tracks["frame_start"], len(self.tracks["objects"][self.objects[0]]["centre"])
         self.frames = list(frames)
         outside = [f for f in self.frames if not start <= f < start + count]

@@ -28,6 +28,9 @@ from pathlib import Path
 
 import numpy as np
 
+from . import _native
+from .frames import MAX_FRAME
+
 TRACKS_NAME = "tracks.json"
 TRACKS_VERSION = 1
 
@@ -154,11 +157,50 @@ def read_tracks(cache_dir):
                                 "baked rigid-body world first)")
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
+    except RecursionError:
+        raise ValueError(f"{path}: unreadable tracks (nested too deeply)") from None
     except (OSError, ValueError) as e:
         raise ValueError(f"{path}: unreadable tracks ({e})") from e
-    if data.get("format") != TRACKS_VERSION or not isinstance(data.get("objects"), dict):
+    if not isinstance(data, dict) or data.get("format") != TRACKS_VERSION or not isinstance(data.get("objects"), dict):
         raise ValueError(f"{path}: not a tracks file of format {TRACKS_VERSION}")
+    _check_tracks(data, path)
     return data
+
+
+def _check_tracks(data, path):
+    """ValueError naming the file, the object and the value: tracks.json is user input, and NaN, inf,
+    1e300 or a string where numbers belong made blank frames or tracebacks."""
+    start = data.get("frame_start")
+    if type(start) is not int or not 0 <= start <= MAX_FRAME:
+        raise ValueError(f"{path}: frame_start must be a whole number from 0 to {MAX_FRAME}, got {start!r}")
+    gravity = data.get("gravity")
+    if (not isinstance(gravity, list) or len(gravity) != 2
+            or not all(type(g) in (int, float) and math.isfinite(g) for g in gravity)):
+        raise ValueError(f"{path}: gravity must be 2 finite numbers, got {gravity!r}")
+    for name, track in data["objects"].items():
+        try:
+            if not isinstance(track, dict):
+                raise ValueError("not a track")
+            _native.check_rigid_track(track)
+        except (TypeError, ValueError, RuntimeError) as e:  # RuntimeError: a value pybind11 cannot convert
+            raise ValueError(f"{path}: object '{name}': {e}") from None
+
+
+def frame_size(cache_dir):
+    """(width, height) of a guide cache's frames (its manifest.json), checked like an image's."""
+    path = Path(cache_dir) / "manifest.json"
+    try:
+        resolution = json.loads(path.read_text(encoding="utf-8"))["resolution"]
+    except (OSError, ValueError, KeyError, TypeError, RecursionError):
+        raise ValueError(f"{cache_dir}: no manifest.json with the frames' resolution") from None
+    if (not isinstance(resolution, list) or len(resolution) != 2
+            or not all(type(x) is int and x >= 1 for x in resolution)):
+        raise ValueError(f"{path}: the resolution must be 2 whole numbers >= 1, got {resolution!r}")
+    width, height = resolution
+    if width * height > _native.max_image_pixels():
+        raise ValueError(f"{path}: the resolution {width}x{height} is more than the limit of "
+                         f"{_native.max_image_pixels()} pixels (raise it with TEMPERA_MAX_IMAGE_PIXELS if real)")
+    return width, height
 
 
 def planarity_warning(axis_world, view_axis_world, limit_degrees=10.0):

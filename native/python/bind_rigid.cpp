@@ -44,7 +44,6 @@ Track track_of(const py::dict& d) {
     tf.velocity = vec2(velocity[f], "a velocity");
     tf.theta = theta[f];
     tf.radius = radius[f];
-    if (!(tf.radius > 0)) throw ValueError(concat("frame ", f, ": the radius must be positive"));
     t.frames.push_back(tf);
   }
   if (d.contains("events"))
@@ -52,6 +51,7 @@ Track track_of(const py::dict& d) {
       const py::dict ed = py::reinterpret_borrow<py::dict>(e);
       t.events.push_back({py::cast<int>(ed["frame"]), vec2(ed["contact"], "a contact"), vec2(ed["normal"], "a normal")});
     }
+  validate_track(t);
   derive_trajectory_angles(t);
   return t;
 }
@@ -108,6 +108,9 @@ void bind_rigid(py::module_& m) {
       m, "ExemplarStyle", exemplar_style_table(),
       "The generated exemplar's style (native/include/tempera/methods/rigid/rigid_exemplar.hpp).");
 
+  m.def(
+      "check_rigid_track", [](const py::dict& track) { track_of(track); }, py::arg("track"),
+      "ValueError (or TypeError) naming what is wrong with a track dict (tracks.json is user input).");
   m.def(
       "bouncing_ball",
       [](std::pair<double, double> start, std::pair<double, double> velocity, double radius, double gravity,

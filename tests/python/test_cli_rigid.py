@@ -71,6 +71,52 @@ def test_bad_input_is_named(inputs, capsys):
     assert "no object 'Nope'" in capsys.readouterr().err
 
 
+def _corrupt(cache, change):
+    path = cache / rigid_tracks.TRACKS_NAME
+    data = json.loads(path.read_text())
+    change(data, data["objects"]["Target"])
+    path.write_text(json.dumps(data))
+
+
+def _set(key, frame, value):
+    def change(data, track):
+        track[key][frame] = value
+    return change
+
+
+@pytest.mark.parametrize("change, words", [
+    (_set("centre", 3, [float("nan"), 40.0]), "frame 3: the centre (nan, 40) must be finite"),
+    (_set("centre", 3, [float("inf"), 40.0]), "frame 3: the centre (inf, 40) must be finite"),
+    (_set("centre", 3, [1e300, 40.0]), "within 1000000 pixels"),
+    (_set("radius", 5, float("nan")), "frame 5: the radius nan must be > 0"),
+    (_set("radius", 5, 1e300), "frame 5: the radius 1e+300 must be > 0 and at most"),
+    (_set("velocity", 2, [0.0, float("-inf")]), "frame 2: the velocity"),
+    (_set("theta", 4, float("nan")), "frame 4: the rotation nan"),
+    (_set("centre", 1, "left"), "object 'Target'"),
+    (lambda data, track: data.update(frame_start="1"), "frame_start must be a whole number"),
+    (lambda data, track: data.update(gravity=[0]), "gravity must be 2 finite numbers"),
+    (lambda data, track: data["objects"].update(Target=[1, 2]), "object 'Target': not a track"),
+])
+def test_bad_track_values_are_named_with_exit_2(inputs, capsys, change, words):
+    """NaN, inf or 1e300 in tracks.json made exit 0 and a blank frame; wrong types a traceback."""
+    _corrupt(inputs / "cache", change)
+    assert _run(inputs) == 2
+    err = capsys.readouterr().err
+    assert words in err and "tracks.json" in err, err
+    assert not list((inputs / "out").glob("frame_*.png")) if (inputs / "out").exists() else True
+
+
+def test_deep_tracks_and_huge_resolutions_are_named_with_exit_2(inputs, capsys):
+    (inputs / "cache" / rigid_tracks.TRACKS_NAME).write_text("[" * 100_000 + "]" * 100_000)
+    assert _run(inputs) == 2
+    assert "nested too deeply" in capsys.readouterr().err
+    _cache(inputs / "cache")
+    for resolution, words in (([100_000, 100_000], "more than the limit"), (["wide", 160], "2 whole numbers")):
+        (inputs / "cache" / "manifest.json").write_text(json.dumps({"resolution": resolution}))
+        assert _run(inputs) == 2
+        assert words in capsys.readouterr().err
+
+
 def _stylize(inputs, *extra):
     return main(["stylize", "--method", "rigid", "--guides", str(inputs / "cache"), "--exemplar", str(inputs / "ex"),
                  "--out", str(inputs / "out"), *extra])

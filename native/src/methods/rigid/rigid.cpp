@@ -22,6 +22,35 @@ std::array<double, 4> augmentation_matrix(const Augmentation& a) {
   return {c * f, -s, s * f, c};  // R_gamma diag(f, 1)
 }
 
+void validate_track(const Track& track) {
+  const auto limit = std::int64_t(kMaxTrackPixels);  // printed whole
+  if (track.frames.empty()) throw ValueError("a track needs at least one frame");
+  const auto within = [](double v) { return std::isfinite(v) && std::abs(v) <= kMaxTrackPixels; };
+  const auto check = [&](Vec2 v, const char* what, std::size_t f) {
+    if (!within(v.x) || !within(v.y))
+      throw ValueError(concat("frame ", f, ": the ", what, " (", v.x, ", ", v.y, ") must be finite and within ",
+                              limit, " pixels"));
+  };
+  for (std::size_t f = 0; f < track.frames.size(); ++f) {
+    const TrackFrame& t = track.frames[f];
+    check(t.centre, "centre", f);
+    check(t.velocity, "velocity", f);
+    if (!within(t.theta))
+      throw ValueError(concat("frame ", f, ": the rotation ", t.theta, " must be finite and within ", limit));
+    if (!(t.radius > 0 && t.radius <= kMaxTrackPixels))
+      throw ValueError(concat("frame ", f, ": the radius ", t.radius, " must be > 0 and at most ", limit,
+                              " pixels"));
+  }
+  for (const RigidEvent& e : track.events) {
+    if (e.frame < 0 || e.frame >= int(track.frames.size()))
+      throw ValueError(concat("an event at frame ", e.frame, " is outside the track's ", track.frames.size(),
+                              " frames"));
+    check(e.contact, "event's contact", std::size_t(e.frame));
+    if (!within(e.normal.x) || !within(e.normal.y) || (e.normal.x == 0 && e.normal.y == 0))
+      throw ValueError(concat("frame ", e.frame, ": the event's normal must be finite and not zero"));
+  }
+}
+
 void derive_trajectory_angles(Track& track, double rest_speed) {
   double delta = 0;
   for (TrackFrame& f : track.frames) {

@@ -124,6 +124,14 @@ inline const auto& rigid_option_table() {
 // last direction.
 void derive_trajectory_angles(Track& track, double rest_speed = 1e-3);
 
+// Screen positions, speeds and radii of a real shot stay far below this (px);
+// beyond it, like NaN and inf, they only make blank frames.
+constexpr double kMaxTrackPixels = 1e6;
+// ValueError naming the first frame or event whose values are not finite, out
+// of kMaxTrackPixels (radius: not in (0, kMaxTrackPixels]) or an event frame
+// outside the track; tracks.json is user input.
+void validate_track(const Track& track);
+
 // The sub-sequences of a track of `frame_count` frames.
 std::vector<SubSequence> cut_subsequences(const Track& track);
 
