@@ -73,6 +73,16 @@ def test_a_key_comes_out_as_painted():
     np.testing.assert_allclose(out[2][8:24, 10:30], painting[8:24, 10:30], atol=1 / 255)
 
 
+def test_an_empty_key_mask_is_named_as_the_keys():
+    """The solver sees a key as an extra exemplar and used to say "exemplar 1 mask is empty"."""
+    style, guides, frames = shot(frames=4)
+    painting = np.random.default_rng(5).random((32, 48, 3)).astype(np.float32)
+    with pytest.raises(ValueError, match="the mask of keyframe 2 is empty") as error:
+        tcia.stylize_shot(style, guides, frames, keys=[(2, painting, np.zeros((32, 48), np.float32))], levels=3,
+                          patch_size=7, threads=2)
+    assert "exemplar 1" not in str(error.value)
+
+
 def test_shot_job_runs_segments_like_the_cli(tmp_path):
     from synthetic_cache import make_cache, make_exemplar
 

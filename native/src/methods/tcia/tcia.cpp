@@ -85,6 +85,11 @@ void validate(const Shot& shot, const TciaOptions& o) {
     if (k.painting.channels != shot.style.channels)
       throw ValueError(concat("the painting of keyframe ", k.frame, " has ", k.painting.channels,
                               " channels, the style ", shot.style.channels));
+    // Named here: the solver would only see "exemplar 1 mask" (a key is an extra exemplar there).
+    if (!k.mask.empty() && std::none_of(k.mask.data, k.mask.data + k.mask.size(), [](float v) { return v > 0.5f; }))
+      throw ValueError(concat("the mask of keyframe ", k.frame,
+                              " is empty (nothing above 0.5): paint white where the key holds, or give no mask "
+                              "for the whole frame"));
   }
   validate_fields(o, tcia_option_table());
   validate(o.synthesis);
