@@ -25,14 +25,18 @@ needs_ffmpeg = pytest.mark.skipif(FFMPEG is None, reason="ffmpeg is not on PATH"
 BLENDER_OPTIONS = {"-b", "--factory-startup", "--python-exit-code", "--python-expr"}
 
 
+def stand_in_blender(tmp_path, name, body):
+    """An executable Python script `name` that does `body` where Tempera expects Blender."""
+    script = tmp_path / name
+    script.write_text(f"#!{sys.executable}\nimport os, sys, time\n{body}\n")
+    script.chmod(0o755)
+    return script
+
+
 def fake_blender(tmp_path):
     """A stand-in for Blender that appends its arguments, one call a line, to calls.txt."""
     calls = tmp_path / "calls.txt"
-    script = tmp_path / "blender"
-    script.write_text(f"#!{sys.executable}\nimport sys\n"
-                      f"open({str(calls)!r}, 'a').write(repr(sys.argv[1:]) + '\\n')\n")
-    script.chmod(0o755)
-    return script, calls
+    return stand_in_blender(tmp_path, "blender", f"open({str(calls)!r}, 'a').write(repr(sys.argv[1:]) + '\\n')"), calls
 
 
 def blender_calls(calls):
@@ -115,11 +119,8 @@ def test_movie_exemplar_named_like_a_url_and_cache_like_an_option(tmp_path, monk
 def _sleeping_blender(tmp_path):
     """A stand-in for Blender that writes its pid, then sleeps (a long render)."""
     pid_file = tmp_path / "blender.pid"
-    script = tmp_path / "slow_blender"
-    script.write_text(f"#!{sys.executable}\nimport os, time\n"
-                      f"open({str(pid_file)!r}, 'w').write(str(os.getpid()))\ntime.sleep(120)\n")
-    script.chmod(0o755)
-    return script, pid_file
+    body = f"open({str(pid_file)!r}, 'w').write(str(os.getpid()))\ntime.sleep(120)"
+    return stand_in_blender(tmp_path, "slow_blender", body), pid_file
 
 
 def _alive(pid):

@@ -306,18 +306,23 @@ def _png_declaring(width, height):
             + chunk(b"IDAT", zlib.compress(b"\x00")) + chunk(b"IEND", b""))
 
 
+def _open_in_a_small_child(path):
+    """read_image and image_info of `path` in a child with 1.2 GB of memory; each OSError printed."""
+    return child(f"""
+        import tempera
+        for call in (tempera.read_image, tempera.image_info):
+            try:
+                call({str(path)!r})
+            except OSError as exc:
+                print("OSError:", exc)
+        """, memory_mb=1200)
+
+
 def test_declared_image_size_is_capped_before_allocating(tmp_path):
     bomb = tmp_path / "bomb.png"
     bomb.write_bytes(_png_declaring(12000, 12000))
     assert bomb.stat().st_size < 100
-    result = child(f"""
-        import tempera
-        for call in (tempera.read_image, tempera.image_info):
-            try:
-                call({str(bomb)!r})
-            except OSError as exc:
-                print("OSError:", exc)
-        """, memory_mb=1200)
+    result = _open_in_a_small_child(bomb)
     assert result.returncode == 0, result.stderr[-2000:]
     assert result.stdout.count("more than the limit of 50000000 pixels") == 2, result.stdout
     # The cap can be raised (then the file fails as the broken PNG it is, within memory).
@@ -347,14 +352,7 @@ def test_declared_channels_count_against_the_cap(tmp_path, cli_path):
     bomb = tmp_path / "bomb.tif"
     bomb.write_bytes(_tiff_declaring(1000, 500, 1024))
     assert bomb.stat().st_size < 200
-    result = child(f"""
-        import tempera
-        for call in (tempera.read_image, tempera.image_info):
-            try:
-                call({str(bomb)!r})
-            except OSError as exc:
-                print("OSError:", exc)
-        """, memory_mb=1200)
+    result = _open_in_a_small_child(bomb)
     assert result.returncode == 0, result.stderr[-2000:]
     assert result.stdout.count("1000x500 pixels of 1024 channels, 2048 MB decoded, more than the limit") == 2, \
         result.stdout
