@@ -31,8 +31,8 @@ WHEEL_SOURCES := CMakeLists.txt pyproject.toml README.md native/python/tempera_n
                          -o -name CMakeLists.txt 2>/dev/null)
 # The exemplar kit bundled in the add-on zip (scenes/exemplar_kit.py renders and paints it).
 KIT      := $(BUILD)/kit/sphere_on_table
-KIT_SOURCES := scenes/exemplar_kit.py scenes/scene_kit.py addon/tempera/exemplar_paint.py \
-               addon/tempera/blender/guide_render.py addon/tempera/guide_cache.py
+KIT_SOURCES := scenes/exemplar_kit.py scenes/scene_kit.py addon/tempera/methods/stylit/exemplar_paint.py \
+               addon/tempera/blender/guide_render.py addon/tempera/app/guide_cache.py
 DEMO_OUT ?= out/demo
 
 .PHONY: all deps build kit addon-zip wheel extension test demo demo-rigid demo-fluids demo-fluids-stylize bench bench-tracer sanitize fuzz clean

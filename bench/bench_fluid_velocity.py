@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Benchmark of the fluid_velocity guide (tempera.fluid_velocity) on a large
+"""Benchmark of the fluid_velocity guide (tempera.app.fluid_velocity) on a large
 gas domain seen at HD, with no Blender: a 128 x 64 x 64 grid of random
 velocities, half its voxels with density, through an orthographic camera into
 a 1920 x 1080 guide whose alpha covers 1300 x 700 pixels (the diffusion fill
@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 
-from tempera import fluid_velocity as fv
+from tempera.app import fluid_velocity as fv
 
 WIDTH, HEIGHT = 1920, 1080
 RESOLUTION = (128, 64, 64)

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Seconds per frame and peak memory of Fluidymation (tempera.fluidymation)
+"""Seconds per frame and peak memory of Fluidymation (tempera.methods.fluidymation.fluidymation)
 at the paper's second size: a 500 x 600 target whose mask is a spreading
 blob of about 60k pixels, and a 200 x 200 x 20 exemplar (ink rings on a
 spreading disc, RGB + mask). The method's defaults (5 x 5 patches, b = 30,
@@ -19,7 +19,7 @@ import time
 
 import numpy as np
 
-from tempera import fluidymation
+from tempera.methods.fluidymation import fluidymation
 
 
 def disc(h, w, radius, cx, cy):

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""LazyFluids (tempera.lazyfluids): seconds per frame, and the 120-frame
+"""LazyFluids (tempera.methods.lazyfluids.lazyfluids): seconds per frame, and the 120-frame
 wash-out run of the issue.
 
 Speed: a `--side`² target (default 512²) whose alpha is a disc of radius
@@ -23,7 +23,7 @@ import time
 
 import numpy as np
 
-from tempera import lazyfluids
+from tempera.methods.lazyfluids import lazyfluids
 
 
 def smoke(n, seed=1):

@@ -42,7 +42,7 @@ def noise(a, b, mask):
 
 def traced(scene, samples, seed):
     from tempera.blender.scene_export import evaluated_depsgraph, export_scene, path_settings
-    from tempera.lpe import trace_lpe
+    from tempera.tracer.lpe import trace_lpe
 
     size = (scene.render.resolution_x, scene.render.resolution_y)
     scene_dict, _ = export_scene(scene, evaluated_depsgraph(scene, scene.view_layers[0], 1), size)

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Seconds per frame of Color Me Noisy (tempera.noisy.noisy_frame) at 0.25
+"""Seconds per frame of Color Me Noisy (tempera.methods.noisy.noisy.noisy_frame) at 0.25
 and 1 Mpix, for the calm and the lively end of the slider (f = 2.2, 4.3).
 The paper: about 30 s per Mpix on one core of a 3.5 GHz Xeon (§4).
 
@@ -37,7 +37,7 @@ def medium(rng, h, w):
 
 def run_one(size, f, threads):
     """One frame of one size and width: wall and CPU seconds."""
-    from tempera import noisy
+    from tempera.methods.noisy import noisy
 
     w, h = SIZES[size]
     rng = np.random.default_rng(1)

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Seconds per frame of the rigid-body method (tempera.rigid, Dvorožňák
+"""Seconds per frame of the rigid-body method (tempera.methods.rigid.rigid, Dvorožňák
 2017) at the demo's 640 x 360 and at 1280 x 720: fitting the drawn exemplar
 (per drawn frame), matching and blending the deformations (the whole target
 track), and making the RGBA frames of one object (per target frame).
@@ -15,7 +15,8 @@ import os
 import platform
 import time
 
-from tempera import _native, rigid
+from tempera import _native
+from tempera.methods.rigid import rigid
 
 SIZES = {"640 x 360": (640, 360), "1280 x 720": (1280, 720)}
 TARGET_FRAMES = 96

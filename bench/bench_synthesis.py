@@ -37,7 +37,7 @@ import time
 import numpy as np
 
 import tempera
-from tempera.synthesis import synthesize
+from tempera.engine.synthesis import synthesize
 
 
 def shade_scene(h, w, spheres):

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Seconds per frame of the coherent method (Bénard et al. 2013, tempera.tcia)
+"""Seconds per frame of the coherent method (Bénard et al. 2013, tempera.methods.tcia.tcia)
 on a synthetic panning shot, at a given size.
 
 The shot: a camera panning `--speed` px per frame over shaded spheres on a
@@ -13,7 +13,7 @@ backward sweep per level, 4 PatchMatch iterations per visit).
     PYTHONPATH=addon /usr/bin/python3 bench/bench_tcia.py --mpix 0.25 --frames 4 [--json out.json]
 
 With `--layers N` the frame is also solved as N layers (vertical strips,
-tempera.tcia.stylize_layers: motion and guides extended past each strip, one
+tempera.methods.tcia.tcia.stylize_layers: motion and guides extended past each strip, one
 solve per layer) in the same run, beside the one-layer solve.
 """
 import argparse
@@ -25,7 +25,7 @@ import time
 import numpy as np
 
 from bench_synthesis import hatching_style, shade_scene
-from tempera import tcia
+from tempera.methods.tcia import tcia
 
 
 def panning_shot(side, frames, speed):

@@ -24,7 +24,7 @@ import time
 import numpy as np
 
 import tempera
-from tempera.lpe import STYLIT_EXPRESSIONS
+from tempera.tracer.lpe import STYLIT_EXPRESSIONS
 
 
 def sphere(center, radius, rings, segments):

@@ -15,7 +15,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bench_synthesis as bs  # noqa: E402
-from tempera.synthesis import synthesize  # noqa: E402
+from tempera.engine.synthesis import synthesize  # noqa: E402
 
 
 def digest(a):

@@ -152,7 +152,7 @@ def test_layers_picked_from_collections_give_per_layer_frames_and_their_composit
     collection's mask as alpha) and composited by depth into the frames."""
     import tempera
     from test_addon import _Recorder
-    from tempera import guide_cache
+    from tempera.app import guide_cache
     from tempera.blender.stylize_operator import StylizeRun
 
     scene, settings = coherent, coherent.tempera
@@ -211,7 +211,7 @@ def test_a_keyframe_of_one_layer(coherent, tmp_path):
     composite is the painting where the cube is (in front), the wall is
     solved without a key, and the shot splits there."""
     import tempera
-    from tempera import guide_cache
+    from tempera.app import guide_cache
     from tempera.blender.stylize_operator import StylizeRun
 
     scene, settings = coherent, coherent.tempera

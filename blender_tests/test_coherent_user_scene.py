@@ -53,8 +53,9 @@ def _frames(folder):
 
 def _warp_errors(guides, frames):
     """Per frame f > first: the mean colour change from f - 1 along the
-    rendered motion where it is valid (tempera.temporal.flicker)."""
-    from tempera import guide_cache, temporal
+    rendered motion where it is valid (tempera.engine.temporal.flicker)."""
+    from tempera.app import guide_cache
+    from tempera.engine import temporal
 
     errors = {}
     for f in list(FRAMES)[1:]:
@@ -67,8 +68,8 @@ def _paint_keys(guides, folder):
     """The demo's stand-in artist (scenes/demo_scene.py paint_keys): hatching
     over each key frame's render where the scene covers the film."""
     import tempera
-    from tempera import guide_cache
-    from tempera.exemplar_paint import paint_hatching
+    from tempera.app import guide_cache
+    from tempera.methods.stylit.exemplar_paint import paint_hatching
 
     folder.mkdir()
     keys = []
@@ -82,7 +83,7 @@ def _paint_keys(guides, folder):
 
 def test_coherent_method_on_a_users_scene_from_the_panel_and_the_cli(user_scene, tmp_path):
     import tempera
-    from tempera import kit
+    from tempera.methods.stylit import kit
     from tempera.blender.properties import WEIGHT_PROPERTIES
 
     scene, settings = user_scene, user_scene.tempera

@@ -50,7 +50,7 @@ def test_blot_grows_steadily_with_one_topology(ink_scene):
 
 
 def test_guides_have_the_mask_and_an_outward_flow(ink_scene, tmp_path):
-    from tempera import guide_cache
+    from tempera.app import guide_cache
     from tempera.blender.guide_render import render_guides
 
     scene, ink = ink_scene

@@ -183,13 +183,13 @@ def smoke(tmp_path_factory):
 
 
 def _frame(smoke, f):
-    from tempera import guide_cache
+    from tempera.app import guide_cache
 
     return guide_cache.read_frame(smoke["cache"], f, ["alpha", "velocity_forward", "fluid_velocity"])
 
 
 def test_the_guide_is_written_for_a_smoke_scene(smoke):
-    from tempera import guide_cache
+    from tempera.app import guide_cache
 
     assert smoke["report"]["rendered"] == FRAMES
     assert "fluid_velocity" in guide_cache.read_manifest(smoke["cache"])["guides"]
@@ -209,7 +209,7 @@ def test_fluid_velocity_points_along_the_flow_where_the_smoke_is(smoke):
 def _smoke_centroid(scene, frame):
     """Pixel position of the density-weighted centre of the smoke at `frame`,
     from the density grid alone (the velocity grid plays no part)."""
-    from tempera import fluid_velocity as fv
+    from tempera.app import fluid_velocity as fv
     from tempera.blender import fluid_velocity as bfv
     from tempera.blender.scene_export import evaluated_depsgraph
 
@@ -268,7 +268,7 @@ def liquid(tmp_path_factory):
 
 def _liquid_centre(scene, domain, frame):
     """Pixel position of the mean vertex of the liquid mesh at `frame`."""
-    from tempera import fluid_velocity as fv
+    from tempera.app import fluid_velocity as fv
     from tempera.blender import fluid_velocity as bfv
     from tempera.blender.scene_export import evaluated_depsgraph
 
@@ -285,7 +285,7 @@ def test_liquid_moves_by_its_fluid_velocity(liquid):
     """The liquid's mean vertex moves by the guide's mean over the liquid
     from one frame to the next, both along x (thrown) and y (falling); the
     Vector pass sees none of it."""
-    from tempera import guide_cache
+    from tempera.app import guide_cache
 
     scene, domain = liquid["scene"], liquid["domain"]
     moved = _liquid_centre(scene, domain, LIQUID_FRAMES[1]) - _liquid_centre(scene, domain, LIQUID_FRAMES[0])
@@ -341,7 +341,7 @@ def test_particles_move_by_their_velocity_times_the_timestep(particles):
     """A particle moves by velocity * timestep (0.04 s) per frame, whatever
     the fps; Cycles' motion vectors of the instanced spheres say the same,
     which checks the convention (p moves to p + F) against velocity_forward."""
-    from tempera import guide_cache
+    from tempera.app import guide_cache
 
     assert "fluid_velocity" in guide_cache.read_manifest(particles["cache"])["guides"]
     expected = PARTICLE_SPEED * 0.04 * SIZE[0] / ORTHO_SCALE  # pixels per frame

@@ -70,7 +70,7 @@ def rendered(tmp_path_factory):
 
 
 def frame(rendered, f):
-    from tempera import guide_cache
+    from tempera.app import guide_cache
 
     return guide_cache.read_frame(rendered["cache"], f)
 
@@ -84,7 +84,8 @@ def screen_position(scene, point):
 
 
 def test_manifest_and_channels(rendered):
-    from tempera import guide_cache, image_info
+    from tempera.app import guide_cache
+    from tempera import image_info
 
     report, cache = rendered["report"], rendered["cache"]
     assert report["rendered"] == list(FRAMES) and report["skipped"] == []
@@ -190,7 +191,7 @@ def test_the_world_has_no_velocity_while_the_camera_turns(tmp_path):
     turntable it moved the coherent method's background by up to 7 px a
     frame. With the camera panning over a backdrop that leaves the world in
     view, the world's pixels must have no velocity and the backdrop's must."""
-    from tempera import guide_cache
+    from tempera.app import guide_cache
     from tempera.blender.guide_render import render_guides
 
     scene = _build_scene("Turning camera")
@@ -297,7 +298,7 @@ def test_settings_come_back_when_rendering_fails(rendered, tmp_path):
 
 
 def test_workbench_scene_gets_cycles_guides_and_keeps_its_engine(rendered, tmp_path):
-    from tempera import guide_cache
+    from tempera.app import guide_cache
     from tempera.blender.guide_render import render_guides
 
     scene = rendered["scene"]
@@ -349,7 +350,7 @@ def test_frame_key_follows_the_scene(rendered):
 def test_freestyle_lines_join_the_line_guide(rendered, tmp_path):
     """With Freestyle on, the artist's lines are part of the line guide. The
     depth and normal thresholds are set out of reach so only Freestyle draws."""
-    from tempera import guide_cache
+    from tempera.app import guide_cache
     from tempera.blender.guide_render import render_guides
 
     scene = rendered["scene"]
@@ -375,7 +376,8 @@ def test_freestyle_lines_join_the_line_guide(rendered, tmp_path):
 def test_orientation_from_the_artists_aov(rendered, tmp_path):
     """Strokes along x written to a Color AOV on the cube become the cube's
     orientation; pixels without the AOV keep the computed one."""
-    from tempera import guide_cache, guides
+    from tempera.app import guide_cache
+    from tempera.engine import guides
     from tempera.blender.guide_render import GuideRenderError, render_guides
 
     scene = rendered["scene"]

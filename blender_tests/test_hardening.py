@@ -23,7 +23,7 @@ def scene():
 
 
 def params(**extra):
-    from tempera import guide_cache
+    from tempera.app import guide_cache
 
     return {**guide_cache.DEFAULT_PARAMS, **PARAMS, **extra}
 
@@ -39,7 +39,7 @@ def private_tmp(tmp_path):
 
 
 def test_interrupted_render_keeps_each_finished_frame(scene, tmp_path, private_tmp):
-    from tempera import guide_cache
+    from tempera.app import guide_cache
     from tempera.blender.guide_render import WORK_PREFIX, render_guides
 
     cache = tmp_path / "guides"
@@ -75,7 +75,7 @@ def test_interrupted_render_keeps_each_finished_frame(scene, tmp_path, private_t
 
 
 def test_corrupt_cache_frame_and_manifest_are_redone(scene, tmp_path):
-    from tempera import guide_cache
+    from tempera.app import guide_cache
     from tempera.blender.guide_render import render_guides
 
     cache = tmp_path / "guides"
@@ -113,12 +113,12 @@ def test_frames_blender_cannot_render_are_refused(scene, tmp_path):
 
 
 def test_panel_draw_never_compiles_light_path_expressions(scene, monkeypatch):
-    import tempera.lpe
+    import tempera.tracer.lpe
     from tempera.blender import guide_operator
 
     compiled = []
     monkeypatch.setattr(guide_operator, "check_lpe_expressions", lambda e: compiled.append(e))
-    monkeypatch.setattr(tempera.lpe._native, "check_lpe", lambda e: compiled.append(e))
+    monkeypatch.setattr(tempera.tracer.lpe._native, "check_lpe", lambda e: compiled.append(e))
     settings = scene.tempera
     settings.guide_lpe = "L.*D.{11}E; LDE"  # the update callback checks it, outside draw()
     try:

@@ -50,7 +50,7 @@ def compare(traced, reference, alpha):
 
 def render(scene, cache, expressions, samples=SAMPLES):
     """Cycles guides and the tracer's guides of frame 1, through render_guides."""
-    from tempera import guide_cache
+    from tempera.app import guide_cache
     from tempera.blender.guide_render import render_guides
 
     report = render_guides(scene, [1], cache, {"samples": samples, "ld12e_samples": 1, "masks": "none",
@@ -62,7 +62,7 @@ def render(scene, cache, expressions, samples=SAMPLES):
 def trace(scene, expressions, samples=SAMPLES):
     """The tracer's images and alpha of the scene at its current frame."""
     from tempera.blender.scene_export import evaluated_depsgraph, export_scene
-    from tempera.lpe import trace_lpe
+    from tempera.tracer.lpe import trace_lpe
 
     depsgraph = evaluated_depsgraph(scene, scene.view_layers[0], scene.frame_current)
     scene_dict, warnings = export_scene(scene, depsgraph, SIZE)
@@ -91,7 +91,7 @@ def diffuse(tmp_path_factory):
 
 
 def traced(guides, expression):
-    from tempera import guide_cache
+    from tempera.app import guide_cache
 
     return guides[guide_cache.lpe_guide(expression)]
 
@@ -134,10 +134,10 @@ def test_alpha_matches_cycles(metal):
 def test_alpha_matches_cycles_for_other_cameras(kind, size, fit, shift, tmp_path):
     """The tracer's own camera (not only the exported numbers) against Cycles:
     portrait and landscape, sensor fits, shifts, orthographic."""
-    from tempera import guide_cache
+    from tempera.app import guide_cache
     from tempera.blender.guide_render import render_guides
     from tempera.blender.scene_export import evaluated_depsgraph, export_scene
-    from tempera.lpe import trace_lpe
+    from tempera.tracer.lpe import trace_lpe
 
     scene = lpe_scene.build_scene(f"LPE {kind} {fit}", size)
     camera = scene.camera.data
@@ -261,7 +261,8 @@ def test_caustics_under_a_mirror_sphere():
 # --------------------------------------------------------------------------- the guide cache
 
 def test_render_guides_writes_the_lpe_channels(metal):
-    from tempera import guide_cache, image_info
+    from tempera.app import guide_cache
+    from tempera import image_info
 
     cache, expressions = metal["cache"], metal["expressions"]
     manifest = guide_cache.read_manifest(cache)
@@ -279,7 +280,7 @@ def test_animated_frames_are_traced_at_their_frame(tmp_path):
     """The moving cube of guide_scene.py: each frame's L.*E against Cycles'
     FULL of the same frame (no glossy surfaces, so they hold the same paths)."""
     from guide_scene import build_scene, remove_scene
-    from tempera import guide_cache
+    from tempera.app import guide_cache
     from tempera.blender.guide_render import render_guides
 
     scene = build_scene("LPE animation")
@@ -345,7 +346,7 @@ CAMERAS = [  # (type, resolution, sensor fit, shift x, shift y)
 def test_camera_rays_follow_blenders_projection(kind, size, fit, shift_x, shift_y):
     """Points on the exported camera's pixel rays land on the same pixel
     centres under Blender's own projection matrix."""
-    from tempera import scene_units
+    from tempera.tracer import scene_units
     from tempera.blender.scene_export import evaluated_depsgraph, export_camera
 
     scene = bpy.data.scenes.new("LPE camera")

@@ -123,7 +123,7 @@ def traced_buffers(scene, samples=SAMPLES, seed=0):
     """The tracer's buffers at the scene's current settings (after
     cycles_buffers: caustics off, as Cycles rendered)."""
     from tempera.blender.scene_export import evaluated_depsgraph, export_scene, path_settings
-    from tempera.lpe import trace_lpe
+    from tempera.tracer.lpe import trace_lpe
 
     size = (scene.render.resolution_x, scene.render.resolution_y)
     scene_dict, warnings = export_scene(scene, evaluated_depsgraph(scene, scene.view_layers[0], 1), size)
@@ -169,7 +169,7 @@ def test_gallery_figures_catch_a_wrong_material(tmp_path):
     """The figures are not lenient: the Mix Shader sphere traced as what the
     exporter used to make of it (a diffuse surface of a viewport white) fails them."""
     from tempera.blender.scene_export import evaluated_depsgraph, export_scene, path_settings
-    from tempera.lpe import trace_lpe
+    from tempera.tracer.lpe import trace_lpe
 
     scene = lpe_gallery.build("mix_glossy_diffuse")
     try:
@@ -194,7 +194,7 @@ def test_pixel_filter_matches_cycles_per_pixel(tmp_path):
     over 3 pixels): the tracer with the scene's filter agrees pixel by pixel
     (RMS, relative to the mean) far better than with a box of one pixel."""
     from tempera.blender.scene_export import evaluated_depsgraph, export_scene, path_settings
-    from tempera.lpe import trace_lpe
+    from tempera.tracer.lpe import trace_lpe
 
     scene = lpe_gallery.build("spot")  # sharp shadow edges and the cone's rim
     try:

@@ -112,9 +112,9 @@ PANEL_CHANGES = {"LAZYFLUIDS": {"lf_eta": ("alpha_guide_weight", 1.25), "lf_alph
 
 @pytest.mark.parametrize("method", sorted(PANEL_CHANGES))
 def test_panel_options_reach_the_job(media_scene, tmp_path, monkeypatch, method):
-    import tempera.fluidymation
-    import tempera.lazyfluids
-    from tempera import settings as limits
+    import tempera.methods.fluidymation.fluidymation
+    import tempera.methods.lazyfluids.lazyfluids
+    from tempera.app import settings as limits
     from tempera.blender.stylize_operator import StylizeRun
 
     s = media_scene.tempera
@@ -134,8 +134,8 @@ def test_panel_options_reach_the_job(media_scene, tmp_path, monkeypatch, method)
             made.update(values)
             raise RuntimeError("recorded")
 
-    monkeypatch.setattr(tempera.lazyfluids, "FluidJob", Job)
-    monkeypatch.setattr(tempera.fluidymation, "MediaJob", Job)
+    monkeypatch.setattr(tempera.methods.lazyfluids.lazyfluids, "FluidJob", Job)
+    monkeypatch.setattr(tempera.methods.fluidymation.fluidymation, "MediaJob", Job)
     run = StylizeRun.from_settings(media_scene, "ANIMATION")
     with pytest.raises(RuntimeError, match="recorded"):
         run.make_method_job()
@@ -151,7 +151,7 @@ def _check_result(scene, tmp_path, folder, target_guide):
     """The RGBA frames' alpha covers the target (IoU >= 0.9) and the
     composite scene lays them over the render."""
     import tempera
-    from tempera import guide_cache
+    from tempera.app import guide_cache
 
     frames = list(range(FRAMES[0], FRAMES[-1] + 1))
     out = sorted((tmp_path / "out" / folder).rglob("frame_*.png"))
@@ -214,7 +214,7 @@ def _movie(tmp_path):
 
 
 def test_natural_media_on_an_object_end_to_end_and_resume(media_scene, tmp_path):
-    from tempera import guide_cache
+    from tempera.app import guide_cache
 
     s = media_scene.tempera
     s.method = "FLUIDYMATION"
@@ -260,7 +260,7 @@ def test_fluid_method_on_a_baked_smoke_domain(tmp_path):
     """LazyFluids from the panel on Mantaflow smoke: its alpha follows the
     smoke's, the flow is the fluid_velocity guide (the Vector pass is zero there)."""
     import tempera
-    from tempera import guide_cache
+    from tempera.app import guide_cache
     from test_fluid_velocity import (FRAMES as SMOKE_FRAMES, _bake, _remove_scene, build_smoke_scene,
                                      skip_without_mantaflow)
 

@@ -54,8 +54,9 @@ def _frames(folder):
 
 
 def _energy(frames, guides):
-    """Non-DC temporal power along the rendered motion (tempera.temporal)."""
-    from tempera import guide_cache, temporal
+    """Non-DC temporal power along the rendered motion (tempera.engine.temporal)."""
+    from tempera.app import guide_cache
+    from tempera.engine import temporal
 
     motion = [guide_cache.read_frame(guides, f, ["velocity_forward", "occlusion_forward"])
               for f in range(FRAMES[0], FRAMES[1] + 1)]
@@ -64,8 +65,9 @@ def _energy(frames, guides):
 
 
 def test_temporal_noise_from_the_panel_and_the_cli(user_scene, tmp_path):
-    from tempera import noisy, temporal
-    from tempera.kit import kit_exemplar
+    from tempera.methods.noisy import noisy
+    from tempera.engine import temporal
+    from tempera.methods.stylit.kit import kit_exemplar
 
     settings = user_scene.tempera
     settings.noise_level = HIGH

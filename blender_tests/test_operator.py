@@ -31,7 +31,7 @@ def scene():
 @pytest.fixture(scope="module")
 def first_run(scene, tmp_path_factory):
     """The operator run on frames 2-3 into a fresh absolute folder."""
-    from tempera import guide_cache
+    from tempera.app import guide_cache
 
     cache = tmp_path_factory.mktemp("operator") / "guides"
     settings = scene.tempera
@@ -45,7 +45,7 @@ def first_run(scene, tmp_path_factory):
 
 
 def test_default_settings_are_the_default_params():
-    from tempera import guide_cache
+    from tempera.app import guide_cache
     from tempera.blender.guide_operator import guide_params
 
     settings = bpy.context.scene.tempera
@@ -151,7 +151,7 @@ def test_panel_line_counts_current_frames(scene, first_run):
 def test_job_steps_one_frame_at_a_time(scene, tmp_path):
     """The modal run's step, stopped after the first frame (as Esc does):
     that frame stays in the cache, the next run renders only the rest."""
-    from tempera import guide_cache
+    from tempera.app import guide_cache
     from tempera.blender.guide_operator import GuideJob
 
     settings = scene.tempera

@@ -81,7 +81,7 @@ def test_lazyfluids_from_the_panel_and_the_cli_follow_the_liquid(liquid):
 
 def test_natural_media_on_the_liquid_takes_its_fluid_velocity(liquid, tmp_path):
     import tempera
-    from tempera import media_exemplars
+    from tempera.app import media_exemplars
     from tempera.blender.stylize_operator import StylizeRun
 
     ink = tmp_path / "ink"

@@ -88,7 +88,7 @@ def baked_and_stylized(tmp_path_factory, build_scene, frames):
     then the LazyFluids panel run on `frames` from the procedural smoke still;
     yields {"scene", "tmp", "still"} and removes the scenes afterwards."""
     import tempera
-    from tempera import media_exemplars
+    from tempera.app import media_exemplars
 
     skip_without_mantaflow()
     tmp = tmp_path_factory.mktemp("quick_effect")
@@ -118,7 +118,7 @@ def smoke(tmp_path_factory):
 
 
 def _guides(tmp, frame):
-    from tempera import guide_cache
+    from tempera.app import guide_cache
 
     return guide_cache.read_frame(tmp / "guides", frame, ["alpha", "fluid_velocity"])
 
@@ -187,7 +187,7 @@ def test_the_cli_on_the_same_cache_and_the_temporal_term(smoke):
 
 def test_natural_media_on_the_smoke_takes_its_fluid_velocity(smoke, tmp_path):
     import tempera
-    from tempera import media_exemplars
+    from tempera.app import media_exemplars
     from tempera.blender.stylize_operator import StylizeRun
 
     ink = tmp_path / "ink"
@@ -215,7 +215,7 @@ def test_quick_fire_from_the_cli(tmp_path, monkeypatch):
     still be written (they failed on the size mismatch before). Measured:
     alpha IoU 0.92 / 0.93 / 0.93 with the fire still."""
     import tempera
-    from tempera import media_exemplars
+    from tempera.app import media_exemplars
     from tempera.blender.guide_render import render_guides
 
     skip_without_mantaflow()

@@ -18,7 +18,8 @@ FRAMES = (5, 14)  # around the bounce (frame ~12): guides of 10 frames, two chun
 
 
 def _exemplar(folder):
-    from tempera import _native, rigid, rigid_tracks
+    from tempera import _native
+    from tempera.methods.rigid import rigid, rigid_tracks
 
     track = _native.bouncing_ball((20, 15), (2.0, 0), 8, 0.6, 62, 0.65, 0.05, 24)
     rigid_tracks.write_tracks(folder, {"Ball": track}, 1, (0, 0.6))
@@ -98,7 +99,7 @@ def test_stylize_animation_draws_the_ball_and_resumes(rigid_scene, tmp_path):
     frames = list(range(FRAMES[0], FRAMES[1] + 1))
     out = tmp_path / "out" / "rigid" / "frames"
     assert _frames(out) == [f"frame_{f:04d}.png" for f in frames]
-    tracks = tempera.rigid_tracks.read_tracks(tmp_path / "guides")
+    tracks = tempera.methods.rigid.rigid_tracks.read_tracks(tmp_path / "guides")
     ball = tracks["objects"]["Ball"]
     assert len(ball["depth"]) == 16 and ball["events"]
     for f in frames:
@@ -150,7 +151,7 @@ def test_panel_options_reach_the_job(rigid_scene):
     """K, augmentation, damping and the strokes of the panel are the job's
     (names of the method's option table), and the panel shows them."""
     from test_addon import _Recorder
-    from tempera import settings as limits
+    from tempera.app import settings as limits
     from tempera.blender.stylize_operator import StylizeRun
 
     settings = rigid_scene.tempera

@@ -127,7 +127,7 @@ def test_planarity_warning(world):
 
 
 def test_guide_render_writes_the_tracks(world, tmp_path):
-    from tempera import rigid_tracks
+    from tempera.methods.rigid import rigid_tracks
     from tempera.blender.guide_render import render_guides
 
     _ball("Cached", (0, 0, 3))

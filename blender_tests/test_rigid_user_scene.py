@@ -24,7 +24,8 @@ FRAMES = (8, 23)  # the fall, the impact (frame ~14) and the scatter: two chunks
 
 def _exemplar(folder):
     """A tumbling box drawn from the generated exemplar (the project's own)."""
-    from tempera import _native, rigid, rigid_tracks
+    from tempera import _native
+    from tempera.methods.rigid import rigid, rigid_tracks
 
     track = _native.bouncing_ball((40, 40), (3.0, 0), 14, 1.0, 110, 0.65, 0.12, 36)
     rigid_tracks.write_tracks(folder, {"Box": track}, 1, (0, 1.0))
@@ -75,7 +76,7 @@ def _min_det(D):
 
 def test_fractured_cube_from_the_panel_and_the_cli(fractured_scene, tmp_path):
     import tempera
-    from tempera import rigid, rigid_cli, rigid_tracks
+    from tempera.methods.rigid import rigid, rigid_cli, rigid_tracks
     from tempera.__main__ import main
 
     scene, shards = fractured_scene

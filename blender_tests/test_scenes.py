@@ -75,8 +75,8 @@ def test_render_settings(exemplar_scene):
 
 
 def test_exemplar_renders_to_guides(exemplar_scene, tmp_path):
-    from tempera.passes import read_pass
-    from tempera.stylize import tonemap
+    from tempera.app.passes import read_pass
+    from tempera.methods.stylit.stylize import tonemap
 
     path = exemplar_kit.render_exemplar(exemplar_scene, tmp_path / "exemplar" / "guides.exr", (48, 36), 2)
     assert path == tmp_path / "exemplar" / "guides.exr" and path.is_file()
@@ -123,7 +123,7 @@ def test_exemplar_kit_outputs(tmp_path):
     assert 0 < x0 < x1 < page.shape[1] and 0 < y0 < y1 < page.shape[0]
     assert (folder / "template.pdf").read_bytes().startswith(b"%PDF")
     # Ready to stylize with: the painting and the guide cache, at the kit's resolution.
-    from tempera import kit as bundled
+    from tempera.methods.stylit import kit as bundled
 
     style, guides = bundled.kit_exemplar(folder.name, kit_dir=folder.parent)
     assert tempera.read_image(str(style)).shape[:2] == (36, 48)

@@ -27,9 +27,9 @@ def exemplar(tmp_path_factory):
     """(painting path, guide cache) of the scene's frame 2: a two-tone drawing
     whose colour follows the render's brightness, with a stroke texture."""
     import tempera
-    from tempera import guide_cache
+    from tempera.app import guide_cache
     from tempera.blender.guide_render import render_guides
-    from tempera.stylize import tonemap
+    from tempera.methods.stylit.stylize import tonemap
 
     folder = tmp_path_factory.mktemp("exemplar")
     scene = build_scene("Stylize exemplar")
@@ -203,7 +203,7 @@ def test_temporal_noise_boils_the_coherent_frames_where_the_map_says(scene, tmp_
     moving cube's mask as the map, the pixels off the cube stay the coherent
     frame bit for bit; a rerun finds every frame current."""
     import tempera
-    from tempera import guide_cache
+    from tempera.app import guide_cache
     from tempera.blender.stylize_operator import StylizeRun
 
     settings = scene.tempera

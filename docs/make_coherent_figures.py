@@ -24,7 +24,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "bench"))
 import tempera  # noqa: E402
 from bench_tcia import panning_shot  # noqa: E402
-from tempera import tcia  # noqa: E402
+from tempera.methods.tcia import tcia  # noqa: E402
 
 OUT = ROOT / "docs" / "images"
 SHOWN = (1, 4, 7, 10, 12)  # frames of the per-frame / coherent rows

@@ -4,9 +4,9 @@
     PYTHONPATH=addon /usr/bin/python3 docs/make_exemplar_kit_figures.py [--kit out/kit/sphere_on_table]
 
 Renders the kit with Blender first if KIT/kit.json is missing. The "artist"
-is tempera.exemplar_paint (hatching, as in the demo); their painting is laid
+is tempera.methods.stylit.exemplar_paint (hatching, as in the demo); their painting is laid
 over the template page, "photographed" upside down in perspective under
-uneven light (tempera.registration.simulate_photo, then JPEG), and
+uneven light (tempera.methods.stylit.registration.simulate_photo, then JPEG), and
 registered back. Writes exemplar_template.png (the page) and
 exemplar_registration.png (photo | registered exemplar | the painting as
 painted), and prints how close the registered exemplar is (PSNR).
@@ -22,10 +22,10 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tools"))
 import blender_env  # noqa: E402
 import tempera  # noqa: E402
-from tempera.exemplar_paint import paint_hatching  # noqa: E402
-from tempera.painting_template import place_picture, read_kit_json  # noqa: E402
-from tempera.passes import read_pass  # noqa: E402
-from tempera.registration import estimate_homography, register_painting, simulate_photo  # noqa: E402
+from tempera.methods.stylit.exemplar_paint import paint_hatching  # noqa: E402
+from tempera.methods.stylit.painting_template import place_picture, read_kit_json  # noqa: E402
+from tempera.app.passes import read_pass  # noqa: E402
+from tempera.methods.stylit.registration import estimate_homography, register_painting, simulate_photo  # noqa: E402
 
 OUT = ROOT / "docs" / "images"
 

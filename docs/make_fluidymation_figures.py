@@ -18,7 +18,8 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "addon"))
-from tempera import fluidymation, write_image  # noqa: E402
+from tempera.methods.fluidymation import fluidymation
+from tempera import write_image  # noqa: E402
 
 S, T, FRAMES = 96, 128, 10
 OUT = ROOT / "docs" / "images"

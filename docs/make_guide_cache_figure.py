@@ -24,9 +24,10 @@ sys.path.insert(0, str(ROOT / "scenes"))
 sys.path.insert(0, str(ROOT / "addon"))
 import demo_scene  # noqa: E402
 import tempera  # noqa: E402
-from tempera import guide_cache, guides  # noqa: E402
+from tempera.app import guide_cache
+from tempera.engine import guides  # noqa: E402
 from tempera.blender.guide_render import render_guides  # noqa: E402
-from tempera.stylize import tonemap  # noqa: E402
+from tempera.methods.stylit.stylize import tonemap  # noqa: E402
 
 OUT = ROOT / "docs" / "images" / "guide_cache_frame.png"
 FRAME = 4

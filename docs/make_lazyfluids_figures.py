@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 import tempera
-from tempera import lazyfluids
+from tempera.methods.lazyfluids import lazyfluids
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "bench"))

@@ -26,7 +26,7 @@ import bpy  # noqa: E402  (before the scene scripts: PyPI's bpy provides bmesh o
 import lpe_gallery  # noqa: E402
 import tempera  # noqa: E402
 import test_lpe_gallery as gallery  # noqa: E402
-from tempera.color import linear_to_srgb  # noqa: E402
+from tempera.engine.color import linear_to_srgb  # noqa: E402
 
 _SUFFIX = "" if bpy.app.version < (4, 0, 0) else "_{}.{}".format(*bpy.app.version[:2])
 OUT = ROOT / "docs" / "images" / f"lpe_gallery{_SUFFIX}.png"

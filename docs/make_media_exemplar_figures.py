@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Regenerates the pictures of docs/media_exemplars.md from the project's
-own exemplars (tempera.media_exemplars; no Blender):
+own exemplars (tempera.app.media_exemplars; no Blender):
 
     PYTHONPATH=addon /usr/bin/python3 docs/make_media_exemplar_figures.py
 
@@ -17,7 +17,8 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "addon"))
-from tempera import contact_sheet, media_exemplars, write_image  # noqa: E402
+from tempera import contact_sheet, write_image
+from tempera.app import media_exemplars  # noqa: E402
 
 OUT = ROOT / "docs" / "images"
 SIZE = 192

@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 
 import tempera
-from tempera import noisy, temporal
+from tempera.methods.noisy import noisy
+from tempera.engine import temporal
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "docs" / "images"

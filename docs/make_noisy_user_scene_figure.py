@@ -46,8 +46,8 @@ def row(images, gap=6):
 
 def make(work):
     import tempera
-    from tempera import guide_cache
-    from tempera.stylize import tonemap
+    from tempera.app import guide_cache
+    from tempera.methods.stylit.stylize import tonemap
 
     scene = bpy.context.scene
     for o in list(scene.objects):

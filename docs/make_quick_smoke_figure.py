@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 import tempera
-from tempera import guide_cache
+from tempera.app import guide_cache
 
 IMAGES = Path(__file__).resolve().parent / "images"
 GREY = 0.18

@@ -11,7 +11,7 @@ rigid_residual.png  one squashed frame: the drawing f^e, its residual
 rigid_transfer.png  target frames around two bounces: the output (graphite)
                     over the oracle's outline (D_gen of the target, red);
 rigid_onion.png     the whole target sequence, every second frame, on paper;
-rigid_strokes.png   stroke re-synthesis (tempera.rigid_strokes): the drawn
+rigid_strokes.png   stroke re-synthesis (tempera.methods.rigid.rigid_strokes): the drawn
                     line, the stroke exemplar, the line re-made on the
                     stroke-position guide, and the same with the guide off.
 
@@ -29,7 +29,8 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "addon"))
-from tempera import _native, rigid, rigid_strokes  # noqa: E402
+from tempera import _native
+from tempera.methods.rigid import rigid, rigid_strokes  # noqa: E402
 
 W, H = 320, 200
 OUT = ROOT / "docs" / "images"

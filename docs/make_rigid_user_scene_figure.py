@@ -16,7 +16,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path[:0] = [str(ROOT / "addon"), str(ROOT / "scenes")]
 import rigid_fractured_cube  # noqa: E402
-from tempera import _native, rigid  # noqa: E402
+from tempera import _native
+from tempera.methods.rigid import rigid  # noqa: E402
 from tempera.blender import rigid_tracks as brt  # noqa: E402
 
 W, H = 480, 270

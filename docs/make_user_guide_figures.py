@@ -14,9 +14,9 @@ from pathlib import Path
 import numpy as np
 
 import tempera
-from tempera import guide_cache
-from tempera.stylize import tonemap
-from tempera.stylize import StylizeJob
+from tempera.app import guide_cache
+from tempera.methods.stylit.stylize import tonemap
+from tempera.methods.stylit.stylize import StylizeJob
 
 IMAGES = Path(__file__).resolve().parent / "images"
 LIGHT_PATHS = ("FULL", "LDE", "LSE", "LDDE", "LD12E")

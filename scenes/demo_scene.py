@@ -120,8 +120,9 @@ def comparison_sheet(out, scene):
     mapped as the synthesis sees it) above its stylized frame."""
     import numpy as np
     import tempera
-    from tempera import guide_cache, kit
-    from tempera.stylize import tonemap
+    from tempera.app import guide_cache
+    from tempera.methods.stylit import kit
+    from tempera.methods.stylit.stylize import tonemap
 
     style_path, exemplar_guides = kit.kit_exemplar()
     exemplar_render = tempera.read_image(str(style_path.parent / "render.png"))[:, :, :3]
@@ -145,12 +146,12 @@ def comparison_sheet(out, scene):
 
 def paint_keys(out):
     """Two painted keyframes made by the project's own stand-in artist: the
-    hatching that painted the kit's exemplar (tempera.exemplar_paint), drawn
+    hatching that painted the kit's exemplar (tempera.methods.stylit.exemplar_paint), drawn
     over each key frame's render (the guide cache's FULL) where the scene
     covers the film (alpha; bare paper elsewhere), one seed per frame."""
     import tempera
-    from tempera import guide_cache
-    from tempera.exemplar_paint import paint_hatching
+    from tempera.app import guide_cache
+    from tempera.methods.stylit.exemplar_paint import paint_hatching
 
     keys = out / "keys"
     keys.mkdir(exist_ok=True)
@@ -167,7 +168,9 @@ def run_coherent(scene, out):
     """Stylize Animation again with Method "Temporally Coherent (Bénard
     2013)" and the two keys imported into the Keyframes list; the guides are
     current, so only the segments run. Returns (per-frame, coherent) mean flicker."""
-    from tempera import guide_cache, read_image, temporal
+    from tempera.app import guide_cache
+    from tempera import read_image
+    from tempera.engine import temporal
 
     settings = scene.tempera
     settings.method = "TCIA"

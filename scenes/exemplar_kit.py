@@ -22,9 +22,9 @@ artist paints from:
 which writes into kit/: guides.exr (the exemplar's render passes), guides/
 (its guide cache, what the synthesis matches), style.png (the project's own
 coloured-pencil painting of it), render.png, template.png and template.pdf (the printable painting template
-of tempera.painting_template) and kit.json (variant, resolution and the
+of tempera.methods.stylit.painting_template) and kit.json (variant, resolution and the
 template's mark and picture geometry, read by `python -m
-tempera.register_painting`). See docs/exemplar_kit.md.
+tempera.methods.stylit.register_painting`). See docs/exemplar_kit.md.
 """
 import argparse
 import math
@@ -80,9 +80,9 @@ def render_exemplar(scene, path, resolution, samples):
 
 
 def render_exemplar_guides(scene, folder, resolution, samples):
-    """The exemplar's guide cache (tempera.guide_cache, frame 1) in `folder`:
+    """The exemplar's guide cache (tempera.app.guide_cache, frame 1) in `folder`:
     the guides the synthesis matches, rendered exactly as a target scene's."""
-    from tempera import guide_cache
+    from tempera.app import guide_cache
     from tempera.blender.guide_render import render_guides
 
     scene.render.resolution_x, scene.render.resolution_y = resolution
@@ -99,12 +99,12 @@ def make_kit(out, variant=DEFAULT_VARIANT, resolution=(320, 240), samples=64, dp
     Besides what an artist paints from (render, template), the kit holds the
     exemplar's guide cache (guides/) and the project's own painting of it
     (style.png: coloured-pencil hatching whose density and colours follow the
-    exemplar's shading, tempera.exemplar_paint), ready to stylize with."""
+    exemplar's shading, tempera.methods.stylit.exemplar_paint), ready to stylize with."""
     import tempera
-    from tempera.color import linear_to_srgb
-    from tempera.exemplar_paint import paint_hatching
-    from tempera.painting_template import make_template, write_kit_json, write_pdf
-    from tempera.passes import read_pass
+    from tempera.engine.color import linear_to_srgb
+    from tempera.methods.stylit.exemplar_paint import paint_hatching
+    from tempera.methods.stylit.painting_template import make_template, write_kit_json, write_pdf
+    from tempera.app.passes import read_pass
 
     out = Path(out)
     scene = build_exemplar_scene(variant=variant)

@@ -22,7 +22,8 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "addon"))
-from tempera import _native, rigid, rigid_strokes, rigid_tracks  # noqa: E402
+from tempera import _native
+from tempera.methods.rigid import rigid, rigid_strokes, rigid_tracks  # noqa: E402
 from tempera.blender import rigid_tracks as brt  # noqa: E402
 
 W, H = 640, 360

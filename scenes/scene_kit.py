@@ -134,8 +134,8 @@ def configure_render(scene, resolution, samples, passes, frames=None):
     no denoising (it smears the passes differently), no indirect clamping
     (it would bias DiffInd), no motion blur (the Vector pass needs it off),
     a fixed seed; output as a 32-bit multilayer EXR with the given `passes`
-    (names as in tempera.passes.PASSES) enabled on the first view layer."""
-    from tempera.passes import PASSES
+    (names as in tempera.app.passes.PASSES) enabled on the first view layer."""
+    from tempera.app.passes import PASSES
 
     unknown = sorted(set(passes) - set(PASSES))
     if unknown:
@@ -151,7 +151,7 @@ def configure_render(scene, resolution, samples, passes, frames=None):
     scene.render.resolution_x, scene.render.resolution_y = resolution
     scene.render.resolution_percentage = 100
     scene.render.film_transparent = False
-    scene.view_settings.view_transform = "Standard"  # plain sRGB, as tempera.color
+    scene.view_settings.view_transform = "Standard"  # plain sRGB, as tempera.engine.color
     if frames is not None:
         scene.frame_start, scene.frame_end = frames[0], frames[-1]
 

@@ -21,9 +21,10 @@ from pathlib import Path
 import numpy as np
 
 import tempera
-from tempera import guide_cache, noisy
-from tempera.settings import DEFAULT_GUIDE_WEIGHTS
-from tempera.stylize import tonemap
+from tempera.app import guide_cache
+from tempera.methods.noisy import noisy
+from tempera.app.settings import DEFAULT_GUIDE_WEIGHTS
+from tempera.methods.stylit.stylize import tonemap
 
 ROOT = Path(__file__).resolve().parent.parent
 PAINTING = ROOT / "build" / "kit" / "sphere_on_table" / "style.png"

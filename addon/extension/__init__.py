@@ -13,7 +13,7 @@ from pathlib import Path
 
 def register():
     import tempera
-    from tempera import kit
+    from tempera.methods.stylit import kit
 
     kit.KIT_DIR = Path(__file__).resolve().parent / "kit"
     tempera.register(addon_id=__name__)

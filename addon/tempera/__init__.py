@@ -51,9 +51,9 @@ Cancelled, image_info, read_image, write_image = (
 max_image_pixels, set_max_image_pixels = _native.max_image_pixels, _native.set_max_image_pixels
 
 # Python API on top of the native module; public entry points are listed in __all__.
-from .contact_sheet import contact_sheet
-from .lpe import check_lpe, trace_lpe
-from .synthesis import USAGE_MODES, SynthesisOptions, synthesize
+from .app.contact_sheet import contact_sheet
+from .tracer.lpe import check_lpe, trace_lpe
+from .engine.synthesis import USAGE_MODES, SynthesisOptions, synthesize
 
 __all__ = [
     "__version__",

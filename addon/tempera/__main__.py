@@ -2,10 +2,10 @@
 `python -m tempera`.
 
 `tempera farm ...` and `tempera stylize --scheduler ADDRESS ...` run a shot on
-a Dask cluster (tempera.farm); `tempera rigid ...` and `tempera stylize
+a Dask cluster (tempera.app.farm); `tempera rigid ...` and `tempera stylize
 --method rigid ...` run the rigid-body method on a guide cache's tracks
-(tempera.rigid_cli); `tempera exemplar ...` writes one of the
-project's own smoke/fire/ink exemplars (tempera.exemplar_cli); every other command is the
+(tempera.methods.rigid.rigid_cli); `tempera exemplar ...` writes one of the
+project's own smoke/fire/ink exemplars (tempera.app.exemplar_cli); every other command is the
 native batch CLI
 (tempera_native/bin/tempera: synth, stylize, render-guides), run with this
 package as the add-on that `render-guides` hands to Blender.
@@ -50,19 +50,19 @@ def main(argv=None):
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv[:1] == ["farm"] or (argv[:1] == ["stylize"] and any(
             a == "--scheduler" or a.startswith("--scheduler=") for a in argv)):
-        from .farm import main as farm_main
+        from .app.farm import main as farm_main
 
         return farm_main(argv[1:])
     if argv[:1] == ["rigid"]:
-        from .rigid_cli import main as rigid_main
+        from .methods.rigid.rigid_cli import main as rigid_main
 
         return rigid_main(argv[1:])
     if argv[:1] == ["stylize"] and stylize_method(argv[1:]) == "rigid":
-        from .rigid_cli import stylize_main
+        from .methods.rigid.rigid_cli import stylize_main
 
         return stylize_main(argv[1:])
     if argv[:1] == ["exemplar"]:
-        from .exemplar_cli import main as exemplar_main
+        from .app.exemplar_cli import main as exemplar_main
 
         return exemplar_main(argv[1:])
     try:

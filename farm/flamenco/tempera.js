@@ -7,7 +7,7 @@
 // render guides from a .blend, Blender (the manager's {blender} variable is not
 // used: render-guides runs $TEMPERA_BLENDER or `blender`).
 //
-// The job becomes the same tasks as tempera.farm.plan() (addon/tempera/farm.py,
+// The job becomes the same tasks as tempera.app.farm.plan() (addon/tempera/app/farm.py,
 // which the tests compare against this file):
 //   exemplar-guides   tempera render-guides EXEMPLAR.blend --frames N     (with an exemplar scene)
 //   guides A-B        tempera render-guides SCENE.blend --frames A-B      (per chunk, with a scene)
@@ -87,7 +87,7 @@ function splitArgs(text) {
     return String(text || "").split(" ").filter((a) => a.length > 0);
 }
 
-// Python's repr() of a float, as tempera.farm writes the temporal weight.
+// Python's repr() of a float, as tempera.app.farm writes the temporal weight.
 function pyFloat(x) {
     return Number.isInteger(x) ? `${x}.0` : `${x}`;
 }
@@ -111,7 +111,7 @@ function optionValues(args, name) {
     return values;
 }
 
-// The coherent method's segments (tempera.farm.tcia_segments): from key to key
+// The coherent method's segments (tempera.app.farm.tcia_segments): from key to key
 // and to the shot's ends; null for per-frame StyLit.
 function tciaSegments(frames, args) {
     const methods = optionValues(args, "--method");

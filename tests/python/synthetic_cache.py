@@ -1,9 +1,10 @@
 """A tiny synthetic guide cache for the stylization tests: a shaded gradient
 with a bright blob moving right by `speed` pixels per frame, written with
-tempera.guide_cache like the Blender renderer writes it."""
+tempera.app.guide_cache like the Blender renderer writes it."""
 import numpy as np
 
-from tempera import guide_cache, write_image
+from tempera.app import guide_cache
+from tempera import write_image
 
 H, W = 48, 64
 
@@ -34,7 +35,7 @@ def write_frame(cache, frame, blob_x, speed, forward=False, masks=False, size=(W
     visible[:, : int(np.ceil(speed))] = 0  # entered from outside the frame
     guides["occlusion_backward"] = visible
     if forward:  # V+ and χ+ (the coherent method's backward sweeps), and lines around the blob (eq. 9)
-        from tempera.guides import line_distance
+        from tempera.engine.guides import line_distance
 
         guides["velocity_forward"] = guides["velocity_backward"]
         leaving = np.ones((h, w), np.float32)

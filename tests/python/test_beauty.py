@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import tempera
-from tempera import beauty, guide_cache
-from tempera.color import linear_to_srgb
+from tempera.app import beauty, guide_cache
+from tempera.engine.color import linear_to_srgb
 from synthetic_cache import light_paths, make_cache
 
 

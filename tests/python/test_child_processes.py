@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 
 import tempera
-from tempera import media_source
-from tempera.stylize import encode_video
+from tempera.app import media_source
+from tempera.methods.stylit.stylize import encode_video
 
 FFMPEG = shutil.which("ffmpeg")
 needs_ffmpeg = pytest.mark.skipif(FFMPEG is None, reason="ffmpeg is not on PATH")

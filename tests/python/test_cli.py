@@ -1,4 +1,4 @@
-"""The `tempera` batch command line, and tempera.cli which locates it."""
+"""The `tempera` batch command line, and tempera.app.cli which locates it."""
 import os
 import subprocess
 import sys
@@ -6,7 +6,7 @@ import sys
 import pytest
 
 import tempera
-from tempera import cli
+from tempera.app import cli
 
 
 def run(cli_path, *args):

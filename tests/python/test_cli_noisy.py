@@ -144,7 +144,8 @@ def test_the_warp_error_of_a_stylized_moving_shot_rises_with_the_width(cli_path,
     noise pass at f = 1.3, 2.2, 3.1, 4.3 on those same frames. The warp
     error along the cache's own V- and chi- (the flicker figure) rises
     strictly with f, and every noisy run is above R's."""
-    from tempera import guide_cache, temporal
+    from tempera.app import guide_cache
+    from tempera.engine import temporal
 
     shot, size = (1, 2, 3, 4, 5, 6), (128, 96)
     make_cache(tmp_path / "cache", frames=shot, start=40.0, size=size)

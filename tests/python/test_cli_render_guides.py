@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from tempera import guide_cache
+from tempera.app import guide_cache
 
 ROOT = Path(__file__).resolve().parents[2]
 BLENDER = os.environ.get("TEMPERA_BLENDER", "blender")

@@ -1,4 +1,4 @@
-"""`tempera rigid` (tempera.rigid_cli) on a guide cache's tracks: RGBA frames
+"""`tempera rigid` (tempera.methods.rigid.rigid_cli) on a guide cache's tracks: RGBA frames
 written atomically, resumed runs keep finished frames, bad input is named
 with a non-zero exit code."""
 import json
@@ -6,7 +6,8 @@ import json
 import numpy as np
 import pytest
 
-from tempera import _native, rigid, rigid_tracks
+from tempera import _native
+from tempera.methods.rigid import rigid, rigid_tracks
 from tempera.__main__ import main
 
 W, H = 240, 160

@@ -87,7 +87,7 @@ def test_errors_and_exit_codes(cli_path, caches):
 
 def test_ctrl_c_keeps_finished_frames(cli_path, tmp_path):
     # Frames big enough to take a while, so the interrupt lands mid-run.
-    from tempera import guide_cache
+    from tempera.app import guide_cache
     from synthetic_cache import light_paths
 
     h, w = 192, 256

@@ -162,7 +162,7 @@ def _turning_hatching(p, frames=8, size=40, start=60.0, step=4.0):
     render's structure or an orientation AOV would give); the exemplar is
     horizontal hatching (edge direction 0) with its own tensor. Only the
     orientation says which way to hatch. Returns the field's angle per frame."""
-    from tempera import guide_cache
+    from tempera.app import guide_cache
 
     def tensor(angle, h, w):  # the gradient across the strokes, n = (-sin a, cos a)
         nx, ny = -np.sin(angle), np.cos(angle)
@@ -196,7 +196,7 @@ def _turning_hatching(p, frames=8, size=40, start=60.0, step=4.0):
 def _median_angle_error(folder, truth, inset=6):
     """Median over frames and coherent pixels of the axial angle, in degrees,
     between the output's hatching (its structure tensor) and the field."""
-    from tempera import guides
+    from tempera.engine import guides
 
     errors = []
     for t, angle in enumerate(truth):

@@ -1,6 +1,6 @@
 import numpy as np
 
-from tempera.color import linear_to_srgb, srgb_to_linear
+from tempera.engine.color import linear_to_srgb, srgb_to_linear
 
 
 def test_reference_values():

@@ -1,8 +1,8 @@
-"""tempera.exemplar_paint: the procedural hatched exemplar."""
+"""tempera.methods.stylit.exemplar_paint: the procedural hatched exemplar."""
 import numpy as np
 import pytest
 
-from tempera.exemplar_paint import PAPER, darkness_map, paint_hatching
+from tempera.methods.stylit.exemplar_paint import PAPER, darkness_map, paint_hatching
 
 LUMA = np.array([0.2126, 0.7152, 0.0722])
 

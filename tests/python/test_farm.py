@@ -1,4 +1,4 @@
-"""tempera.farm without a cluster: frame ranges, the plan of a shot, the
+"""tempera.app.farm without a cluster: frame ranges, the plan of a shot, the
 `tempera farm --dry-run` command line, and agreement with the Flamenco job
 type (farm/flamenco/tempera.js run under Node with the stand-in API)."""
 import json
@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from tempera import farm
+from tempera.app import farm
 from conftest import ROOT
 
 SHOT = dict(frames="1-48", out="/shared/out", exemplar="/shared/style.png", scene="/shared/shot010.blend",
@@ -130,7 +130,7 @@ def test_flamenco_job_type_makes_the_same_tasks(temporal):
 def test_flamenco_default_temporal_weight_is_temperas():
     from pathlib import Path
 
-    from tempera.settings import DEFAULT_TEMPORAL_WEIGHT
+    from tempera.app.settings import DEFAULT_TEMPORAL_WEIGHT
 
     js = (Path(__file__).resolve().parents[2] / "farm" / "flamenco" / "tempera.js").read_text()
     assert f'key: "temporal", type: "float", default: {DEFAULT_TEMPORAL_WEIGHT:.1f}' in js

@@ -1,9 +1,9 @@
-"""tempera.fluid_velocity: projection, splat, diffusion fill and the units of each fluid source."""
+"""tempera.app.fluid_velocity: projection, splat, diffusion fill and the units of each fluid source."""
 import numpy as np
 import pytest
 
-from tempera import fluid_velocity as fv
-from tempera import guide_cache
+from tempera.app import fluid_velocity as fv
+from tempera.app import guide_cache
 
 W, H = 64, 48
 

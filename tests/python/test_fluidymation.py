@@ -6,7 +6,9 @@ import numpy as np
 import pytest
 
 import tempera
-from tempera import fluidymation, guide_cache, read_image, write_image
+from tempera.methods.fluidymation import fluidymation
+from tempera.app import guide_cache
+from tempera import read_image, write_image
 from conftest import assert_releases_gil
 
 SIZE = 40

@@ -1,6 +1,6 @@
 import pytest
 
-from tempera.frames import parse_frames
+from tempera.app.frames import parse_frames
 
 
 def test_ranges_lists_and_single_frames():

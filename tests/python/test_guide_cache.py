@@ -1,10 +1,11 @@
-"""tempera.guide_cache: cache layout, manifest, frame I/O and the numpy conversions."""
+"""tempera.app.guide_cache: cache layout, manifest, frame I/O and the numpy conversions."""
 import json
 
 import numpy as np
 import pytest
 
-from tempera import guide_cache, guides
+from tempera.app import guide_cache
+from tempera.engine import guides
 
 
 def test_channel_names_of_the_documented_guides():
@@ -84,7 +85,7 @@ def test_vector_pass_signs():
 
 
 def test_vector_pass_of_a_moving_square_gives_clean_occlusion():
-    """Converted velocities feed tempera.guides: a square moving right by 3 px
+    """Converted velocities feed tempera.engine.guides: a square moving right by 3 px
     reveals 3 columns behind it (chi- = 0) and nothing else."""
     h, w = 12, 24
 

@@ -1,9 +1,9 @@
-"""tempera.guides: motion, orientation and line-distance building blocks."""
+"""tempera.engine.guides: motion, orientation and line-distance building blocks."""
 import numpy as np
 import pytest
 
 from conftest import assert_releases_gil
-from tempera import guides
+from tempera.engine import guides
 
 H, W, STEP = 12, 24, 3
 

@@ -20,9 +20,10 @@ import numpy as np
 import pytest
 
 import tempera
-from tempera import _native, guide_cache
-from tempera.frames import MAX_FRAME, parse_frames
-from tempera.stylize import StylizeJob
+from tempera import _native
+from tempera.app import guide_cache
+from tempera.app.frames import MAX_FRAME, parse_frames
+from tempera.methods.stylit.stylize import StylizeJob
 
 from synthetic_cache import H, W, make_cache, make_exemplar
 
@@ -43,7 +44,7 @@ def child(code, timeout=60, memory_mb=None, env=None):
 def expect_value_error(code, match, timeout=60, memory_mb=None):
     result = child(f"""
         import numpy as np, tempera
-        from tempera import guides
+        from tempera.engine import guides
         try:
             {code}
         except ValueError as exc:
@@ -121,7 +122,7 @@ def _reference_blur(image, sigma):
 
 
 def test_wide_kernel_is_clamped_to_the_image_exactly():
-    from tempera import guides
+    from tempera.engine import guides
 
     rng = np.random.default_rng(1)
     image = rng.random((8, 11, 1), dtype=np.float32)
@@ -262,7 +263,7 @@ def test_temporary_names_differ_between_processes_with_the_same_pid(tmp_path):
 
 def test_absurd_thread_count_is_clamped_to_the_cores(caches):
     result = child(f"""
-        from tempera.stylize import StylizeJob
+        from tempera.methods.stylit.stylize import StylizeJob
         j = StylizeJob({str(caches / 'paint.png')!r}, {str(caches / 'exemplar')!r}, {str(caches / 'cache')!r}, [1],
                        {str(caches / 'out')!r}, threads=4096, quality="preview")
         print(j.run_frame(0)["status"])
@@ -384,7 +385,7 @@ def test_contact_sheet_streams_downscaled_frames(caches):
         tempera.write_image(str(out / f"frame_{f:04d}.exr"), big)
     result = child(f"""
         import resource
-        from tempera.stylize import StylizeJob
+        from tempera.methods.stylit.stylize import StylizeJob
         j = StylizeJob({str(caches / 'paint.png')!r}, {str(caches / 'exemplar')!r}, {str(caches / 'cache')!r},
                        {frames!r}, {str(out)!r}, format="exr")
         base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss

@@ -1,7 +1,7 @@
-"""tempera.kit: finding the bundled exemplar kit (no Blender)."""
+"""tempera.methods.stylit.kit: finding the bundled exemplar kit (no Blender)."""
 import pytest
 
-from tempera import kit
+from tempera.methods.stylit import kit
 
 
 def make_kit(folder, variant):

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 import tempera
-from tempera import guide_cache, lazyfluids
+from tempera.app import guide_cache
+from tempera.methods.lazyfluids import lazyfluids
 
 H, W = 36, 44
 

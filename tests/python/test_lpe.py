@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import tempera
-from tempera.lpe import STYLIT_EXPRESSIONS, lpe_matches
+from tempera.tracer.lpe import STYLIT_EXPRESSIONS, lpe_matches
 
 from conftest import assert_releases_gil
 
@@ -134,7 +134,7 @@ def test_closure_keys_are_checked():
 def test_typed_scene_is_the_dict_scene():
     """scene_from_dict gives the bound classes, field by field; tracing either is the same."""
     from tempera import _native
-    from tempera.lpe import scene_from_dict
+    from tempera.tracer.lpe import scene_from_dict
 
     typed = scene_from_dict(plane_scene())
     assert isinstance(typed, _native.Scene) and typed.camera.width == 16
@@ -152,7 +152,7 @@ def test_closure_model_reaches_the_tracer():
     """The exporter's closure_model (compat.cycles_closure_model) is read key
     by key: Cycles 4.0's height-correlated shadowing brightens a rough glossy
     floor under a low sun; a misspelt key is named."""
-    from tempera.lpe import scene_from_dict
+    from tempera.tracer.lpe import scene_from_dict
 
     scene = plane_scene()
     scene["materials"] = [{"closures": [{"type": "glossy", "color": [1, 1, 1], "roughness": 1.0}]}]
@@ -173,7 +173,7 @@ def test_principled_v2_reaches_the_tracer():
     a coat over a black base reflects (v1 would trace the coat weight as
     clearcoat of F0 0.04 and weight 0.25, v2 as a full dielectric layer), and
     its tint, read as a colour, darkens the diffuse below it."""
-    from tempera.lpe import scene_from_dict
+    from tempera.tracer.lpe import scene_from_dict
 
     scene = plane_scene()
     coat = {"type": "principled", "color": [0.8, 0.8, 0.8], "roughness": 0.5, "ior": 1.5, "clearcoat": 1.0,

@@ -1,10 +1,10 @@
-"""The project's own exemplars (tempera.media_exemplars) and `tempera
+"""The project's own exemplars (tempera.app.media_exemplars) and `tempera
 exemplar`: seamless loops, soft alpha, the ink front's measured speed, masks
 from the pigment, determinism by seed, named errors with exit status 2."""
 import numpy as np
 import pytest
 
-from tempera import media_exemplars as me
+from tempera.app import media_exemplars as me
 from tempera import read_image
 from tempera.__main__ import main
 

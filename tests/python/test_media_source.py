@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import tempera
-from tempera import media_source
-from tempera.media_source import MediaError, exemplar_source
+from tempera.app import media_source
+from tempera.app.media_source import MediaError, exemplar_source
 
 FFMPEG = shutil.which("ffmpeg")
 needs_ffmpeg = pytest.mark.skipif(FFMPEG is None, reason="ffmpeg is not on PATH (needed to make the test movie)")

@@ -1,10 +1,11 @@
-"""Color Me Noisy (tempera.noisy, native/src/methods/noisy/noisy.cpp): the amount of
+"""Color Me Noisy (tempera.methods.noisy.noisy, native/src/methods/noisy/noisy.cpp): the amount of
 temporal noise follows the low-pass width f, the noise is white, R's large
 shapes stay, the MLS pre-deformation and the low-frequency term matter."""
 import numpy as np
 import pytest
 
-from tempera import noisy, synthesis, temporal
+from tempera.methods.noisy import noisy
+from tempera.engine import synthesis, temporal
 
 FRAMES = 32  # a static R repeated 32 times, as in the issue
 
@@ -281,7 +282,7 @@ def test_guided_noise_names_missing_or_bad_guides():
 
 def test_a_guided_sequence_reads_both_caches_and_keys_the_setting(tmp_path):
     import tempera
-    from tempera import guide_cache
+    from tempera.app import guide_cache
 
     style, reference, guides = thin_strokes()
     source, target, _ = guides["LDE"]

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 import tempera
-from tempera import passes
+from tempera.app import passes
 
 
 def test_channel_names_follow_blender_multilayer_exr():

@@ -1,5 +1,5 @@
-"""Painting template (tempera.painting_template) and registration of a photo
-of the painted template (tempera.registration, tempera.register_painting)."""
+"""Painting template (tempera.methods.stylit.painting_template) and registration of a photo
+of the painted template (tempera.methods.stylit.registration, tempera.methods.stylit.register_painting)."""
 import re
 import subprocess
 import sys
@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 import tempera
-from tempera.painting_template import make_template, place_picture, write_kit_json, write_pdf
-from tempera.registration import (apply_homography, estimate_homography, find_marks, label_components,
+from tempera.methods.stylit.painting_template import make_template, place_picture, write_kit_json, write_pdf
+from tempera.methods.stylit.registration import (apply_homography, estimate_homography, find_marks, label_components,
                                   register_painting, simulate_photo)
 
 W, H = 64, 48  # guide resolution of the synthetic exemplar
@@ -202,13 +202,14 @@ def test_register_painting_command(template, tmp_path):
     photo = photograph(painted_page(template, known_painting()), homography_onto(template.image.shape, TURNED_90),
                        (860, 680), np.random.default_rng(7))
     tempera.write_image(str(tmp_path / "photo.png"), photo)
-    command = [sys.executable, "-m", "tempera.register_painting", str(tmp_path / "photo.png"), "--kit", str(kit)]
+    command = [sys.executable, "-m", "tempera.methods.stylit.register_painting", str(tmp_path / "photo.png"),
+               "--kit", str(kit)]
     result = subprocess.run(command + ["--out", str(tmp_path / "style.png")], capture_output=True, text=True)
     assert result.returncode == 0, result.stderr
     assert tempera.read_image(str(tmp_path / "style.png")).shape[:2] == (H, W)
 
     tempera.write_image(str(tmp_path / "blank.png"), np.ones((300, 400, 3), np.float32))
-    result = subprocess.run([sys.executable, "-m", "tempera.register_painting", str(tmp_path / "blank.png"),
+    result = subprocess.run([sys.executable, "-m", "tempera.methods.stylit.register_painting", str(tmp_path / "blank.png"),
                              "--kit", str(kit), "--out", str(tmp_path / "x.png")], capture_output=True, text=True)
     assert result.returncode != 0 and "found 0 of 4 alignment marks" in result.stderr
     result = subprocess.run(command[:-1] + [str(tmp_path), "--out", str(tmp_path / "x.png")],

@@ -1,10 +1,11 @@
-"""The rigid-body method from Python (tempera.rigid): the generated exemplar
+"""The rigid-body method from Python (tempera.methods.rigid.rigid): the generated exemplar
 fitted and transferred onto a target ball, checked against the generator's
 oracle; option validation and named errors."""
 import numpy as np
 import pytest
 
-from tempera import _native, rigid
+from tempera import _native
+from tempera.methods.rigid import rigid
 
 W, H = 320, 200
 

@@ -1,4 +1,4 @@
-"""tempera.rigid_job, the panel's rigid-body method as steps: one per object
+"""tempera.methods.rigid.rigid_job, the panel's rigid-body method as steps: one per object
 and chunk, then the composites by depth; resumed runs keep finished steps,
 a cancelled step writes nothing, other settings redo everything."""
 import json
@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 
 import tempera
-from tempera import _native, rigid, rigid_tracks
-from tempera.rigid_job import RigidJob, exemplar_folders
+from tempera import _native
+from tempera.methods.rigid import rigid, rigid_tracks
+from tempera.methods.rigid.rigid_job import RigidJob, exemplar_folders
 
 W, H = 200, 140
 FRAMES = 16
@@ -100,7 +101,7 @@ def test_strokes_are_resynthesized_cancellable_and_part_of_the_settings(examples
     """With a stroke exemplar the layers take its look; Esc while the strokes
     are re-made writes nothing of the step; plain and stroked runs are
     different settings (each redoes the other's files)."""
-    from tempera import rigid_strokes
+    from tempera.methods.rigid import rigid_strokes
 
     out = tmp_path / "out"
     plain = RigidJob(cache, examples, out, [6, 7], objects=["Near"])

@@ -1,4 +1,4 @@
-"""Stroke re-synthesis of the rigid-body method (tempera.rigid_strokes): the
+"""Stroke re-synthesis of the rigid-body method (tempera.methods.rigid.rigid_strokes): the
 drawn body's line re-made by the engine from a stroke exemplar on the
 stroke-position guide takes the exemplar's look and stays on the line; with
 the guide off the ink leaves the line (the test's own check that it is the
@@ -8,7 +8,9 @@ import json
 import numpy as np
 import pytest
 
-from tempera import _native, guides, rigid, rigid_strokes, rigid_tracks
+from tempera import _native
+from tempera.engine import guides
+from tempera.methods.rigid import rigid, rigid_strokes, rigid_tracks
 from tempera.__main__ import main
 
 W, H = 240, 160

@@ -1,4 +1,4 @@
-"""Tracks and collision events of the rigid-body method (tempera.rigid_tracks)
+"""Tracks and collision events of the rigid-body method (tempera.methods.rigid.rigid_tracks)
 on three scenes baked by a small 2D rigid-body integrator (a drop, a throw
 against a wall, two bodies colliding): every bounce is found within +-1
 frame and nothing else is."""
@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from tempera import rigid_tracks as rt
+from tempera.methods.rigid import rigid_tracks as rt
 
 W, H = 640, 360
 G = np.array([0.0, 0.8])  # px per frame^2, down the image

@@ -1,11 +1,11 @@
-"""tempera.scene_units: Blender's light and camera settings in the tracer's units.
+"""tempera.tracer.scene_units: Blender's light and camera settings in the tracer's units.
 The camera against Blender's own projection is checked in blender_tests/test_lpe.py."""
 import math
 
 import numpy as np
 import pytest
 
-from tempera import scene_units as su
+from tempera.tracer import scene_units as su
 
 
 def test_light_conversions():

@@ -1,4 +1,4 @@
-from tempera import settings
+from tempera.app import settings
 
 
 def test_default_is_odd_and_in_range():

@@ -1,4 +1,4 @@
-"""tempera.stylize: StyLit over a guide cache through the native StylizeJob."""
+"""tempera.methods.stylit.stylize: StyLit over a guide cache through the native StylizeJob."""
 import json
 import math
 
@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 
 import tempera
-from tempera import _native, guide_cache
-from tempera.stylize import tonemap
-from tempera.stylize import StylizeJob, stylize_frame
+from tempera import _native
+from tempera.app import guide_cache
+from tempera.methods.stylit.stylize import tonemap
+from tempera.methods.stylit.stylize import StylizeJob, stylize_frame
 
 from conftest import assert_releases_gil
 from synthetic_cache import H, W, light_paths, make_cache, make_exemplar
@@ -130,7 +131,7 @@ def test_frames_split_over_machines_stay_current(inputs):
 
 
 def test_tonemap_values():
-    from tempera.color import linear_to_srgb
+    from tempera.engine.color import linear_to_srgb
 
     x = np.array([0.0, 1.0, 3.0, 1e9], dtype=np.float32)
     expected = linear_to_srgb(np.array([0.0, 0.5, 0.75, 1.0]))
@@ -146,7 +147,9 @@ def test_one_guide_table_everywhere():
     """Names, expressions and default weights of the light-path guides come
     from the native table alone."""
     import tempera
-    from tempera import guide_cache, lpe, settings, stylize
+    from tempera.app import guide_cache, settings
+    from tempera.tracer import lpe
+    from tempera.methods.stylit import stylize
 
     table = tempera._native.light_path_guides()
     names = [g["name"] for g in table]

@@ -1,8 +1,9 @@
-"""tempera.tcia: Bénard et al. 2013's sweeps from Python."""
+"""tempera.methods.tcia.tcia: Bénard et al. 2013's sweeps from Python."""
 import numpy as np
 import pytest
 
-from tempera import tcia, temporal
+from tempera.methods.tcia import tcia
+from tempera.engine import temporal
 
 
 def shot(frames=5, w=48, h=32, speed=2):
@@ -118,7 +119,7 @@ def test_line_term_puts_the_ink_on_the_frames_lines():
     paired with the frames' D(I) (rings moving 2 px per frame): at least 95%
     of the ink lies within d_max of the lines and at least 90% of the line
     pixels have ink within 2 px. Without the term the ink lands anywhere."""
-    from tempera.guides import line_distance
+    from tempera.engine.guides import line_distance
 
     d_max, rng = 10.0, np.random.default_rng(1)
     yy, xx = np.mgrid[0:64, 0:80].astype(np.float32)

@@ -1,8 +1,8 @@
-"""tempera.tcia.stylize_layers and composite (Bénard 2013 layers, native/src/methods/tcia/tcia_layers.cpp)."""
+"""tempera.methods.tcia.tcia.stylize_layers and composite (Bénard 2013 layers, native/src/methods/tcia/tcia_layers.cpp)."""
 import numpy as np
 import pytest
 
-from tempera import tcia
+from tempera.methods.tcia import tcia
 
 W, H, N, SIDE, SPEED = 40, 28, 4, 10, 2
 

@@ -1,6 +1,6 @@
 import numpy as np
 
-from tempera import temporal
+from tempera.engine import temporal
 
 
 def vector_pass(h, w, dx):

@@ -1,4 +1,4 @@
-"""tempera farm on Dask (tempera.farm), through the pip-installed `tempera`
+"""tempera farm on Dask (tempera.app.farm), through the pip-installed `tempera`
 command: a local-cluster run equals a single-process run frame for frame,
 killing a worker mid-shot loses no finished frame and a rerun completes the
 shot, and the scene form renders its guides in chunks with Blender."""
@@ -19,7 +19,7 @@ def make_shot(root, frames, h, w):
     """A synthetic shot (moving blob) and exemplar at h x w, plus a painting."""
     import tempera
     from synthetic_cache import light_paths
-    from tempera import guide_cache
+    from tempera.app import guide_cache
 
     for i, f in enumerate(frames):
         guides = light_paths(w / 3 + 2 * i, h, w)

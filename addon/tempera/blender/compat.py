@@ -57,7 +57,7 @@ operators (4.0 removed that; Context.temp_override exists since 3.2).
 import bpy
 import numpy as np
 
-from .. import passes
+from ..app import passes
 
 # Principled BSDF sockets: the name Tempera uses (Blender 3.x) -> the 4.0+ name.
 PRINCIPLED_RENAMES = {
@@ -153,7 +153,7 @@ def compositor_node_tree(scene, create=False):
 
 def exr_pass_name(channels, layer, name):
     """The name the render pass `name` (short form, 'DiffDir') has in an EXR
-    file with `channels`: see tempera.passes.stored_pass_name (no bpy there,
+    file with `channels`: see tempera.app.passes.stored_pass_name (no bpy there,
     so the guide readers outside Blender share it)."""
     return passes.stored_pass_name(channels, layer, name)
 

@@ -1,4 +1,4 @@
-"""The fluids of a scene as samples for the fluid_velocity guide (tempera.fluid_velocity).
+"""The fluids of a scene as samples for the fluid_velocity guide (tempera.app.fluid_velocity).
 
     samples = scene_fluid_samples(scene, depsgraph)    # None if the scene has no fluids
     field = fluid_velocity_guide(scene, depsgraph, samples, alpha)
@@ -19,7 +19,7 @@ is why this guide exists (docs/guide_cache.md).
 """
 import numpy as np
 
-from .. import fluid_velocity as fv
+from ..app import fluid_velocity as fv
 
 
 def _fluid_domain(obj):

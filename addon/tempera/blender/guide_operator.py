@@ -2,7 +2,7 @@
 
     bpy.ops.tempera.render_guides()
 
-renders the guide cache (tempera.guide_cache) of the scene's frames as set in
+renders the guide cache (tempera.app.guide_cache) of the scene's frames as set in
 Scene.tempera (folder, frame range, parameters). In the UI it is modal: a
 window-manager timer renders one frame per step, with a progress cursor and
 "Tempera: guides frame i/N, ETA ..." in the status bar; Esc stops after the
@@ -21,7 +21,7 @@ import bpy
 from bpy.props import StringProperty
 from bpy.types import Operator
 
-from .. import guide_cache
+from ..app import guide_cache
 from .guide_render import (LPE_PROBLEMS, GuideRenderError, check_lpe_expressions, check_scene, render_guides,
                            scene_fingerprint)
 from .job_operator import JobOperator

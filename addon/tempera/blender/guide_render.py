@@ -1,16 +1,16 @@
-"""Rendering a scene's guides with Cycles into the guide cache (tempera.guide_cache).
+"""Rendering a scene's guides with Cycles into the guide cache (tempera.app.guide_cache).
 
     render_guides(scene, frames, out_dir, params=None, progress=None)
 
 Per frame: one main render with the light-path, motion, depth, normal and
 object-index passes, and a second render with one diffuse and no glossy or
 transmission bounce for LD{1,2}E. The derived guides (velocities, occlusion,
-structure tensor, lines, masks) are computed with numpy and tempera.guides.
+structure tensor, lines, masks) are computed with numpy and tempera.engine.guides.
 Scenes with fluids (gas and liquid domains, emitter particles) also get the
 fluid_velocity guide from the simulation (tempera.blender.fluid_velocity),
 since the Vector pass is zero on volumes.
 Guides of arbitrary light path expressions (params["lpe"]) come from
-Tempera's own path tracer on the exported scene (scene_export, tempera.lpe).
+Tempera's own path tracer on the exported scene (scene_export, tempera.tracer.lpe).
 
 Every setting changed for this (render, Cycles, passes, view layers, frame,
 objects' pass index) is put back exactly afterwards by GuideRenderSettings:
@@ -26,11 +26,13 @@ from pathlib import Path
 import bpy
 import numpy as np
 
-from .. import guide_cache, guides, image_info, read_image
+from ..app import guide_cache
+from ..engine import guides
+from .. import image_info, read_image
 from . import compat, fluid_velocity, rigid_tracks
-from ..frames import MAX_FRAME, check_frame
-from ..lpe import check_lpe, trace_lpe
-from ..stylize import tonemap
+from ..app.frames import MAX_FRAME, check_frame
+from ..tracer.lpe import check_lpe, trace_lpe
+from ..methods.stylit.stylize import tonemap
 from .scene_export import SceneExportError, evaluated_depsgraph, export_scene, path_settings
 
 
@@ -485,7 +487,7 @@ def render_guides(scene, frames, out_dir, params=None, progress=None):
     """Renders the guides of `frames` of `scene` into the cache folder `out_dir`.
 
     Frames whose cache is current (same parameters, same scene at that frame)
-    are skipped. `params` overrides tempera.guide_cache.DEFAULT_PARAMS.
+    are skipped. `params` overrides tempera.app.guide_cache.DEFAULT_PARAMS.
     `progress(done, total, message)` is called as frames complete.
     Returns {"rendered": [frames], "skipped": [frames], "manifest": path,
     "warnings": [what the light-path tracer approximates]}.

@@ -32,8 +32,8 @@ def keyframe_ground(scene, frame):
     """(image (H, W, 3) in [0, 1], what it is) to paint keyframe `frame` over:
     its StyLit result if there is one, else its render in low contrast."""
     import tempera
-    from tempera import guide_cache
-    from tempera.stylize import tonemap
+    from tempera.app import guide_cache
+    from tempera.methods.stylit.stylize import tonemap
 
 
     settings = scene.tempera
@@ -64,7 +64,7 @@ def add_key(settings, frame, painting, mask=""):
 
 def key_list(settings, layer=None):
     """[(frame, painting path, mask path or None), ...] in frame order, for
-    tempera.tcia.ShotJob: the keys of the whole frame, or those of the
+    tempera.methods.tcia.tcia.ShotJob: the keys of the whole frame, or those of the
     layer `layer` (a collection). Keys painted in Blender are saved first."""
 
     keys = []

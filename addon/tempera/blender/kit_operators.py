@@ -2,7 +2,7 @@
 the printable painting template of the exemplar, and register a photo or
 scan of the painted template as the exemplar's painting. Before, both kit
 steps needed a terminal (scenes/exemplar_kit.py, python -m
-tempera.register_painting)."""
+tempera.methods.stylit.register_painting)."""
 import os
 
 import bpy
@@ -97,9 +97,9 @@ class TEMPERA_OT_painting_template(Operator):
     bl_options = {"REGISTER"}
 
     def execute(self, context):
-        from .. import guide_cache
-        from ..painting_template import make_template, write_kit_json, write_pdf
-        from ..stylize import tonemap
+        from ..app import guide_cache
+        from ..methods.stylit.painting_template import make_template, write_kit_json, write_pdf
+        from ..methods.stylit.stylize import tonemap
 
         settings = context.scene.tempera
         try:
@@ -140,8 +140,8 @@ class TEMPERA_OT_register_painting(ImageFileChooser, Operator):
                           description="Divide by the paper's colour as photographed: even lighting, white paper")
 
     def execute(self, context):
-        from ..painting_template import read_kit_json
-        from ..registration import register_painting
+        from ..methods.stylit.painting_template import read_kit_json
+        from ..methods.stylit.registration import register_painting
 
         settings = context.scene.tempera
         try:

@@ -7,7 +7,7 @@ import re
 
 from bpy.types import Operator, UIList
 
-from .. import guide_cache
+from ..app import guide_cache
 from .keyframes import remove_selected
 from .setting_paths import resolve_path
 
@@ -19,7 +19,7 @@ def layer_name(collection_name):
 
 def layer_list(settings, frames=None):
     """[(name, mask guide, painting path or None, its own keys), ...] for
-    tempera.tcia.ShotJob, in list order (the first at the back when the
+    tempera.methods.tcia.tcia.ShotJob, in list order (the first at the back when the
     order is 'given'); keys only of `frames` (first, last) when given."""
     from .keyframes import key_list
 

@@ -7,7 +7,8 @@ import os
 import bpy
 from bpy.types import Panel
 
-from .. import __version__, settings as limits
+from .. import __version__
+from ..app import settings as limits
 from .guide_operator import TEMPERA_OT_render_guides, cache_status
 from .keyframes import TEMPERA_OT_add_keyframe, TEMPERA_OT_import_keyframe, TEMPERA_OT_remove_keyframe
 from .layers import TEMPERA_OT_add_tcia_layer, TEMPERA_OT_remove_tcia_layer
@@ -159,7 +160,7 @@ def draw_synthesis(box, settings):
 
 def draw_noise(box, settings):
     """Temporal Noise (Color Me Noisy): the slider, its width f, the map picker."""
-    from .. import noisy
+    from ..methods.noisy import noisy
 
     col = box.column()
     wide_prop(col, settings, "noise_level")

@@ -4,7 +4,8 @@ import functools
 from bpy.props import StringProperty
 from bpy.types import AddonPreferences
 
-from .. import __version__, cli
+from .. import __version__
+from ..app import cli
 
 # The legacy add-on's module name; the extension registers the preferences under
 # its own ("bl_ext.<repository>.tempera", see tempera.blender.register).

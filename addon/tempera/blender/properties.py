@@ -4,10 +4,10 @@ from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProp
                        StringProperty)
 from bpy.types import PropertyGroup
 
-from .. import guide_cache
-from .. import noisy
-from .. import settings as limits
-from ..frames import MAX_FRAME
+from ..app import guide_cache
+from ..methods.noisy import noisy
+from ..app import settings as limits
+from ..app.frames import MAX_FRAME
 
 DEFAULT_GUIDE_DIR = "//tempera/guides/"
 

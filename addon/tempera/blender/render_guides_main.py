@@ -17,8 +17,8 @@ from pathlib import Path
 
 import bpy
 
-from .. import guide_cache
-from ..frames import parse_frames
+from ..app import guide_cache
+from ..app.frames import parse_frames
 from .guide_render import GuideRenderError, render_guides
 
 # Exit statuses, mapped by the `tempera` CLI (native/cli/render_guides_command.cpp):

@@ -1,5 +1,5 @@
 """Tracks of a baked rigid-body world, projected through the scene camera,
-into the guide cache's tracks.json (the math: tempera.rigid_tracks).
+into the guide cache's tracks.json (the math: tempera.methods.rigid.rigid_tracks).
 
 For every object and frame (after frame_set, so the bake is evaluated):
 the screen centroid (the origin, which the recommended setup puts at the
@@ -15,7 +15,7 @@ import math
 from bpy_extras.object_utils import world_to_camera_view
 from mathutils import Vector
 
-from .. import rigid_tracks
+from ..methods.rigid import rigid_tracks
 
 
 def _pixel(scene, camera, co, width, height):

@@ -7,7 +7,7 @@ Geometry comes from the depsgraph (modifiers applied, instances expanded,
 world transforms) as triangles with per-corner split normals and UVs;
 materials become Cycles' closures by a small interpreter of the shader nodes
 (tempera.blender.shader_nodes); lights, world
-and camera are converted to physical units with tempera.scene_units so that
+and camera are converted to physical units with tempera.tracer.scene_units so that
 the tracer's buffers match Cycles pixel for pixel. Whatever the tracer cannot
 represent is approximated and named in `warnings` (docs/lpe_guides.md lists
 what is supported). Blender units are taken as metres, as Cycles does (the
@@ -15,7 +15,7 @@ scene's unit scale is ignored by Cycles too).
 """
 import numpy as np
 
-from .. import scene_units
+from ..tracer import scene_units
 from . import compat
 from .shader_nodes import DEFAULT_GREY, ImageCache, ShaderInterpreter
 
@@ -355,7 +355,7 @@ def _index_textures(material, textures):
 # --------------------------------------------------------------------------- lights and world
 
 def _light(obj, matrix, warnings):
-    """A light object at world `matrix` in the tracer's units (tempera.scene_units)."""
+    """A light object at world `matrix` in the tracer's units (tempera.tracer.scene_units)."""
     light = obj.data
     position = matrix[:3, 3]
     z_axis = matrix[:3, 2] / np.linalg.norm(matrix[:3, 2])  # Blender lights shine down their local -Z

@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from .. import scene_units
+from ..tracer import scene_units
 
 DEFAULT_GREY = (0.8, 0.8, 0.8)
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])

@@ -7,7 +7,7 @@ runs them: modal with progress and Esc in the UI, all at once in background):
 
 1. guides: the scene's guide cache is brought up to date (frames already
    current are skipped, see guide_operator.GuideJob);
-2. stylize: tempera.stylize.StylizeJob, the native sequence driver, stylizes
+2. stylize: tempera.methods.stylit.stylize.StylizeJob, the native sequence driver, stylizes
    one frame per step in a worker thread (the solver releases the GIL), with
    the previous stylized frame as temporal guide. Frames already stylized
    with the same settings are skipped, so a rerun resumes where a stopped
@@ -17,14 +17,14 @@ After the last frame of an animation: a contact sheet, an mp4 (when ffmpeg
 is present) and the result loaded back into Blender (Load Result).
 
 With Method "Temporally Coherent (Bénard 2013)", Stylize Animation's second
-phase is CoherentRun: tempera.tcia.ShotJob, one step per segment between
+phase is CoherentRun: tempera.methods.tcia.tcia.ShotJob, one step per segment between
 painted keyframes (each resumable, Esc stops within a segment and nothing of
 it is written). Stylize Frame stays per-frame StyLit: a quick look, and the
 ground Add Keyframe paints over.
 
 With Method "Rigid Bodies (hand-drawn)", Stylize Animation is RigidRun:
 the guides (which write tracks.json for a rigid-body world), then
-tempera.rigid_job.RigidJob, one step per target object and chunk of frames,
+tempera.methods.rigid.rigid_job.RigidJob, one step per target object and chunk of frames,
 then the composites by depth, into Output Folder/rigid/frames (each step
 resumable; Esc stops within a step and nothing of it is written). Stylize
 Frame stays per-frame StyLit.
@@ -36,7 +36,7 @@ import bpy
 from bpy.types import Operator
 from bpy.props import EnumProperty, StringProperty
 
-from .. import settings as limits
+from ..app import settings as limits
 from .guide_operator import (ETA_AFTER_FRAMES, GuideJob, estimate_guide_seconds, format_duration, guide_frames,
                              long_run_question)
 from .guide_render import GuideRenderError
@@ -71,7 +71,7 @@ def stylize_options(settings):
 def noise_config(settings, out, config):
     """The NoisySequence arguments of the Temporal Noise settings (None = off):
     the coherent frames of this run boiled into OUT/noisy."""
-    from .. import noisy
+    from ..methods.noisy import noisy
 
     if settings.noise_level == 0:
         return None
@@ -173,7 +173,7 @@ class StylizeRun:
         self.index += 1
 
     def _stylize(self, progress):
-        from ..stylize import StylizeJob
+        from ..methods.stylit.stylize import StylizeJob
 
         if self.job is None:
             self.job = StylizeJob(**self.config)
@@ -192,7 +192,7 @@ class StylizeRun:
             print(f"Tempera: frame {result['frame']} {result['status']} in {seconds:.1f} s{note}", flush=True)
 
     def _boil(self, progress):
-        from ..noisy import NoisySequence
+        from ..methods.noisy.noisy import NoisySequence
 
         if self.noise_job is None:
             self.noise_job = NoisySequence(**self.noise)
@@ -262,7 +262,8 @@ class CoherentRun(StylizeRun):
     """Guides of every frame, then the coherent method, one segment per step."""
 
     def __init__(self, scene, frames, mode="ANIMATION"):
-        from .. import guide_cache, tcia
+        from ..app import guide_cache
+        from ..methods.tcia import tcia
         from .keyframes import key_list
         from .layers import layer_list
 
@@ -284,7 +285,7 @@ class CoherentRun(StylizeRun):
         return len(self.segments)
 
     def _stylize(self, progress):
-        from ..tcia import ShotJob
+        from ..methods.tcia.tcia import ShotJob
 
         c = self.config
         if self.job is None:
@@ -350,7 +351,7 @@ class RigidRun(StylizeRun):
         self.mode = mode
         self.frames = list(frames)
         self.out = output_dir(settings)
-        from ..rigid_job import exemplar_folders
+        from ..methods.rigid.rigid_job import exemplar_folders
 
         self.examples = resolve_path(settings.rigid_examples, "rigid-body Examples folder")
         exemplar_folders(self.examples)  # a named error now, not after the guides
@@ -368,11 +369,11 @@ class RigidRun(StylizeRun):
         self.options = rigid_options(settings)
         self.strokes = None
         if settings.rigid_strokes == "GENERATED":
-            from ..rigid_strokes import GENERATED
+            from ..methods.rigid.rigid_strokes import GENERATED
 
             self.strokes = GENERATED
         elif settings.rigid_strokes == "IMAGE":
-            from ..rigid_strokes import load_stroke_exemplar
+            from ..methods.rigid.rigid_strokes import load_stroke_exemplar
 
             self.strokes = resolve_path(settings.rigid_stroke_image, "rigid-body Stroke Image")
             load_stroke_exemplar(self.strokes)  # a named error now, not after the guides
@@ -385,7 +386,7 @@ class RigidRun(StylizeRun):
         self.warnings = []
 
     def _rigid_job(self):
-        from ..rigid_job import RigidJob
+        from ..methods.rigid.rigid_job import RigidJob
 
         if self.job is None:
             self.job = RigidJob(self.guides.folder, self.examples, os.path.join(self.out, RIGID_DIR), self.frames,
@@ -458,12 +459,12 @@ class RigidRun(StylizeRun):
 
 
 EXEMPLAR_FRAMES_DIR = "exemplar_frames"  # decoded movies and linked sequences, in the Output Folder
-RENDER_DIR = "render"  # the render under an RGBA result (tempera.beauty), in the method's folder
+RENDER_DIR = "render"  # the render under an RGBA result (tempera.app.beauty), in the method's folder
 
 
 class RgbaRun(StylizeRun):
     """Guides of every frame, then an RGBA method's job a frame per step:
-    the frames go over the render (tempera.beauty) in a composite scene."""
+    the frames go over the render (tempera.app.beauty) in a composite scene."""
 
     folder = None  # the method's folder in the Output Folder
     method_label = None  # the method's name in messages
@@ -471,7 +472,7 @@ class RgbaRun(StylizeRun):
     kinds = ("STILL", "SEQUENCE", "MOVIE")  # the exemplars the method takes
 
     def __init__(self, scene, frames, mode="ANIMATION"):
-        from ..media_source import exemplar_source
+        from ..app.media_source import exemplar_source
 
         settings = scene.tempera
         self.mode = mode
@@ -523,13 +524,13 @@ class RgbaRun(StylizeRun):
 
     def render_paths(self):
         """The render frames under the result (made from the guide cache when stale)."""
-        from ..beauty import write_render_frames
+        from ..app.beauty import write_render_frames
 
         return write_render_frames(self.guides.folder, self.frames, os.path.join(self.method_out, RENDER_DIR))
 
 
 class FluidRun(RgbaRun):
-    """Guides, then LazyFluids (tempera.lazyfluids.FluidJob): smoke, fire and liquids."""
+    """Guides, then LazyFluids (tempera.methods.lazyfluids.lazyfluids.FluidJob): smoke, fire and liquids."""
 
     folder = "lazyfluids"
     method_label = "Fluid"
@@ -541,7 +542,7 @@ class FluidRun(RgbaRun):
                 **limits.panel_options(settings, "lf_")}
 
     def make_method_job(self):
-        from ..lazyfluids import FluidJob
+        from ..methods.lazyfluids.lazyfluids import FluidJob
 
         return FluidJob(self.exemplar, self.guides.folder, self.frames, self.config["out"],
                         format=self.config["format"], **self.options)
@@ -549,7 +550,7 @@ class FluidRun(RgbaRun):
 
 class MediaRun(RgbaRun):
     """Guides (with the target's mask), then Fluidymation
-    (tempera.fluidymation.MediaJob): a moving object or collection as a medium."""
+    (tempera.methods.fluidymation.fluidymation.MediaJob): a moving object or collection as a medium."""
 
     folder = "fluidymation"
     method_label = "Natural Media"
@@ -557,7 +558,7 @@ class MediaRun(RgbaRun):
     kinds = ("SEQUENCE", "MOVIE")
 
     def __init__(self, scene, frames, mode="ANIMATION"):
-        from .. import guide_cache
+        from ..app import guide_cache
 
         super().__init__(scene, frames, mode)
         settings = scene.tempera
@@ -577,7 +578,7 @@ class MediaRun(RgbaRun):
                 "seed": int(settings.seed), **limits.panel_options(settings, "fm_")}
 
     def make_method_job(self):
-        from ..fluidymation import MediaJob
+        from ..methods.fluidymation.fluidymation import MediaJob
 
         return MediaJob(self.exemplar, self.guides.folder, self.frames, self.config["out"],
                         exemplar_masks=self.exemplar_masks, target_mask=self.target_mask,
@@ -661,7 +662,7 @@ class TEMPERA_OT_stylize(JobOperator, Operator):
 
     def _encode_video(self, scene, job):
         """Encodes the mp4; its path, or None (reported why)."""
-        from ..stylize import encode_video
+        from ..methods.stylit.stylize import encode_video
 
         if job.config["format"] != "png":
             self.report({"INFO"}, "No mp4: the video is made from PNG frames (Format is OpenEXR)")

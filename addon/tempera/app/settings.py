@@ -1,0 +1,76 @@
+"""Limits and defaults of Tempera's user settings (no bpy: shared by the
+Blender UI, the tests and scripts that drive the engine without Blender).
+The engine's and StyLit's come from the native tables, where they are
+defined once (synthesis_options.hpp, stylit.hpp)."""
+from .. import _native
+
+DEFAULT_OUTPUT_DIR = "//tempera/"  # "//" = relative to the .blend file
+
+# name -> row of the engine's option table (name, flag, help, default, min, max, choices).
+ENGINE_OPTIONS = {row["name"]: row for row in _native.SynthesisOptions.table()}
+PATCH_SIZE_DEFAULT = ENGINE_OPTIONS["patch_size"]["default"]
+PATCH_SIZE_MIN = int(ENGINE_OPTIONS["patch_size"]["min"])
+# The panel stops at 15 (the engine takes up to the table's max, for very
+# coarse media, from scripts and the CLI).
+PATCH_SIZE_MAX = min(15, int(ENGINE_OPTIONS["patch_size"]["max"]))
+SEED_DEFAULT = ENGINE_OPTIONS["seed"]["default"]
+
+
+def odd_patch_size(size):
+    """The patch size actually used for `size`: patches need a centre pixel, so
+    even sizes are rounded up to the next odd one, within [MIN, MAX]."""
+    size = int(size)
+    if size % 2 == 0:
+        size += 1
+    return max(PATCH_SIZE_MIN, min(PATCH_SIZE_MAX, size))
+
+
+# StyLit's light-path guides (names as in the guide cache): name, expression,
+# default weight, label and help, in matching order.
+LIGHT_PATH_GUIDES = tuple(_native.light_path_guides())
+DEFAULT_GUIDE_WEIGHTS = {g["name"]: g["weight"] for g in LIGHT_PATH_GUIDES}
+# Pull towards the previous stylized frame advected along the motion (Fišer
+# 2017, EbSynth); 0 stylizes every frame on its own. The engine and the CLI
+# default to 0 (frames independent, so farms can split a shot anywhere); the
+# panel starts artists at 0.5, measured on the demo: flicker 0.030 -> 0.011
+# with the stroke detail kept (docs/user_guide.md).
+DEFAULT_TEMPORAL_WEIGHT = _native.stylit_defaults()["temporal_weight"]
+PANEL_TEMPORAL_WEIGHT = 0.5
+# The panel's Guided Noise checkbox sets noise_guides to this (docs/noisy.md:
+# 0.5 and 1 keep the same share of thin strokes; 0.5 was the probe's best).
+PANEL_NOISE_GUIDES = 0.5
+DEFAULT_QUALITY = _native.stylit_defaults()["quality"]
+QUALITY_PRESETS = ("preview", "final")
+OUTPUT_FORMATS = ("png", "exr")
+
+# The fluid methods' option tables (name -> row, as ENGINE_OPTIONS):
+# LazyFluids (lazyfluids.hpp) and Fluidymation (fluidymation.hpp). The panel
+# shows λ, rotations and motion blur of the one, bidirectional of the other,
+# and the options of PANEL_OPTIONS; its sliders stop at these soft maxima
+# (the tables take more, for scripts).
+LAZYFLUIDS_OPTIONS = {row["name"]: row for row in _native.LazyFluidsOptions.table()}
+FLUIDYMATION_OPTIONS = {row["name"]: row for row in _native.FluidymationOptions.table()}
+PANEL_SOFT_MAX = {"temporal_weight": 1.0, "motion_blur": 16.0}
+# The rigid-body method's option table (rigid.hpp, name -> row); the panel
+# shows K, augmentation, damping and the stroke guide's weight.
+RIGID_OPTIONS = {row["name"]: row for row in _native.RigidOptions.table()}
+# Table options the panel shows as they are (default, limits and tooltip from
+# the table row): Scene.tempera property -> (table, option name, label, soft
+# maximum), in panel order. The job gets each under its option name.
+PANEL_OPTIONS = {
+    "lf_eta": (LAZYFLUIDS_OPTIONS, "alpha_guide_weight", "Boundary Shape (η)", 10.0),
+    "lf_alpha_weight": (LAZYFLUIDS_OPTIONS, "alpha_weight", "Alpha Weight", 10.0),
+    "lf_warm_start": (LAZYFLUIDS_OPTIONS, "warm_start", "Warm Start", None),
+    "fm_boundary_weight": (FLUIDYMATION_OPTIONS, "boundary_weight", "Boundary (w_b)", 10.0),
+    "fm_direction_weight": (FLUIDYMATION_OPTIONS, "direction_weight", "Direction (w_d)", 10.0),
+    "fm_extent_weight": (FLUIDYMATION_OPTIONS, "extent_weight", "Motion Extent (w_e)", 2.0),
+    "fm_temporal_weight": (FLUIDYMATION_OPTIONS, "temporal_weight", "Temporal (w_t)", 10.0),
+    "fm_uniformity_weight": (FLUIDYMATION_OPTIONS, "uniformity_weight", "Uniformity (w_u)", 10.0),
+}
+
+
+def panel_options(settings, prefix):
+    """The PANEL_OPTIONS values of `settings` whose property starts with
+    `prefix` ("lf_", "fm_"), by option name (the jobs' keywords)."""
+    return {option: getattr(settings, prop) for prop, (_table, option, _label, _soft) in PANEL_OPTIONS.items()
+            if prop.startswith(prefix)}

@@ -1,0 +1,1 @@
+"""One package per paper (native/src/methods/<method>): stylit, tcia, noisy, lazyfluids, fluidymation, rigid."""

@@ -1,0 +1,207 @@
+"""`tempera rigid`: the rigid-body method (tempera.methods.rigid.rigid) on a guide cache's
+tracks, with no Blender.
+
+    tempera rigid --cache CACHE --exemplar EXEMPLAR [--exemplar ...] --out OUT
+                  [--object NAME] [--frames A-B] [--shape circle|box] [--paper]
+                  [--strokes IMAGE|generated] [method options]
+    tempera stylize --method rigid --guides CACHE --exemplar EXEMPLAR ... (the same,
+                  in the form of the other methods: --guides names the cache)
+
+CACHE holds tracks.json (tempera.methods.rigid.rigid_tracks) of the target simulation and
+its manifest (the frame size). Each EXEMPLAR folder holds the source
+simulation's tracks.json and its drawn frames, drawn/0001.png ... (RGBA ink,
+numbered from the tracks' frame_start; every frame drawn). OUT receives
+frame_0001.png ... (RGBA, straight alpha; --paper: opaque, on paper) and
+rigid.json, the settings key: a rerun with the same inputs and options keeps
+the frames already written (resume), Ctrl-C stops between frames with every
+written frame complete (each is written to a temporary file, then renamed).
+"""
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from ... import _native
+from . import rigid, rigid_strokes, rigid_tracks
+from ...app.command import run_command
+from ...app.frames import parse_frames
+
+PAPER = (0.97, 0.96, 0.92)
+OPTION_TABLES = (rigid.RigidOptions.table(), rigid.QuadraticFitOptions.table())
+
+
+def _parser(prog="tempera rigid"):
+    p = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0])
+    p.add_argument("--cache", "--guides", dest="cache", required=True,
+                   help="guide cache with the target's tracks.json")
+    p.add_argument("--exemplar", action="append", required=True,
+                   help="folder with a source tracks.json and drawn/NNNN.png (repeatable)")
+    p.add_argument("--out", required=True, help="output folder")
+    p.add_argument("--object", help="the target object (needed when the cache tracks several)")
+    p.add_argument("--frames", help="frames to draw, e.g. 1-24 (default: every tracked frame)")
+    p.add_argument("--shape", default="circle", choices=["circle", "box"], help="the objects' proxy (circle)")
+    p.add_argument("--paper", action="store_true", help="opaque frames on paper instead of RGBA")
+    p.add_argument("--strokes", help="re-synthesize the lines from this stroke exemplar (an RGBA image of strokes, "
+                   f"or '{rigid_strokes.GENERATED}': the project's blue brush pen) on a stroke-position guide")
+    for table in OPTION_TABLES:
+        for row in table:
+            kind = type(row["default"])
+            if kind is bool:
+                p.add_argument(f"--{row['flag']}", dest=row["name"], choices=["true", "false"], help=row["help"])
+            elif kind is list:
+                p.add_argument(f"--{row['flag']}", dest=row["name"], help=row["help"] + " (comma-separated)")
+            else:
+                p.add_argument(f"--{row['flag']}", dest=row["name"], type=kind, help=row["help"])
+    return p
+
+
+def _values(args, table):
+    out = {}
+    for row in table:
+        v = getattr(args, row["name"])
+        if v is None:
+            continue
+        if isinstance(row["default"], bool):
+            v = v == "true"
+        elif isinstance(row["default"], list):
+            try:
+                v = [float(x) for x in v.split(",")]
+            except ValueError:
+                raise ValueError(f"--{row['flag']} expects comma-separated numbers, got '{v}'") from None
+        out[row["name"]] = v
+    return out
+
+
+def _one_object(tracks, name, where):
+    objects = tracks["objects"]
+    if name is None:
+        if len(objects) != 1:
+            raise ValueError(f"{where} tracks {len(objects)} objects ({', '.join(sorted(objects))}): name one with --object")
+        name = next(iter(objects))
+    if name not in objects:
+        raise ValueError(f"{where} has no object '{name}' (it has {', '.join(sorted(objects)) or 'none'})")
+    return name, objects[name]
+
+
+def _read_exemplar(folder, shape, fit_values):
+    folder = Path(folder)
+    tracks = rigid_tracks.read_tracks(folder)
+    _, track = _one_object(tracks, None, f"exemplar {folder}")
+    drawings = []
+    for i in range(len(track["centre"])):
+        path = folder / "drawn" / f"{tracks['frame_start'] + i:04d}.png"
+        if not path.is_file():
+            raise FileNotFoundError(f"{path}: drawn frame missing (every frame of the exemplar must be drawn)")
+        image = _native.read_image(str(path), None)
+        if image.ndim != 3 or image.shape[2] != 4:
+            raise ValueError(f"{path}: a drawn frame must be RGBA (ink in alpha)")
+        drawings.append(image)
+    return rigid.fit_exemplar(track, drawings, shape=shape, **fit_values), folder
+
+
+def _stamp(path):
+    st = Path(path).stat()
+    return f"{path}:{st.st_size}:{st.st_mtime_ns}"
+
+
+def _settings_key(args, exemplar_dirs, values):
+    parts = [_stamp(Path(args.cache) / rigid_tracks.TRACKS_NAME), args.object or "", args.shape, str(args.paper),
+             json.dumps(values, sort_keys=True), strokes_stamp(args.strokes) or ""]
+    for d in exemplar_dirs:
+        parts += [_stamp(d / rigid_tracks.TRACKS_NAME)] + sorted(_stamp(p) for p in (d / "drawn").glob("*.png"))
+    return hashlib.sha256("\n".join(parts).encode()).hexdigest()
+
+
+def strokes_stamp(spec):
+    """The stroke exemplar in a settings key ('' for none)."""
+    return spec if spec in (None, "", rigid_strokes.GENERATED) else _stamp(spec)
+
+
+def _write_atomic(path, write):
+    tmp = path.with_name(f".{path.stem}.partial{path.suffix}")
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def _frame_indices(text, start, count):
+    """Track indices of the frames of --frames (all when None); a frame
+    outside the tracks is an error naming the tracked range."""
+    if text is None:
+        return list(range(count))
+    frames = parse_frames(text)
+    outside = [f for f in frames if not start <= f < start + count]
+    if outside:
+        raise ValueError(f"--frames {text}: frame {outside[0]} is outside the tracked frames "
+                         f"{start}-{start + count - 1}")
+    return [f - start for f in frames]
+
+
+def run(args):
+    tracks = rigid_tracks.read_tracks(args.cache)
+    name, target = _one_object(tracks, args.object, f"guide cache {args.cache}")
+    width, height = rigid_tracks.frame_size(args.cache)
+    rigid_values, fit_values = (_values(args, t) for t in OPTION_TABLES)
+    rigid_values = {"symmetry": rigid.SYMMETRY[args.shape], **rigid_values}  # --symmetry overrides the shape's
+    rigid.RigidOptions(**rigid_values), rigid.QuadraticFitOptions(**fit_values)  # named errors before any work
+    strokes = rigid_strokes.load_stroke_exemplar(args.strokes) if args.strokes else None
+    exemplars = [_read_exemplar(d, args.shape, fit_values) for d in args.exemplar]
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    key = _settings_key(args, [d for _, d in exemplars], {**rigid_values, **fit_values})
+    state = out / "rigid.json"
+    previous = json.loads(state.read_text()).get("settings") if state.is_file() else None
+    wanted = _frame_indices(args.frames, tracks["frame_start"], len(target["centre"]))
+    paths = {i: out / f"frame_{tracks['frame_start'] + i:04d}.png" for i in wanted}
+    todo = [i for i in wanted if previous != key or not paths[i].is_file()]
+    if previous != key:  # frames of other settings must not pass for these on a later run
+        for stale in out.glob("frame_*.png"):
+            stale.unlink()
+    _write_atomic(state, lambda p: p.write_text(json.dumps({"settings": key, "object": name}, indent=1)))
+
+    def progress(f):
+        print(f"tempera rigid: frame {tracks['frame_start'] + f}", file=sys.stderr, flush=True)
+        return True
+
+    frames = rigid.stylize([e for e, _ in exemplars], target, width, height, progress=progress, only=todo,
+                           **rigid_values) if todo else []
+    for i in todo:
+        rgba = frames[i][0] if strokes is None else rigid_strokes.restyle(frames[i][0], strokes, rigid_values)
+        if args.paper:
+            a = rgba[:, :, 3:4]
+            rgba = np.concatenate([rgba[:, :, :3] * a + np.asarray(PAPER, np.float32) * (1 - a),
+                                   np.ones_like(a)], axis=2)
+        _write_atomic(paths[i], lambda p, img=np.ascontiguousarray(rgba, np.float32): _native.write_image(str(p), img, []))
+    print(f"tempera rigid: {len(todo)} frames written, {len(paths) - len(todo)} kept, in {out}")
+    return 0
+
+
+def main(argv=None, prog="tempera rigid"):
+    args = _parser(prog).parse_args(argv)
+    return run_command(prog, lambda: run(args), "cancelled; rerun the same command to resume")
+
+
+STYLIZE_PROG = "tempera stylize --method rigid"
+
+
+def stylize_main(argv):
+    """`tempera stylize --method rigid ...`: `tempera rigid` in the form of
+    the other methods (stylize's argv without "stylize"); the same run."""
+    rest, skip = [], False
+    for a, b in zip(argv, argv[1:] + [""]):
+        if skip:
+            skip = False
+        elif a == "--method" and b == "rigid":
+            skip = True
+        elif a != "--method=rigid":
+            rest.append(a)
+    return main(rest, STYLIZE_PROG)

@@ -1,0 +1,1 @@
+"""StyLit (Fišer et al. 2016): stylization guided by light-path expressions, its painting template and exemplar kit."""

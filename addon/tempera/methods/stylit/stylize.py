@@ -1,0 +1,156 @@
+"""StyLit stylization of animations from guide caches (thesis ch. 8).
+
+``StylizeJob`` drives a whole sequence (what ``tempera stylize`` and the
+add-on's operator run); ``stylize_frame`` stylizes one frame from in-memory
+guides. Both are thin layers over the native code (native/src/methods/stylit/stylit.cpp,
+native/src/methods/stylit/stylize_job.cpp); see docs/cli.md for the job's files and resume.
+"""
+from __future__ import annotations
+
+import os
+from typing import Callable, Iterable, Mapping, Optional
+
+import numpy as np
+
+from ... import _native
+from ...app.settings import DEFAULT_GUIDE_WEIGHTS as DEFAULT_WEIGHTS
+from ...app.settings import LIGHT_PATH_GUIDES, QUALITY_PRESETS as QUALITIES
+
+GUIDES = tuple(g["name"] for g in LIGHT_PATH_GUIDES)
+
+ProgressFn = Optional[Callable[[float], Optional[bool]]]
+
+
+def tonemap(linear):
+    """Linear radiance -> guide values in [0, 1) as StyLit matches them:
+    NaN and negatives to 0, Reinhard x / (1 + x), then the sRGB encoding.
+    Per pixel, with no image-dependent normalization, so equal lighting gives
+    equal guides in the exemplar and in every frame."""
+    a = np.asarray(linear, dtype=np.float32)
+    flat = a.reshape(a.shape[0], -1) if a.ndim == 1 else a
+    return _native.tonemap_guide(np.ascontiguousarray(flat)).reshape(a.shape)
+
+
+def _stylit_options(weights, temporal_weight, quality, engine):
+    """The native options dict: StyLit's keys plus engine options (names of
+    tempera.SynthesisOptions; the native side rejects unknown ones)."""
+    options = dict(engine)
+    if temporal_weight is not None:
+        options["temporal_weight"] = float(temporal_weight)
+    if quality is not None:
+        options["quality"] = str(quality)
+    if weights is not None:
+        options["weights"] = {str(k): float(v) for k, v in dict(weights).items()}
+    return options
+
+
+class FrameJob:
+    """What every per-frame job wrapper exposes of its native job (``_job``):
+    the frames, the warnings of its checks and the output path of a frame."""
+
+    @property
+    def frames(self) -> list:
+        return self._job.frames
+
+    @property
+    def warnings(self) -> list:
+        return self._job.warnings
+
+    def output_path(self, frame: int) -> str:
+        return self._job.output_path(int(frame))
+
+    def write_contact_sheet(self, path, columns: int = 0) -> None:
+        """The exemplar followed by the frames written so far, on one image under ~2000 px wide."""
+        self._job.write_contact_sheet(os.fspath(path), int(columns))
+
+
+class SequenceJob(FrameJob):
+    """A job whose frames follow one another (the fluid methods: each frame
+    starts from the one before)."""
+
+    def run_frame(self, index: int, progress=None) -> dict:
+        """Stylizes frames[index] (solving the frames before it first where
+        the method needs them), or skips it when current. ``progress(fraction)``
+        returning False cancels (tempera.Cancelled), nothing written. Returns
+        dict(status "stylized" | "skipped", seconds)."""
+        report = None if progress is None else (lambda x: progress(x) is not False)
+        status, seconds = self._job.run_frame(int(index), report)
+        return {"status": status, "seconds": seconds}
+
+
+class StylizeJob(FrameJob):
+    """Stylization of the frames of a guide cache with one painted exemplar.
+
+    style            the painting (PNG/EXR/...), made on the exemplar render
+    exemplar_guides  guide cache folder of the exemplar render
+    guides           guide cache folder of the animation
+    frames           frame numbers, in order (consecutive frames are chained
+                     by the temporal guide and the flicker figure)
+    out              output folder; frames are written as out/<prefix>0001.<format>
+    exemplar_frame   frame of exemplar_guides to use (default: its only frame)
+    weights          {guide: weight} overriding DEFAULT_WEIGHTS (<= 0 leaves a guide out)
+    temporal_weight  pull towards the previous stylized frame advected along
+                     the motion (0 = frames independent; None = the default,
+                     settings.DEFAULT_TEMPORAL_WEIGHT)
+    quality          "final" (engine defaults) or "preview" (fast, for interaction)
+    **engine         engine options (tempera.SynthesisOptions: usage, patch_size, seed, threads, ...)
+    resume           skip frames whose output is current (see docs/cli.md)
+
+    Construction checks every file and guide up front (FileNotFoundError,
+    ValueError); ``warnings`` lists what was fixed on the way (a resampled
+    painting). Call ``run_frame(i)`` for i in range(len(job.frames)).
+    """
+
+    def __init__(self, style, exemplar_guides, guides, frames: Iterable[int], out, *, exemplar_frame=None,
+                 format="png", prefix="frame_", weights: Optional[Mapping[str, float]] = None,
+                 temporal_weight=None, quality=None, resume=True, **engine):
+        config = dict(style=os.fspath(style), exemplar_guides=os.fspath(exemplar_guides),
+                      guides=os.fspath(guides), frames=[int(f) for f in frames], out=os.fspath(out),
+                      exemplar_frame=None if exemplar_frame is None else int(exemplar_frame),
+                      format=str(format), prefix=str(prefix), resume=bool(resume),
+                      **_stylit_options(weights, temporal_weight, quality, engine))
+        self._job = _native.StylizeJob(config)
+
+    @property
+    def report_path(self) -> str:
+        """The job's sidecar (out/tempera_stylize.json): settings, key and flicker per frame."""
+        return self._job.report_path
+
+    def run_frame(self, index: int, progress: ProgressFn = None) -> dict:
+        """Stylizes frames[index], or skips it when its output is current.
+
+        Returns dict(frame, path, status "stylized" | "skipped", seconds,
+        flicker (NaN without a previous frame), source_coverage). The GIL is
+        released meanwhile; ``progress(fraction)`` returning False cancels
+        (tempera.Cancelled) and nothing is written.
+        """
+        return self._job.run_frame(int(index), progress)
+
+
+def stylize_frame(style, exemplar: Mapping, target: Mapping, *, previous=None, velocity_backward=None,
+                  occlusion_backward=None, weights=None, temporal_weight=None, quality=None,
+                  progress: ProgressFn = None, **engine):
+    """One StyLit frame from arrays: ``exemplar`` and ``target`` map guide names
+    (FULL, LDE, ...) to linear (H, W, 3) arrays as in a guide cache (they are
+    tone-mapped here). Give ``previous`` (the previous stylized frame) with the
+    target's ``velocity_backward`` and ``occlusion_backward`` to add the
+    temporal guide. Returns (image, stats)."""
+    temporal = None
+    if previous is not None:
+        if velocity_backward is None or occlusion_backward is None:
+            raise ValueError("previous needs velocity_backward and occlusion_backward")
+        temporal = dict(previous=_float(previous), velocity_backward=_float(velocity_backward),
+                        occlusion_backward=_float(occlusion_backward))
+    options = _stylit_options(weights, temporal_weight, quality, engine)
+    return _native.stylize_frame(_float(style), {k: _float(v) for k, v in exemplar.items()},
+                                 {k: _float(v) for k, v in target.items()}, options, temporal, progress)
+
+
+def encode_video(pattern, first_frame: int, out, fps: float = 24.0) -> bool:
+    """H.264 MP4 of numbered frames (printf pattern, e.g. 'out/frame_%04d.png')
+    with ffmpeg, written atomically; False (and no file) when ffmpeg is missing."""
+    return _native.encode_video(os.fspath(pattern), int(first_frame), float(fps), os.fspath(out))
+
+
+def _float(array):
+    return np.ascontiguousarray(array, dtype=np.float32)
