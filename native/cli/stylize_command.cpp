@@ -197,7 +197,7 @@ bool set_engine_flag(Options& o, const std::string& flag, ArgReader& r) {
   return true;
 }
 
-// The rigid-body method is the Python package's (tempera.rigid_cli): the
+// The rigid-body method is the Python package's (tempera.methods.rigid.rigid_cli): the
 // wheel's `tempera` command and `python -m tempera` run it before this CLI.
 constexpr const char* kRigidElsewhere =
     "--method rigid runs in the Python package: use the pip-installed 'tempera stylize --method rigid ...' "

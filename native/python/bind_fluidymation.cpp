@@ -1,5 +1,5 @@
 // Python binding of Fluidymation (fluidymation.hpp, fluidymation_job.hpp);
-// tempera.fluidymation wraps it.
+// tempera.methods.fluidymation.fluidymation wraps it.
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
@@ -113,8 +113,8 @@ void bind_fluidymation(py::module_& m) {
         return result;
       },
       py::arg("exemplar"), py::arg("exemplar_masks"), py::arg("target_masks"), py::arg("target_flows"),
-      py::arg("options"), py::arg("progress") = nullptr, "Use tempera.fluidymation.stylize_sequence.");
-  auto job_class = py::class_<FluidymationJob>(m, "FluidymationJob", "Fluidymation over a guide cache; use tempera.fluidymation.MediaJob.")
+      py::arg("options"), py::arg("progress") = nullptr, "Use tempera.methods.fluidymation.fluidymation.stylize_sequence.");
+  auto job_class = py::class_<FluidymationJob>(m, "FluidymationJob", "Fluidymation over a guide cache; use tempera.methods.fluidymation.fluidymation.MediaJob.")
       .def(py::init([](const py::dict& config, const FluidymationOptions& options) {
              FluidymationJobConfig c = job_config(config, options);
              py::gil_scoped_release release;  // reads the exemplar and the target's masks

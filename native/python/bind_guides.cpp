@@ -1,6 +1,6 @@
 // Python binding of the guide building blocks (motion, orientation, line
 // distance). Arrays are viewed in place and the GIL is released while the
-// native code runs; tempera.guides wraps these with numpy-friendly shapes.
+// native code runs; tempera.engine.guides wraps these with numpy-friendly shapes.
 #include "numpy_bridge.hpp"
 #include "tempera/engine/distance_transform.hpp"
 #include "tempera/engine/motion.hpp"
@@ -33,7 +33,7 @@ void bind_guides(py::module_& m) {
         return without_gil([&] { return occlusion_backward(a, b, epsilon); });
       },
       py::arg("v_minus_t"), py::arg("v_plus_prev"), py::arg("epsilon") = 2.0f,
-      "chi-(p, t): 1 where p was visible in frame t-1 (Benard 2013, 3.1); use tempera.guides.");
+      "chi-(p, t): 1 where p was visible in frame t-1 (Benard 2013, 3.1); use tempera.engine.guides.");
   m.def(
       "occlusion_forward",
       [](const FloatArray& v_plus_t, const FloatArray& v_minus_next, float epsilon) {
@@ -41,33 +41,33 @@ void bind_guides(py::module_& m) {
         return without_gil([&] { return occlusion_forward(a, b, epsilon); });
       },
       py::arg("v_plus_t"), py::arg("v_minus_next"), py::arg("epsilon") = 2.0f,
-      "chi+(p, t): 1 where p stays visible in frame t+1 (Benard 2013, 3.1); use tempera.guides.");
+      "chi+(p, t): 1 where p stays visible in frame t+1 (Benard 2013, 3.1); use tempera.engine.guides.");
   m.def(
       "warp_backward",
       [](const FloatArray& previous, const FloatArray& v_minus_t) {
         ImageView a = py_bridge::view_of(previous, "previous"), b = py_bridge::view_of(v_minus_t, "v_minus_t");
         return without_gil([&] { return warp_backward(a, b); });
       },
-      py::arg("previous"), py::arg("v_minus_t"), "previous(p - V-_t(p)), bilinear; use tempera.guides.");
+      py::arg("previous"), py::arg("v_minus_t"), "previous(p - V-_t(p)), bilinear; use tempera.engine.guides.");
   m.def(
       "structure_tensor",
       [](const FloatArray& image, float sigma) {
         ImageView a = py_bridge::view_of(image, "image");
         return without_gil([&] { return structure_tensor(a, sigma); });
       },
-      py::arg("image"), py::arg("sigma") = 2.0f, "(Jxx, Jxy, Jyy) per pixel; use tempera.guides.");
+      py::arg("image"), py::arg("sigma") = 2.0f, "(Jxx, Jxy, Jyy) per pixel; use tempera.engine.guides.");
   m.def(
       "orientation_from_tensor",
       [](const FloatArray& tensor) {
         ImageView a = py_bridge::view_of(tensor, "structure tensor");
         return without_gil([&] { return orientation_from_tensor(a); });
       },
-      py::arg("tensor"), "(angle in [0, pi), coherence) per pixel; use tempera.guides.");
+      py::arg("tensor"), "(angle in [0, pi), coherence) per pixel; use tempera.engine.guides.");
   m.def(
       "line_distance",
       [](const FloatArray& mask, float d_max) {
         ImageView a = py_bridge::view_of(mask, "line mask");
         return without_gil([&] { return line_distance(a, d_max); });
       },
-      py::arg("mask"), py::arg("d_max") = 10.0f, "min(distance to lines, d_max) / d_max; use tempera.guides.");
+      py::arg("mask"), py::arg("d_max") = 10.0f, "min(distance to lines, d_max) / d_max; use tempera.engine.guides.");
 }

@@ -1,5 +1,5 @@
 // Python binding of LazyFluids (lazyfluids.hpp, lazyfluids_job.hpp);
-// tempera.lazyfluids wraps it.
+// tempera.methods.lazyfluids.lazyfluids wraps it.
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
@@ -49,7 +49,7 @@ void bind_lazyfluids(py::module_& m) {
         return result;
       },
       py::arg("exemplar"), py::arg("alphas"), py::arg("flows"), py::arg("options"), py::arg("progress") = nullptr,
-      "LazyFluids over arrays; use tempera.lazyfluids.stylize_sequence.");
+      "LazyFluids over arrays; use tempera.methods.lazyfluids.lazyfluids.stylize_sequence.");
   m.def(
       "lazyfluids_temporal_weights",
       [](const FloatArray& target_alpha, const FloatArray& advected, float lambda) {
@@ -57,7 +57,7 @@ void bind_lazyfluids(py::module_& m) {
                                                     py_bridge::view_of(advected, "advected"), lambda));
       },
       py::arg("target_alpha"), py::arg("advected"), py::arg("lam"), "λ_q of eq. 5.6.");
-  auto job_class = py::class_<LazyFluidsJob>(m, "LazyFluidsJob", "LazyFluids over a guide cache; use tempera.lazyfluids.FluidJob.")
+  auto job_class = py::class_<LazyFluidsJob>(m, "LazyFluidsJob", "LazyFluids over a guide cache; use tempera.methods.lazyfluids.lazyfluids.FluidJob.")
       .def(py::init([](const std::string& exemplar, const std::string& guides, const std::vector<int>& frames,
                        const std::string& out, const std::string& format, bool resume,
                        const LazyFluidsOptions& options) {

@@ -1,4 +1,4 @@
-// Python binding of Color Me Noisy (noisy.hpp); tempera.noisy wraps it.
+// Python binding of Color Me Noisy (noisy.hpp); tempera.methods.noisy.noisy wraps it.
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
@@ -33,7 +33,7 @@ NoisySequenceConfig sequence_config(const py::dict& d, const NoisyOptions& optio
 }
 
 void bind_sequence(py::module_& m) {
-  py::class_<NoisySequence>(m, "NoisySequence", "Color Me Noisy over a folder of frames; use tempera.noisy.NoisySequence.")
+  py::class_<NoisySequence>(m, "NoisySequence", "Color Me Noisy over a folder of frames; use tempera.methods.noisy.noisy.NoisySequence.")
       .def(py::init([](const py::dict& config, const NoisyOptions& options) {
              NoisySequenceConfig c = sequence_config(config, options);
              py::gil_scoped_release release;  // reads the medium, checks every frame
@@ -92,7 +92,7 @@ void bind_noisy(py::module_& m) {
       },
       py::arg("style"), py::arg("reference"), py::arg("frame"), py::arg("options"), py::arg("noise_map") = py::none(),
       py::arg("progress") = nullptr, py::arg("guides") = std::vector<std::tuple<std::string, FloatArray, FloatArray, float>>{},
-      "One Color Me Noisy frame; use tempera.noisy.noisy_frame.");
+      "One Color Me Noisy frame; use tempera.methods.noisy.noisy.noisy_frame.");
   m.def(
       "deform_exemplar",
       [](const FloatArray& style, const NoisyOptions& options, int frame) {

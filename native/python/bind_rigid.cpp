@@ -1,6 +1,6 @@
 // Python binding of the rigid-body method (rigid.hpp, rigid_frame.hpp,
-// rigid_exemplar.hpp, quadratic_fit.hpp); tempera.rigid wraps it. Tracks
-// cross as the dicts of tracks.json (tempera.rigid_tracks), maps as (2, 6)
+// rigid_exemplar.hpp, quadratic_fit.hpp); tempera.methods.rigid.rigid wraps it. Tracks
+// cross as the dicts of tracks.json (tempera.methods.rigid.rigid_tracks), maps as (2, 6)
 // arrays in the paper's column order (x, y, x^2, y^2, xy, 1).
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>

@@ -1,6 +1,6 @@
 // Python binding of StyLit per frame and of the sequence driver (StylizeJob),
 // plus the contact sheet, flicker and video helpers they use. Configuration
-// comes as dicts whose unknown keys are errors; tempera.stylize wraps these
+// comes as dicts whose unknown keys are errors; tempera.methods.stylit.stylize wraps these
 // with keyword arguments. The GIL is released while native code runs.
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
@@ -187,7 +187,7 @@ py::tuple stylize_frame_py(const FloatArray& style, const py::dict& exemplar, co
 }
 
 void bind_job(py::module_& m) {
-  py::class_<StylizeJob>(m, "StylizeJob", "Stylization of a frame sequence; use tempera.stylize.StylizeJob.")
+  py::class_<StylizeJob>(m, "StylizeJob", "Stylization of a frame sequence; use tempera.methods.stylit.stylize.StylizeJob.")
       .def(py::init([](const py::dict& config) {
              StylizeJobConfig c = parse_job_config(config);
              py::gil_scoped_release release;  // reads the painting and checks every cache frame
@@ -225,7 +225,7 @@ void bind_stylize(py::module_& m) {
   bind_job(m);
   m.def("stylize_frame", &stylize_frame_py, py::arg("style"), py::arg("exemplar"), py::arg("target"),
         py::arg("options"), py::arg("temporal") = py::none(), py::arg("progress") = py::none(),
-        "One StyLit frame from in-memory guides; use tempera.stylize.stylize_frame.");
+        "One StyLit frame from in-memory guides; use tempera.methods.stylit.stylize.stylize_frame.");
   m.def(
       "flicker",
       [](const FloatArray& previous, const FloatArray& current, const FloatArray& velocity, const FloatArray& visible) {
@@ -235,7 +235,7 @@ void bind_stylize(py::module_& m) {
         return flicker(p, c, v, m);
       },
       py::arg("previous"), py::arg("current"), py::arg("velocity_backward"), py::arg("visible"),
-      "Mean absolute colour change along valid motion; use tempera.temporal.flicker.");
+      "Mean absolute colour change along valid motion; use tempera.engine.temporal.flicker.");
   m.def(
       "stylit_defaults",
       [] {
@@ -285,7 +285,7 @@ void bind_stylize(py::module_& m) {
         }
         return py_bridge::to_numpy(std::move(out));
       },
-      py::arg("linear"), "Linear radiance -> guide values in [0, 1): x/(1+x), then sRGB (use tempera.stylize.tonemap).");
+      py::arg("linear"), "Linear radiance -> guide values in [0, 1): x/(1+x), then sRGB (use tempera.methods.stylit.stylize.tonemap).");
   m.def(
       "contact_sheet",
       [](const std::vector<FloatArray>& images, int columns, int gap, int margin, std::vector<float> background) {

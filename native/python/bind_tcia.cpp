@@ -1,4 +1,4 @@
-// Python binding of Bénard et al. 2013 (tcia.hpp); tempera.tcia wraps it.
+// Python binding of Bénard et al. 2013 (tcia.hpp); tempera.methods.tcia.tcia wraps it.
 #include <deque>
 #include <numeric>
 
@@ -22,7 +22,7 @@ ImageView keep_view(const py::handle& array, const std::string& what, std::vecto
   return py_bridge::view_of(keep.back(), what);
 }
 
-// The job's configuration from tempera.tcia.ShotJob's keywords (checked there).
+// The job's configuration from tempera.methods.tcia.tcia.ShotJob's keywords (checked there).
 TciaJobConfig job_config(const py::dict& d, const TciaOptions& options) {
   TciaJobConfig c;
   StylizeJobConfig& f = c.frames;
@@ -62,7 +62,7 @@ TciaJobConfig job_config(const py::dict& d, const TciaOptions& options) {
   return c;
 }
 
-// The Shot of tempera.tcia.stylize_shot's arguments; its views point into `keep`.
+// The Shot of tempera.methods.tcia.tcia.stylize_shot's arguments; its views point into `keep`.
 Shot shot_from(const FloatArray& style, const py::list& guides, const py::list& frames, const py::list& keys,
                const py::object& style_orientation, std::vector<FloatArray>& keep) {
   Shot shot;
@@ -103,7 +103,7 @@ Shot shot_from(const FloatArray& style, const py::list& guides, const py::list& 
 }  // namespace
 
 void bind_tcia(py::module_& m) {
-  py::class_<TciaJob>(m, "TciaJob", "The coherent method over a guide cache; use tempera.tcia.ShotJob.")
+  py::class_<TciaJob>(m, "TciaJob", "The coherent method over a guide cache; use tempera.methods.tcia.tcia.ShotJob.")
       .def(py::init([](const py::dict& config, const TciaOptions& options) {
              TciaJobConfig c = job_config(config, options);
              py::gil_scoped_release release;  // reads the painting, keys and cache headers
@@ -172,7 +172,7 @@ void bind_tcia(py::module_& m) {
       },
       py::arg("style"), py::arg("guides"), py::arg("frames"), py::arg("keys"), py::arg("options"),
       py::arg("progress") = nullptr, py::arg("style_orientation") = py::none(),
-      "A whole shot with Bénard et al. 2013's sweeps; use tempera.tcia.stylize_shot.");
+      "A whole shot with Bénard et al. 2013's sweeps; use tempera.methods.tcia.tcia.stylize_shot.");
   m.def(
       "stylize_shot_layers",
       [](const FloatArray& style, const py::list& guides, const py::list& frames, const py::list& keys,
@@ -209,7 +209,7 @@ void bind_tcia(py::module_& m) {
       },
       py::arg("style"), py::arg("guides"), py::arg("frames"), py::arg("keys"), py::arg("layers"),
       py::arg("extrapolate"), py::arg("options"), py::arg("progress") = nullptr,
-      "Each layer of a shot solved alone (tcia_layers.hpp); use tempera.tcia.stylize_layers.");
+      "Each layer of a shot solved alone (tcia_layers.hpp); use tempera.methods.tcia.tcia.stylize_layers.");
   m.def(
       "composite_layers",
       [](const py::list& images, const py::list& masks, const py::object& depth) {
@@ -223,5 +223,5 @@ void bind_tcia(py::module_& m) {
         return py_bridge::to_numpy(composite_layers(i, a, order));
       },
       py::arg("images"), py::arg("masks"), py::arg("depth") = py::none(),
-      "The layers composited back to front (tcia_layers.hpp); use tempera.tcia.composite.");
+      "The layers composited back to front (tcia_layers.hpp); use tempera.methods.tcia.tcia.composite.");
 }

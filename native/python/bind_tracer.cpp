@@ -1,5 +1,5 @@
 // Python binding of the light-path-expression tracer. The scene arrives as a
-// typed tempera._native.Scene (bind_scene.cpp); tempera.lpe builds it from
+// typed tempera._native.Scene (bind_scene.cpp); tempera.tracer.lpe builds it from
 // the scene dict, strictly: a missing or unknown key is a ValueError naming
 // it, so an exporter typo never silently changes a render.
 #include <pybind11/functional.h>

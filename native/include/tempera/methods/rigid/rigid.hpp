@@ -86,7 +86,7 @@ struct RigidOptions {
   float fold_min_det = 0.05f; // least det J the fold guard allows
   int contact_fade = 3;       // frames over which the contact fix fades out
   bool overlap_blend = true;  // ramp across sub-sequence overlaps; false: a hard cut at their middle
-  // Stroke re-synthesis (§6 (iv), tempera.rigid_strokes, when a stroke
+  // Stroke re-synthesis (§6 (iv), tempera.methods.rigid.rigid_strokes, when a stroke
   // exemplar is given): the stroke-position guide G = 1 - distance / d_max.
   float stroke_d_max = 4;     // px
   float stroke_weight = 4;    // the guide's weight in the engine's patch distance

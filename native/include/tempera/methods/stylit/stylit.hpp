@@ -62,7 +62,7 @@ struct GuideFrame {
 
 // Linear radiance -> guide values in [0, 1): NaN and negatives to 0, +inf to
 // 1e6, Reinhard x / (1 + x), then the sRGB encoding. The same numbers as
-// tempera.stylize.tonemap (computed in double, stored as float).
+// tempera.methods.stylit.stylize.tonemap (computed in double, stored as float).
 Image tonemap_guide(const ImageView& linear);
 
 enum class Quality { Final, Preview };
@@ -119,7 +119,7 @@ SynthesisResult stylize_frame(const ImageView& style, const GuideFrame& exemplar
 
 // Mean absolute colour change along valid motion between two stylized frames:
 // current(p) against previous(p - V-(p)) over the pixels with visible(p) != 0,
-// all channels (0 if no pixel is visible). The figure of tempera.temporal.flicker.
+// all channels (0 if no pixel is visible). The figure of tempera.engine.temporal.flicker.
 double flicker(const ImageView& previous, const ImageView& current, const ImageView& velocity_backward,
                const ImageView& visible);
 
