@@ -1,11 +1,11 @@
 // `tempera stylize --method fluidymation`: Fluidymation (Platkevič et al.
 // 2021) over a guide cache, frame by frame with resume (fluidymation_job.hpp).
-#include <csignal>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
 
 #include "cli_args.hpp"
+#include "frame_loop.hpp"
 #include "tempera/engine/error.hpp"
 #include "tempera/methods/fluidymation/fluidymation_job.hpp"
 #include "tempera/app/image_io.hpp"
@@ -53,9 +53,6 @@ const char* kHelp =
     "Resume: a frame is skipped when its output, matches and record are current (same settings,\n"
     "files and every frame before it); rerun the same command after an interruption.\n"
     "Exit status: 0 done, 1 error (files), 2 bad usage or bad values, 130 interrupted.\n";
-
-volatile std::sig_atomic_t g_stop = 0;
-void on_signal(int) { g_stop = 1; }
 
 FluidymationJobConfig parse(const Args& args) {
   FluidymationJobConfig c;
@@ -105,30 +102,17 @@ int run_stylize_fluidymation(const Args& args) {
   FluidymationJobConfig config = parse(args);
   FluidymationJob job(config);  // bad inputs: ValueError, exit status 2
   for (const auto& w : job.warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
-  struct sigaction action {};
-  action.sa_handler = on_signal;
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);
-  const std::size_t n = job.frames().size();
-  int stylized = 0;
-  double seconds = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    FluidJobFrame r;
-    try {
-      r = job.run_frame(i, [](double) { return !g_stop; });
-    } catch (const CancelledError&) {
-      std::cerr << "tempera stylize: interrupted; finished frames are kept, rerun the same command to resume\n";
-      return 130;
-    }
-    std::cout << "frame " << i + 1 << "/" << n << " (#" << job.frames()[i] << "): ";
-    if (r.status == "skipped") std::cout << "skipped, already current\n";
-    else std::cout << std::fixed << std::setprecision(2) << r.seconds << " s\n" << std::defaultfloat, ++stylized;
-    seconds += r.seconds;
-  }
+  catch_interrupts();
+  FrameRun frames;
+  frames.count = job.frames().size();
+  frames.run = [&](std::size_t i, const ProgressCallback& progress) { return job.run_frame(i, progress); };
+  std::vector<FrameResult> results;
+  if (!run_frames(frames, results)) return report_interrupted("stylize");
+  const FrameTally t = tally(results);
   const fs::path sheet = fs::path(config.out) / "contact_sheet.png";
   job.write_contact_sheet(sheet.string());
-  std::cout << "tempera stylize: " << stylized << " frame(s) stylized in " << std::fixed << std::setprecision(1)
-            << seconds << " s" << std::defaultfloat << "; flow from " << (job.flow_guide().empty() ? "masks" : job.flow_guide())
+  std::cout << "tempera stylize: " << t.made << " frame(s) stylized in " << std::fixed << std::setprecision(1)
+            << t.seconds << " s" << std::defaultfloat << "; flow from " << (job.flow_guide().empty() ? "masks" : job.flow_guide())
             << "; contact sheet " << sheet.string() << "\n";
   return 0;
 }

@@ -1,11 +1,11 @@
 // `tempera stylize --method lazyfluids`: LazyFluids over a guide cache
 // (lazyfluids_job.hpp), frame by frame with resume, then a contact sheet.
-#include <csignal>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
 
 #include "cli_args.hpp"
+#include "frame_loop.hpp"
 #include "tempera/engine/error.hpp"
 #include "tempera/methods/lazyfluids/lazyfluids_job.hpp"
 
@@ -58,9 +58,6 @@ std::string lazyfluids_help() {
   return text;
 }
 
-volatile std::sig_atomic_t g_interrupted = 0;
-void on_sigint(int) { g_interrupted = 1; }
-
 struct Options {
   LazyFluidsJobConfig job;
   std::string out;
@@ -94,29 +91,19 @@ Options parse(const Args& args) {
   return o;
 }
 
-// Runs every frame with a progress line each; false if interrupted.
+// Every frame, one line each with the source coverage; false if interrupted.
 bool run_frames(LazyFluidsJob& job) {
-  const std::size_t n = job.frames().size();
-  int stylized = 0;
-  double spent = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    FrameResult r;
-    try {
-      r = job.run_frame(i, [](double) { return !g_interrupted; });
-    } catch (const CancelledError&) {
-      return false;
-    }
-    std::cout << "frame " << i + 1 << "/" << n << " (#" << r.frame << "): ";
-    if (r.status == "skipped") {
-      std::cout << "skipped, already current\n";
-      continue;
-    }
-    spent += r.seconds, ++stylized;
-    std::cout << std::fixed << std::setprecision(2) << r.seconds << " s, source coverage " << r.source_coverage
-              << std::defaultfloat << std::endl;
-  }
-  std::cout << "tempera stylize: " << stylized << " frame(s) stylized, " << n - std::size_t(stylized)
-            << " skipped (already current) in " << std::fixed << std::setprecision(1) << spent << " s"
+  FrameRun frames;
+  frames.count = job.frames().size();
+  frames.run = [&](std::size_t i, const ProgressCallback& progress) { return job.run_frame(i, progress); };
+  frames.details = [](std::ostream& out, const FrameResult& r) {
+    if (r.status != "skipped") out << ", source coverage " << r.source_coverage;
+  };
+  std::vector<FrameResult> results;
+  if (!cli::run_frames(frames, results)) return false;
+  const FrameTally t = tally(results);
+  std::cout << "tempera stylize: " << t.made << " frame(s) stylized, " << t.skipped
+            << " skipped (already current) in " << std::fixed << std::setprecision(1) << t.seconds << " s"
             << std::defaultfloat << "\n";
   return true;
 }
@@ -135,16 +122,10 @@ int run_lazyfluids(const Args& args) {
     return 0;
   }
   Options o = parse(args);  // usage errors propagate: exit status 2
-  struct sigaction action {};
-  action.sa_handler = on_sigint;
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);
+  catch_interrupts();
   LazyFluidsJob job(o.job);  // bad files or values: exit status 1 or 2
   for (const auto& w : job.warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
-  if (!run_frames(job)) {
-    std::cerr << "tempera stylize: interrupted; finished frames are kept, rerun the same command to resume\n";
-    return 130;
-  }
+  if (!run_frames(job)) return report_interrupted("stylize");
   const fs::path sheet = fs::path(o.out) / "contact_sheet.png";
   job.write_contact_sheet(sheet.string());
   std::cout << "contact sheet: " << sheet.string() << "\nresults in " << o.out << "\n";

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "cli_args.hpp"
+#include "frame_loop.hpp"
 #include "tempera/engine/error.hpp"
 #include "tempera/methods/noisy/noisy_sequence.hpp"
 
@@ -35,7 +36,8 @@ std::string noisy_help() {
          flags_help<NoisyOptions>(noisy_option_table()) +
          "\nengine options (defaults: patch 7, mode voting, 4 EM x 2 PatchMatch, usage none):\n" +
          flags_help<SynthesisOptions>(synthesis_option_table()) +
-         "\nExit status: 0 done, 1 error, 2 bad usage.\n";
+         "\nCtrl-C stops within the current frame; finished frames are kept.\n"
+         "Exit status: 0 done, 1 error, 2 bad usage, 130 interrupted.\n";
 }
 
 }  // namespace
@@ -71,17 +73,15 @@ int run_noisy(const Args& args) {
   if (frames_text.empty()) throw ValueError("--frames is required (e.g. --frames 1-24)");
   if (c.out.empty()) throw ValueError("--out is required (the output folder)");
   NoisySequence sequence(c);
-  int made = 0, skipped = 0;
-  for (std::size_t i = 0; i < sequence.frames().size(); ++i) {
-    const NoisyFrameResult f = sequence.run_frame(i);
-    if (f.status == "skipped") {
-      ++skipped;
-      continue;
-    }
-    ++made;
-    std::cerr << "tempera noisy: frame " << f.frame << " -> " << f.path << "\n";
-  }
-  std::cout << "tempera noisy: " << made << " frame(s) made, " << skipped << " current\n";
+  catch_interrupts();
+  FrameRun frames;
+  frames.count = sequence.frames().size();
+  frames.run = [&](std::size_t i, const ProgressCallback& progress) { return sequence.run_frame(i, progress); };
+  std::vector<FrameResult> results;
+  if (!run_frames(frames, results)) return report_interrupted("noisy");
+  const FrameTally t = tally(results);
+  std::cout << "tempera noisy: " << t.made << " frame(s) made, " << t.skipped << " current; results in " << c.out
+            << "\n";
   return 0;
 }
 

@@ -11,6 +11,7 @@
 #include <iostream>
 
 #include "cli_args.hpp"
+#include "frame_loop.hpp"
 #include "tempera/engine/error.hpp"
 #include "tempera/app/paths.hpp"
 #include "tempera/app/process.hpp"
@@ -48,8 +49,6 @@ const char* kRenderGuidesHelp =
     "  --addon-path DIR        folder holding the tempera package\n"
     "                          (default: $TEMPERA_ADDON_PATH or this build's addon folder)\n";
 
-volatile std::sig_atomic_t g_interrupted = 0;
-void on_sigint(int) { g_interrupted = 1; }
 
 std::string env_or(const char* name, const std::string& fallback) {
   const char* value = std::getenv(name);
@@ -98,7 +97,7 @@ int render_guides_in_blender(const BlenderSetup& setup, const std::string& scene
       std::cerr << "tempera: cannot run '" << setup.blender << "' (install Blender or pass --blender PATH)\n";
       return 1;
     default:
-      if (*interrupted) return 130;  // Ctrl-C: Blender's own exit status says nothing more
+      if (*interrupted) return kInterruptedStatus;  // Ctrl-C: Blender's own exit status says nothing more
       std::cerr << "tempera: Blender ('" << setup.blender << "') exited with status " << status
                 << " while rendering the guides of '" << scene << "'"
                 << (status > 128 ? " (killed by a signal)" : "") << "\n";
@@ -134,15 +133,12 @@ int run_render_guides(const Args& args) {
   // Ctrl-C reaches Blender too (same process group), a farm's SIGTERM only
   // this process, which then stops Blender; either way it waits for Blender
   // to stop and says what is kept, instead of dying silently first.
-  struct sigaction action {};
-  action.sa_handler = on_sigint;
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);
-  const int status = render_guides_in_blender(setup, scene, forwarded, &g_interrupted);
-  if (g_interrupted) {
+  catch_interrupts();
+  const int status = render_guides_in_blender(setup, scene, forwarded, interrupt_flag());
+  if (interrupted()) {
     std::cerr << "tempera render-guides: interrupted; the frames finished so far are in the cache "
                  "(rerun the same command to render the rest)\n";
-    return 130;
+    return kInterruptedStatus;
   }
   return status;
 }

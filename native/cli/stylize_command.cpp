@@ -3,16 +3,15 @@
 // as a render farm does), runs the StylizeJob frame by frame with resume, and
 // writes a contact sheet and a video.
 #include <chrono>
-#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <optional>
-#include <sstream>
 
 #include "cli_args.hpp"
+#include "frame_loop.hpp"
 #include "tempera/engine/error.hpp"
 #include "tempera/app/image_io.hpp"
 #include "tempera/methods/noisy/noisy_sequence.hpp"
@@ -136,10 +135,6 @@ std::string stylize_help() {
                    flags_help<TciaOrientationOptions>(tcia_orientation_option_table()));
   return text;
 }
-
-volatile std::sig_atomic_t g_interrupted = 0;
-
-void on_sigint(int) { g_interrupted = 1; }
 
 NoisyOptions no_noise() {
   NoisyOptions o = default_noisy_options();
@@ -300,17 +295,10 @@ void render_guides(const Options& o, const std::string& scene, const std::string
   if (!o.samples.empty()) options.insert(options.end(), {"--samples", o.samples, "--ld12e-samples", o.samples});
   std::cerr << "tempera stylize: rendering the guides of " << scene << " (frames " << frames << ") into " << out
             << "\n";
-  const int status = render_guides_in_blender(o.blender, scene, options, &g_interrupted);
-  if (g_interrupted) throw CancelledError("interrupted while rendering guides");
+  const int status = render_guides_in_blender(o.blender, scene, options, interrupt_flag());
+  if (interrupted()) throw CancelledError("interrupted while rendering guides");
   if (status == 2) throw ValueError(concat("rendering the guides of '", scene, "' failed: bad values (see above)"));
   if (status != 0) throw IoError(concat("rendering the guides of '", scene, "' failed (see above)"));
-}
-
-std::string clock_text(double seconds) {
-  const long s = std::lround(seconds);
-  std::ostringstream out;
-  out << s / 60 << ":" << std::setw(2) << std::setfill('0') << s % 60;
-  return out.str();
 }
 
 bool consecutive(const std::vector<int>& frames) {
@@ -319,43 +307,26 @@ bool consecutive(const std::vector<int>& frames) {
   return true;
 }
 
-// Runs every frame with a progress line each; returns false if interrupted.
+// StyLit's frames, one line each with the flicker figure and an ETA; false if interrupted.
 bool run_frames(StylizeJob& job, std::vector<FrameResult>& results) {
-  const std::size_t n = job.frames().size();
-  double spent = 0;
-  int stylized = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    try {
-      results.push_back(job.run_frame(i, [](double) { return !g_interrupted; }));
-    } catch (const CancelledError&) {
-      return false;
-    }
-    const FrameResult& r = results.back();
-    std::cout << "frame " << i + 1 << "/" << n << " (#" << r.frame << "): ";
-    if (r.status == "skipped") {
-      std::cout << "skipped, already current";
-    } else {
-      spent += r.seconds;
-      ++stylized;
-      std::cout << std::fixed << std::setprecision(2) << r.seconds << " s";
-    }
-    if (std::isfinite(r.flicker)) std::cout << ", flicker " << std::fixed << std::setprecision(4) << r.flicker;
-    if (stylized > 0 && i + 1 < n) std::cout << ", ETA " << clock_text(spent / stylized * double(n - i - 1));
-    std::cout << std::defaultfloat << std::endl;
-  }
-  return true;
+  FrameRun frames;
+  frames.count = job.frames().size();
+  frames.run = [&](std::size_t i, const ProgressCallback& progress) { return job.run_frame(i, progress); };
+  frames.details = [](std::ostream& out, const FrameResult& r) {
+    if (std::isfinite(r.flicker)) out << ", flicker " << std::fixed << std::setprecision(4) << r.flicker;
+  };
+  frames.eta = true;
+  return cli::run_frames(frames, results);
 }
 
 void print_summary(const std::vector<FrameResult>& results, const std::string& out) {
-  int stylized = 0, skipped = 0, counted = 0;
-  double seconds = 0, flicker_sum = 0;
-  for (const auto& r : results) {
-    (r.status == "skipped" ? skipped : stylized)++;
-    seconds += r.seconds;
+  const FrameTally t = tally(results);
+  int counted = 0;
+  double flicker_sum = 0;
+  for (const auto& r : results)
     if (std::isfinite(r.flicker)) flicker_sum += r.flicker, ++counted;
-  }
-  std::cout << "tempera stylize: " << stylized << " frame(s) stylized, " << skipped
-            << " skipped (already current) in " << std::fixed << std::setprecision(1) << seconds << " s";
+  std::cout << "tempera stylize: " << t.made << " frame(s) stylized, " << t.skipped
+            << " skipped (already current) in " << std::fixed << std::setprecision(1) << t.seconds << " s";
   if (counted) std::cout << "; mean flicker " << std::setprecision(4) << flicker_sum / counted;
   std::cout << std::defaultfloat << "; results in " << out << "\n";
 }
@@ -378,10 +349,10 @@ void write_extras(const StylizeJob& job, const Options& o) {
     std::cout << "no video: ffmpeg is not on PATH\n";
 }
 
-int interrupted(const std::vector<FrameResult>& results) {
+int interrupted_frames(const std::vector<FrameResult>& results) {
   std::cerr << "tempera stylize: interrupted after " << results.size()
             << " frame(s); they are kept, rerun the same command to resume\n";
-  return 130;
+  return kInterruptedStatus;
 }
 
 // The noise pass: the coherent frames (OUT/frames, or --noise-reference)
@@ -402,18 +373,12 @@ bool run_noise_pass(const Options& o) {
   c.options.synthesis.threads = o.stylit.synthesis.threads;
   c.resume = o.resume;
   NoisySequence sequence(c);
-  const std::size_t n = sequence.frames().size();
-  for (std::size_t i = 0; i < n; ++i) {
-    NoisyFrameResult r;
-    try {
-      r = sequence.run_frame(i, [](double) { return !g_interrupted; });
-    } catch (const CancelledError&) {
-      return false;
-    }
-    std::cout << "noisy frame " << i + 1 << "/" << n << " (#" << r.frame << "): ";
-    if (r.status == "skipped") std::cout << "skipped, already current\n";
-    else std::cout << std::fixed << std::setprecision(2) << r.seconds << " s" << std::defaultfloat << std::endl;
-  }
+  FrameRun frames;
+  frames.label = "noisy frame";
+  frames.count = sequence.frames().size();
+  frames.run = [&](std::size_t i, const ProgressCallback& progress) { return sequence.run_frame(i, progress); };
+  std::vector<FrameResult> results;
+  if (!cli::run_frames(frames, results)) return false;
   std::cout << "noisy frames: " << c.out << "\n";
   if (o.video && consecutive(o.frames)) {
     const fs::path video = fs::path(o.out) / "noisy.mp4";
@@ -434,7 +399,7 @@ bool report_sweep(const SweepProgress& p, std::size_t index, std::size_t count, 
               << std::lround(100 * p.fraction) << "%, ETA " << clock_text(spent / p.fraction * (1 - p.fraction))
               << std::endl;
   }
-  return !g_interrupted;
+  return !interrupted();
 }
 
 // The coherent method's segments (all, or the one of --segment); false if interrupted.
@@ -442,7 +407,7 @@ bool run_segments(TciaJob& job, const Options& o) {
   int stylized = 0, skipped = 0;
   double seconds = 0;
   for (std::size_t i : job.selected()) {
-    if (g_interrupted) return false;
+    if (interrupted()) return false;
     const TciaSegment& s = job.segments()[i];
     const auto start = std::chrono::steady_clock::now();
     SegmentResult r;
@@ -464,11 +429,6 @@ bool run_segments(TciaJob& job, const Options& o) {
   return true;
 }
 
-int interrupted_segments() {
-  std::cerr << "tempera stylize: interrupted; finished segments are kept, rerun the same command to resume\n";
-  return 130;
-}
-
 }  // namespace
 
 int run_stylize(const Args& args) {
@@ -481,10 +441,7 @@ int run_stylize(const Args& args) {
     return args.empty() ? 2 : 0;
   }
   Options o = parse(args);  // usage errors propagate: exit status 2
-  struct sigaction action {};
-  action.sa_handler = on_sigint;
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);  // a farm's or the panel's cancel
+  catch_interrupts();
   std::vector<FrameResult> results;
   try {
     const bool guide_map = !o.noise_map.empty() && !fs::is_regular_file(o.noise_map);
@@ -495,7 +452,7 @@ int run_stylize(const Args& args) {
       render_guides(o, o.exemplar_scene, std::to_string(*o.exemplar_frame), o.exemplar_guides);
     }
     if (!o.noise_reference.empty()) {  // boil the given coherent frames
-      if (!run_noise_pass(o)) return interrupted(results);
+      if (!run_noise_pass(o)) return interrupted_frames(results);
       return 0;
     }
     StylizeJobConfig config;
@@ -512,19 +469,19 @@ int run_stylize(const Args& args) {
       TciaJob job({config, o.keys, o.tcia, o.lines, o.layers, o.layer_order.value_or("depth"), o.segment,
                    o.orientation});
       for (const auto& w : job.warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
-      if (!run_segments(job, o)) return interrupted_segments();
+      if (!run_segments(job, o)) return report_interrupted("stylize", "segment");
       if (!o.segment) write_extras(job.frames_job(), o);  // a segment is a farm task: the finish writes them
-      if (o.noisy.noise > 0 && !run_noise_pass(o)) return interrupted_segments();
+      if (o.noisy.noise > 0 && !run_noise_pass(o)) return report_interrupted("stylize", "segment");
       return 0;
     }
     StylizeJob job(config);
     for (const auto& w : job.warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
-    if (!run_frames(job, results)) return interrupted(results);
+    if (!run_frames(job, results)) return interrupted_frames(results);
     write_extras(job, o);
     print_summary(results, o.out);
-    if (o.noisy.noise > 0 && !run_noise_pass(o)) return interrupted(results);
+    if (o.noisy.noise > 0 && !run_noise_pass(o)) return interrupted_frames(results);
   } catch (const CancelledError&) {
-    return interrupted(results);
+    return interrupted_frames(results);
   }  // ValueError (bad values in the files or options) reaches main(): exit status 2
   return 0;
 }

@@ -46,7 +46,7 @@ void bind_sequence(py::module_& m) {
           "run_frame",
           [](NoisySequence& s, std::size_t index, const std::function<bool(double)>& progress) {
             ProgressCallback callback = py_bridge::with_gil([&](double f) { return progress ? progress(f) : true; });
-            NoisyFrameResult r;
+            FrameResult r;
             {
               py::gil_scoped_release release;
               r = s.run_frame(index, callback);

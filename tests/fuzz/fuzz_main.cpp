@@ -25,7 +25,7 @@
 #include <string>
 #include <vector>
 
-#include "../../native/cli/cli_args.hpp"
+#include "cli_args.hpp"
 #include "tempera/engine/error.hpp"
 #include "tempera/app/image_io.hpp"
 #include "tempera/tracer/lpe.hpp"

@@ -1,4 +1,5 @@
 """`tempera noisy`: Color Me Noisy over a folder of frames, resumable."""
+import signal
 import subprocess
 
 import numpy as np
@@ -38,6 +39,37 @@ def test_frames_are_made_then_current(cli_path, inputs):
     third = run(cli_path, *args)
     assert "1 frame(s) made, 2 current" in third.stdout
     np.testing.assert_array_equal(tempera.read_image(str(inputs / "out" / "frame_0002.png")), frames[1])
+
+
+def test_sigterm_keeps_finished_frames_and_the_rerun_equals_an_uninterrupted_run(cli_path, tmp_path):
+    """A farm's cancel: exit 130 after the frame under way is dropped (nothing
+    of it written), finished frames kept; the rerun makes the rest, the same
+    as a run that was never stopped."""
+    rng = np.random.default_rng(5)
+    medium = rng.random((96, 96, 3)).astype(np.float32)
+    tempera.write_image(str(tmp_path / "medium.png"), medium)
+    (tmp_path / "R").mkdir()
+    for f in range(1, 5):  # frames big enough that the signal lands mid-run
+        tempera.write_image(str(tmp_path / "R" / f"frame_{f:04d}.png"), rng.random((192, 256, 3)).astype(np.float32))
+    args = ["--exemplar", tmp_path / "medium.png", "--reference", tmp_path / "R", "--frames", "1-4",
+            "--noise", "2.2", "--threads", "1"]
+    process = subprocess.Popen([str(cli_path), "noisy", *map(str, args), "--out", str(tmp_path / "out")],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    first = process.stdout.readline()
+    process.send_signal(signal.SIGTERM)
+    _, stderr = process.communicate(timeout=300)
+    assert first.startswith("frame 1/4 (#1): ")
+    assert process.returncode == 130, stderr
+    assert "rerun the same command to resume" in stderr
+    out = tmp_path / "out"
+    assert (out / "frame_0001.png").is_file() and not (out / "frame_0004.png").exists()
+    assert [f.name for f in out.iterdir() if f.name.startswith(".") and f.is_file()] == []
+    resumed = run(cli_path, *args, "--out", out)
+    whole = run(cli_path, *args, "--out", tmp_path / "whole")
+    assert resumed.returncode == 0 and whole.returncode == 0, resumed.stderr + whole.stderr
+    for f in range(1, 5):
+        np.testing.assert_array_equal(tempera.read_image(str(out / f"frame_{f:04d}.png")),
+                                      tempera.read_image(str(tmp_path / "whole" / f"frame_{f:04d}.png")))
 
 
 def test_errors_name_the_problem(cli_path, inputs):

@@ -9,6 +9,7 @@
 #include "tempera/app/contact_sheet.hpp"
 #include "tempera/engine/error.hpp"
 #include "tempera/app/file_keys.hpp"
+#include "tempera/app/guide_cache.hpp"
 #include "tempera/app/image_io.hpp"
 #include "tempera/app/paths.hpp"
 #include "tempera/app/text_file.hpp"
@@ -41,10 +42,6 @@ std::vector<std::string> image_files(const std::string& folder, const char* what
 }
 
 Image channel(const Image& image, int c) { return extract_channels(image.view(), c, 1); }
-
-std::string guide_frame(const std::string& folder, int frame) {
-  return (fs::path(folder) / frame_file("frame_", frame, "exr")).string();
-}
 
 bool has_layer(const ImageFileInfo& info, const std::string& layer) {
   return std::any_of(info.channel_names.begin(), info.channel_names.end(),
@@ -120,7 +117,7 @@ FluidymationJob::FluidymationJob(FluidymationJobConfig c) : config_(std::move(c)
   std::vector<std::string> inputs = files;
   inputs.insert(inputs.end(), mask_files.begin(), mask_files.end());
   for (int f : config_.frames) {
-    const std::string path = guide_frame(config_.guides, f);
+    const std::string path = guide_cache_frame(config_.guides, f);
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) throw FileNotFoundError(concat("guide cache frame not found: '", path, "'"));
     const ImageFileInfo info = inspect_image(path);
@@ -185,11 +182,15 @@ void FluidymationJob::write_frame(std::size_t index, const FluidFrame& r) {
   write_text_atomically(record_path(f), concat(kRecordFormat, "\n", keys_[index], "\n"), "Fluidymation frame record");
 }
 
-FluidJobFrame FluidymationJob::run_frame(std::size_t index, const ProgressCallback& progress) {
+FrameResult FluidymationJob::run_frame(std::size_t index, const ProgressCallback& progress) {
   if (index >= config_.frames.size())
     throw ValueError(concat("frame index ", index, " is outside the job's ", config_.frames.size(), " frames"));
   const auto t0 = std::chrono::steady_clock::now();
-  if (is_current(index)) return {"skipped", 0.0};
+  FrameResult result;
+  result.frame = config_.frames[index];
+  result.path = output_path(result.frame);
+  result.status = "skipped";
+  if (is_current(index)) return result;
   if (config_.options.bidirectional) {
     if (both_ways_.empty()) {
       FluidSequence seq;
@@ -219,7 +220,9 @@ FluidJobFrame FluidymationJob::run_frame(std::size_t index, const ProgressCallba
     last_nnf_ = std::move(r.nnf);
     last_index_ = index;
   }
-  return {"stylized", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()};
+  result.status = "stylized";
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return result;
 }
 
 void FluidymationJob::write_contact_sheet(const std::string& path, int columns) const {

@@ -9,6 +9,7 @@
 #include "tempera/app/contact_sheet.hpp"
 #include "tempera/engine/error.hpp"
 #include "tempera/app/file_keys.hpp"
+#include "tempera/app/guide_cache.hpp"
 #include "tempera/app/image_io.hpp"
 #include "tempera/app/paths.hpp"
 #include "tempera/app/text_file.hpp"
@@ -138,7 +139,7 @@ LazyFluidsJob::LazyFluidsJob(LazyFluidsJobConfig config) : config_(std::move(con
 }
 
 std::string LazyFluidsJob::guide_path(int frame) const {
-  return (fs::path(config_.guides) / frame_file("frame_", frame, "exr")).string();
+  return guide_cache_frame(config_.guides, frame);
 }
 
 std::string LazyFluidsJob::output_path(int frame) const {
@@ -204,7 +205,6 @@ FrameResult LazyFluidsJob::run_frame(std::size_t index, const ProgressCallback& 
   FrameResult result;
   result.frame = f;
   result.path = output_path(f);
-  result.flicker = std::numeric_limits<double>::quiet_NaN();
   if (index > 0 && !is_current(index - 1))
     throw ValueError(concat("frame ", f, " continues frame ", f - 1, ", which is not done yet: run it first"));
   if (config_.resume && is_current(index)) {

@@ -7,9 +7,9 @@
 
 #include "tempera/engine/error.hpp"
 #include "tempera/app/file_keys.hpp"
+#include "tempera/app/guide_cache.hpp"
 #include "tempera/app/image_io.hpp"
 #include "tempera/methods/stylit/stylit.hpp"
-#include "tempera/methods/stylit/stylize_job.hpp"
 #include "tempera/app/text_file.hpp"
 
 namespace fs = std::filesystem;
@@ -80,8 +80,7 @@ void NoisySequence::read_exemplar_guides() {
   std::vector<std::string> names;
   for (const auto& [name, weight] : light_path_) names.push_back(name);
   const std::string path =
-      (fs::path(c.exemplar_guides) / frame_file("frame_", exemplar_guide_frame(c.exemplar_guides, c.exemplar_frame), "exr"))
-          .string();
+      guide_cache_frame(c.exemplar_guides, exemplar_guide_frame(c.exemplar_guides, c.exemplar_frame));
   const GuideFrame exemplar = GuideFrame::read(path, names);
   for (const auto& [name, weight] : light_path_) {
     const Image& g = exemplar.get(name);
@@ -109,7 +108,7 @@ std::string NoisySequence::reference_path(int frame) const {
 }
 
 std::string NoisySequence::guide_path(int frame) const {
-  return (fs::path(config_.guides) / frame_file("frame_", frame, "exr")).string();
+  return guide_cache_frame(config_.guides, frame);
 }
 
 std::string NoisySequence::output_path(int frame) const {
@@ -129,11 +128,14 @@ std::string NoisySequence::key(int frame) const {
   return hash_hex(text);
 }
 
-NoisyFrameResult NoisySequence::run_frame(std::size_t index, const ProgressCallback& progress) {
+FrameResult NoisySequence::run_frame(std::size_t index, const ProgressCallback& progress) {
   if (index >= config_.frames.size())
     throw ValueError(concat("frame index ", index, " out of range (", config_.frames.size(), " frames)"));
   const int frame = config_.frames[index];
-  NoisyFrameResult result{frame, output_path(frame), "skipped", 0};
+  FrameResult result;
+  result.frame = frame;
+  result.path = output_path(frame);
+  result.status = "skipped";
   const fs::path key_file = key_path(config_.out, frame);
   const std::string k = key(frame);
   if (config_.resume && fs::is_regular_file(result.path) && fs::is_regular_file(key_file) && read_text(key_file) == k)

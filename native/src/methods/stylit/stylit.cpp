@@ -17,18 +17,6 @@ bool is_light_path_guide(const std::string& name) {
   return std::any_of(known.begin(), known.end(), [&](const LightPathGuide& g) { return name == g.name; });
 }
 
-std::string joined(const std::vector<std::string>& names) {
-  std::string out;
-  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
-  return out;
-}
-
-// The guide a channel name belongs to: "FULL.R" -> "FULL", "mask.OB_a.V" -> "mask.OB_a".
-std::string guide_of_channel(const std::string& channel) {
-  const std::size_t dot = channel.rfind('.');
-  return dot == std::string::npos ? channel : channel.substr(0, dot);
-}
-
 double srgb_encode(double x) {
   x = std::clamp(x, 0.0, 1.0);
   return x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055;
@@ -61,44 +49,6 @@ void parse_guide_weights(const std::string& text, std::vector<std::pair<std::str
     it->second = parse_number<float>(item.substr(eq + 1), concat("--weights '", item, "'"));
     start = end + 1;
   }
-}
-
-const Image& GuideFrame::get(const std::string& name) const {
-  auto it = guides.find(name);
-  if (it == guides.end()) {
-    std::vector<std::string> have;
-    for (const auto& [n, image] : guides) have.push_back(n);
-    throw ValueError(concat("guide '", name, "' missing from '", origin, "' (it has: ", joined(have), ")"));
-  }
-  return it->second;
-}
-
-GuideFrame GuideFrame::read(const std::string& path, const std::vector<std::string>& names) {
-  const ImageFileInfo info = inspect_image(path);
-  std::vector<std::string> channels;
-  std::vector<int> counts;
-  for (const auto& name : names) {
-    int count = 0;
-    for (const auto& channel : info.channel_names)
-      if (guide_of_channel(channel) == name) channels.push_back(channel), ++count;
-    if (count == 0) {
-      std::vector<std::string> have;
-      for (const auto& channel : info.channel_names)
-        if (std::find(have.begin(), have.end(), guide_of_channel(channel)) == have.end())
-          have.push_back(guide_of_channel(channel));
-      throw ValueError(concat("guide '", name, "' missing from '", path, "' (it has: ", joined(have), ")"));
-    }
-    counts.push_back(count);
-  }
-  GuideFrame frame;
-  frame.origin = path;
-  if (names.empty()) return frame;
-  // One read of the file, then split: cache frames hold dozens of channels.
-  const Image all = read_image(path, channels);
-  int first = 0;
-  for (std::size_t i = 0; i < names.size(); first += counts[i++])
-    frame.guides[names[i]] = extract_channels(all.view(), first, counts[i]);
-  return frame;
 }
 
 Image tonemap_guide(const ImageView& linear) {

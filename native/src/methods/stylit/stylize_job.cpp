@@ -5,7 +5,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cctype>
 #include <charconv>
 #include <cerrno>
 #include <chrono>
@@ -41,28 +40,6 @@ void require_file(const std::string& path, const std::string& what) {
 void require_folder(const std::string& path, const std::string& what) {
   std::error_code ec;
   if (!fs::is_directory(path, ec)) throw FileNotFoundError(concat(what, " folder not found: '", path, "'"));
-}
-
-// The frame numbers of the frame_####.exr files in a guide cache folder.
-std::vector<int> cached_frames(const std::string& folder) {
-  std::vector<int> frames;
-  for (const auto& entry : fs::directory_iterator(folder)) {
-    const std::string name = entry.path().filename().string();
-    if (name.size() <= 10 || name.rfind("frame_", 0) != 0 || entry.path().extension() != ".exr") continue;
-    const std::string digits = name.substr(6, name.size() - 10);
-    if (digits.empty() || !std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c); }))
-      continue;
-    int frame = 0;
-    const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), frame);
-    // A number no frame can have (beyond Blender's last frame) is not a cache frame.
-    if (ec == std::errc() && end == digits.data() + digits.size() && frame <= kMaxFrame) frames.push_back(frame);
-  }
-  std::sort(frames.begin(), frames.end());
-  return frames;
-}
-
-std::string guide_cache_frame(const std::string& folder, int frame) {
-  return (fs::path(folder) / frame_file("frame_", frame, "exr")).string();
 }
 
 // Canonical text of everything that changes a stylized frame but the files.
@@ -271,20 +248,6 @@ Image fit_painting(Image painting, const std::string& path, int width, int heigh
 }
 
 }  // namespace
-
-int exemplar_guide_frame(const std::string& folder, std::optional<int> frame) {
-  if (frame) return *frame;
-  const std::vector<int> found = cached_frames(folder);
-  if (found.empty())
-    throw FileNotFoundError(concat("no frame_####.exr in the exemplar guide folder '", folder, "'"));
-  if (found.size() > 1) {
-    std::string list;
-    for (int f : found) list += concat(list.empty() ? "" : ", ", f);
-    throw ValueError(concat("the exemplar guide folder '", folder, "' holds ", found.size(),
-                            " frames (", list, "); choose one with Exemplar Frame (--exemplar-frame)"));
-  }
-  return found.front();
-}
 
 StylizeJob::StylizeJob(StylizeJobConfig config) : config_(std::move(config)) {
   validate_config(config_);

@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "tempera/app/frame_result.hpp"
 #include "tempera/methods/fluidymation/fluidymation.hpp"
 
 namespace tempera {
@@ -48,11 +49,6 @@ struct FluidymationJobConfig {
   FluidymationOptions options = default_fluidymation_options();
 };
 
-struct FluidJobFrame {
-  std::string status;  // "stylized" | "skipped"
-  double seconds = 0;
-};
-
 class FluidymationJob {
  public:
   // Reads and checks every input (FileNotFoundError, ValueError).
@@ -69,7 +65,7 @@ class FluidymationJob {
   // Stylizes frames()[index] (solving earlier frames first when their
   // matches are not on disk), or skips it when current. progress(fraction)
   // returning false cancels: CancelledError, nothing of the frame written.
-  FluidJobFrame run_frame(std::size_t index, const ProgressCallback& progress = {});
+  FrameResult run_frame(std::size_t index, const ProgressCallback& progress = {});
 
   // The first exemplar frame followed by the frames written so far.
   void write_contact_sheet(const std::string& path, int columns = 0) const;

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "tempera/methods/lazyfluids/lazyfluids.hpp"
-#include "tempera/methods/stylit/stylize_job.hpp"  // FrameResult
+#include "tempera/app/frame_result.hpp"
 
 namespace tempera {
 

@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "tempera/app/frame_result.hpp"
 #include "tempera/engine/image.hpp"
 #include "tempera/methods/noisy/noisy.hpp"
 #include "tempera/methods/stylit/stylit.hpp"
@@ -37,13 +38,6 @@ struct NoisySequenceConfig {
   bool resume = true;
 };
 
-struct NoisyFrameResult {
-  int frame = 0;
-  std::string path;
-  std::string status;  // "made" | "skipped"
-  double seconds = 0;
-};
-
 class NoisySequence {
  public:
   // Validates up front: options, folders, the exemplar, every reference
@@ -53,7 +47,7 @@ class NoisySequence {
   std::string output_path(int frame) const;
   // Makes frames()[index] (or skips it when its output is current).
   // `progress` returning false cancels: CancelledError, nothing written.
-  NoisyFrameResult run_frame(std::size_t index, const ProgressCallback& progress = {});
+  FrameResult run_frame(std::size_t index, const ProgressCallback& progress = {});
 
  private:
   std::string reference_path(int frame) const;

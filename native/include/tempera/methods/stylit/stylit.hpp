@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "tempera/app/guide_cache.hpp"
 #include "tempera/engine/image.hpp"
 #include "tempera/engine/synthesis.hpp"
 
@@ -45,20 +46,6 @@ inline const std::vector<LightPathGuide>& light_path_guides() {
   };
   return table;
 }
-
-// Guides of one frame by name ("FULL" -> H x W x 3, "velocity_backward" -> H x W x 2, ...).
-struct GuideFrame {
-  std::map<std::string, Image> guides;
-  std::string origin = "memory";  // the file they came from, for error messages
-
-  // ValueError naming the guide and `origin` when it is missing.
-  const Image& get(const std::string& name) const;
-
-  // Reads the channels "<name>.<component>" of each guide from a guide cache
-  // EXR in one pass. A guide absent from the file -> ValueError naming the
-  // guide and the file; a missing file -> FileNotFoundError.
-  static GuideFrame read(const std::string& path, const std::vector<std::string>& names);
-};
 
 // Linear radiance -> guide values in [0, 1): NaN and negatives to 0, +inf to
 // 1e6, Reinhard x / (1 + x), then the sRGB encoding. The same numbers as

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "tempera/app/frame_result.hpp"
+#include "tempera/app/guide_cache.hpp"
 #include "tempera/engine/image.hpp"
 #include "tempera/methods/stylit/stylit.hpp"
 
@@ -25,19 +27,6 @@ struct StylizeJobConfig {
   std::string prefix = "frame_";      // OUT/<prefix>0001.<format>
   StylitOptions stylit;
   bool resume = true;
-};
-
-// The exemplar's guide cache frame: `frame` if given, else the folder's only
-// frame_*.exr (FileNotFoundError if none, ValueError if several).
-int exemplar_guide_frame(const std::string& folder, std::optional<int> frame);
-
-struct FrameResult {
-  int frame = 0;
-  std::string path;
-  std::string status;     // "stylized" | "skipped"
-  double seconds = 0;
-  double flicker = 0;     // NaN without a previous frame (or without motion guides)
-  double source_coverage = 0;
 };
 
 class StylizeJob {

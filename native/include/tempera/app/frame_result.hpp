@@ -1,0 +1,20 @@
+#pragma once
+// The one result of a job's unit of work for one frame: StyLit's frames,
+// the noise pass, LazyFluids and Fluidymation.
+#include <limits>
+#include <string>
+
+namespace tempera {
+
+struct FrameResult {
+  int frame = 0;
+  std::string path;       // the output file
+  std::string status;     // "stylized" (the noise pass: "made") | "skipped" (already current)
+  double seconds = 0;
+  // StyLit's flicker against the previous frame; NaN where it is not
+  // measured (no previous frame, no motion guides, another method).
+  double flicker = std::numeric_limits<double>::quiet_NaN();
+  double source_coverage = 0;  // fraction of exemplar patches used, where the method reports it
+};
+
+}  // namespace tempera
