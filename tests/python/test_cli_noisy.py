@@ -39,6 +39,11 @@ def test_frames_are_made_then_current(cli_path, inputs):
     third = run(cli_path, *args)
     assert "1 frame(s) made, 2 current" in third.stdout
     np.testing.assert_array_equal(tempera.read_image(str(inputs / "out" / "frame_0002.png")), frames[1])
+    # A frame changed after it was written (overwritten, damaged) is not current: its record holds its digest.
+    tempera.write_image(str(inputs / "out" / "frame_0003.png"), np.zeros((40, 48, 3), np.float32))
+    fourth = run(cli_path, *args)
+    assert "1 frame(s) made, 2 current" in fourth.stdout, fourth.stdout
+    np.testing.assert_array_equal(tempera.read_image(str(inputs / "out" / "frame_0003.png")), frames[2])
 
 
 def test_sigterm_keeps_finished_frames_and_the_rerun_equals_an_uninterrupted_run(cli_path, tmp_path):

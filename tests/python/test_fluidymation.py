@@ -115,6 +115,11 @@ def test_media_job_resumes_to_the_uninterrupted_result(tmp_path):
         a, b = read_image(whole.output_path(f)), read_image(again.output_path(f))
         assert np.array_equal(a, b), f
         assert np.allclose(a[..., 3], disc(7 + 1.5 * (f - 1)), atol=1 / 255)
+    # An output changed after it was written is made again, the same as before.
+    tempera.write_image(again.output_path(4), np.zeros((SIZE, SIZE, 4), np.float32))
+    fresh = fluidymation.MediaJob(exemplar, cache, [1, 2, 3, 4], tmp_path / "part", **FAST)
+    assert [fresh.run_frame(i)["status"] for i in range(4)] == ["skipped"] * 3 + ["stylized"]
+    assert np.array_equal(read_image(fresh.output_path(4)), read_image(whole.output_path(4)))
     whole.write_contact_sheet(tmp_path / "sheet.png")
     assert (tmp_path / "sheet.png").is_file()
 

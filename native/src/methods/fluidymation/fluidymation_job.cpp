@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 
 #include "tempera/app/contact_sheet.hpp"
@@ -12,7 +11,7 @@
 #include "tempera/app/guide_cache.hpp"
 #include "tempera/app/image_io.hpp"
 #include "tempera/app/paths.hpp"
-#include "tempera/app/text_file.hpp"
+#include "tempera/app/record.hpp"
 
 namespace fs = std::filesystem;
 
@@ -21,7 +20,9 @@ namespace {
 
 // 2: frames made since flows from masks keep a symmetric window at the shot's ends and
 // fractional exemplar times vote blended (earlier records are recomputed once).
-constexpr const char* kRecordFormat = "tempera-fluidymation-frame 2";
+// 3: the record holds the digests of the frame and its matches (app/record.hpp), so a
+// changed or damaged output is made again.
+constexpr const char* kRecordFormat = "tempera-fluidymation-frame 3";
 
 bool is_image_file(const fs::path& p) {
   std::string ext = p.extension().string();
@@ -46,13 +47,6 @@ Image channel(const Image& image, int c) { return extract_channels(image.view(),
 bool has_layer(const ImageFileInfo& info, const std::string& layer) {
   return std::any_of(info.channel_names.begin(), info.channel_names.end(),
                      [&](const std::string& n) { return n == layer || n.rfind(layer + ".", 0) == 0; });
-}
-
-std::string read_record(const std::string& path) {
-  std::ifstream in(path);
-  std::string format, key;
-  if (!std::getline(in, format) || format != kRecordFormat || !std::getline(in, key)) return "";
-  return key;
 }
 
 }  // namespace
@@ -152,9 +146,7 @@ std::string FluidymationJob::record_path(int frame) const {
 
 bool FluidymationJob::is_current(std::size_t index) const {
   const int f = config_.frames[index];
-  std::error_code ec;
-  return config_.resume && fs::is_regular_file(output_path(f), ec) && fs::is_regular_file(state_path(f), ec) &&
-         read_record(record_path(f)) == keys_[index];
+  return config_.resume && record_current(record_path(f), kRecordFormat, keys_[index], {output_path(f), state_path(f)});
 }
 
 const Fluidymation& FluidymationJob::method() {
@@ -179,7 +171,7 @@ void FluidymationJob::write_frame(std::size_t index, const FluidFrame& r) {
   }
   write_image(output_path(f), rgba.view(), {"R", "G", "B", "A"});
   write_image(state_path(f), r.nnf.view(), {"i", "x", "y", "phi"});
-  write_text_atomically(record_path(f), concat(kRecordFormat, "\n", keys_[index], "\n"), "Fluidymation frame record");
+  write_record(record_path(f), kRecordFormat, keys_[index], {output_path(f), state_path(f)});
 }
 
 FrameResult FluidymationJob::run_frame(std::size_t index, const ProgressCallback& progress) {

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 
 #include "tempera/app/contact_sheet.hpp"
@@ -12,14 +11,15 @@
 #include "tempera/app/guide_cache.hpp"
 #include "tempera/app/image_io.hpp"
 #include "tempera/app/paths.hpp"
-#include "tempera/app/text_file.hpp"
+#include "tempera/app/record.hpp"
 
 namespace fs = std::filesystem;
 
 namespace tempera {
 namespace {
 
-constexpr const char* kRecordFormat = "tempera-lazyfluids-frame 1";
+// 2: the record names its files (app/record.hpp); records of 1 are made again once.
+constexpr const char* kRecordFormat = "tempera-lazyfluids-frame 2";
 constexpr const char* kStateFolder = "tempera_lazyfluids";
 const char* const kFlowGuides[] = {"fluid_velocity", "velocity_forward"};
 
@@ -177,15 +177,7 @@ std::string LazyFluidsJob::frame_key(std::size_t index) const {
 
 bool LazyFluidsJob::is_current(std::size_t index) const {
   const int f = config_.frames[index];
-  std::ifstream in(record_path(f));
-  std::string line;
-  if (!in || !std::getline(in, line) || line != kRecordFormat) return false;
-  if (!std::getline(in, line) || line != frame_key(index)) return false;
-  for (const std::string& path : {output_path(f), state_path(f)}) {
-    FileDigest recorded;
-    if (!(in >> recorded.size >> recorded.checksum) || !(file_digest(path) == recorded)) return false;
-  }
-  return true;
+  return record_current(record_path(f), kRecordFormat, frame_key(index), {output_path(f), state_path(f)});
 }
 
 Image LazyFluidsJob::read_flow(int frame) const {
@@ -251,13 +243,7 @@ void LazyFluidsJob::write_frame(std::size_t index, const FluidFrameResult& frame
   const Image output = blur > 0 ? motion_blur_along_flow(state.view(), read_flow(f).view(), blur) : Image();
   write_image(state_path(f), state.view());
   write_image(output_path(f), blur > 0 ? output.view() : state.view());
-  std::ostringstream record;
-  record << kRecordFormat << "\n" << frame_key(index) << "\n";
-  for (const std::string& path : {output_path(f), state_path(f)}) {
-    const FileDigest d = file_digest(path);
-    record << d.size << " " << d.checksum << "\n";
-  }
-  write_text_atomically(record_path(f), record.str(), "the frame record");
+  write_record(record_path(f), kRecordFormat, frame_key(index), {output_path(f), state_path(f)});
 }
 
 void LazyFluidsJob::write_contact_sheet(const std::string& path, int columns) const {

@@ -2,29 +2,24 @@
 
 #include <chrono>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "tempera/engine/error.hpp"
 #include "tempera/app/file_keys.hpp"
 #include "tempera/app/guide_cache.hpp"
 #include "tempera/app/image_io.hpp"
+#include "tempera/app/record.hpp"
 #include "tempera/methods/stylit/stylit.hpp"
-#include "tempera/app/text_file.hpp"
 
 namespace fs = std::filesystem;
 
 namespace tempera {
 namespace {
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+// The format line of a frame's resume record (app/record.hpp). Before it,
+// the record was the bare key: such frames are made again once.
+constexpr const char* kRecordFormat = "tempera-noisy-frame 1";
 
-fs::path key_path(const std::string& out, int frame) {
+fs::path record_path(const std::string& out, int frame) {
   return fs::path(out) / ".tempera_noisy" / frame_file("", frame, "key");
 }
 
@@ -136,10 +131,9 @@ FrameResult NoisySequence::run_frame(std::size_t index, const ProgressCallback& 
   result.frame = frame;
   result.path = output_path(frame);
   result.status = "skipped";
-  const fs::path key_file = key_path(config_.out, frame);
+  const fs::path record = record_path(config_.out, frame);
   const std::string k = key(frame);
-  if (config_.resume && fs::is_regular_file(result.path) && fs::is_regular_file(key_file) && read_text(key_file) == k)
-    return result;
+  if (config_.resume && record_current(record.string(), kRecordFormat, k, {result.path})) return result;
   const auto t0 = std::chrono::steady_clock::now();
   const Image r = read_image(reference_path(frame));
   const Image map = noise_map(frame);
@@ -152,9 +146,9 @@ FrameResult NoisySequence::run_frame(std::size_t index, const ProgressCallback& 
   }
   const Image out = noisy_frame(medium_.view(), r.view(), frame, config_.options, map.empty() ? ImageView{} : map.view(),
                                 progress, guides);
-  fs::create_directories(key_file.parent_path());
+  fs::create_directories(record.parent_path());
   write_image(result.path, out.view());  // atomic
-  write_text_atomically(key_file.string(), k, "the resume key");
+  write_record(record.string(), kRecordFormat, k, {result.path});
   result.status = "made";
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;

@@ -13,6 +13,7 @@
 #include "tempera/engine/option_table.hpp"
 #include "tempera/methods/tcia/orientation.hpp"
 #include "tempera/app/paths.hpp"
+#include "tempera/app/record.hpp"
 #include "tempera/app/text_file.hpp"
 
 namespace fs = std::filesystem;
@@ -20,7 +21,6 @@ namespace fs = std::filesystem;
 namespace tempera {
 namespace {
 
-constexpr const char* kRecordFormat = "tempera-tcia-segment 1";
 const char* const kMotion[] = {"velocity_backward", "occlusion_backward", "velocity_forward", "occlusion_forward"};
 
 std::vector<int> segment_bounds(const std::vector<int>& frames, const std::vector<KeyFile>& keys) {
@@ -200,7 +200,7 @@ TciaJob::TciaJob(TciaJobConfig config)
   for (const LayerFile& l : config_.layers)
     read_keys(l.keys, layer_key_paintings_.emplace_back(), layer_key_masks_.emplace_back());
   std::ostringstream s;
-  s << kRecordFormat << ";weights=";
+  s << kTciaRecordFormat << ";weights=";
   for (const auto& [name, weight] : active_guides(config_.frames.stylit)) s << name << ":" << weight << ",";
   s << ";" << settings_text(config_.tcia, tcia_option_table())
     << settings_text(config_.tcia.synthesis, synthesis_option_table())
@@ -258,31 +258,6 @@ std::string TciaJob::segment_key(const TciaSegment& segment) const {
   return hash_hex(text);
 }
 
-bool TciaJob::record_current(const std::string& record, const std::string& key, const std::vector<std::string>& files) {
-  std::ifstream in(record);
-  std::string line;
-  if (!in || !std::getline(in, line) || line != kRecordFormat) return false;
-  if (!std::getline(in, line) || line != key) return false;
-  for (const std::string& path : files) {
-    const FileDigest digest = file_digest(path);
-    std::string name;
-    FileDigest recorded;
-    if (!(in >> name >> recorded.size >> recorded.checksum)) return false;
-    if (name != fs::path(path).filename().string() || !(digest == recorded)) return false;
-  }
-  return true;
-}
-
-void TciaJob::write_record(const std::string& record, const std::string& key, const std::vector<std::string>& files) {
-  std::ostringstream text;
-  text << kRecordFormat << "\n" << key << "\n";
-  for (const std::string& path : files) {
-    const FileDigest d = file_digest(path);
-    text << fs::path(path).filename().string() << " " << d.size << " " << d.checksum << "\n";
-  }
-  write_text_atomically(record, text.str(), "the segment record");
-}
-
 std::string TciaJob::composite_key(const TciaSegment& segment) const {
   if (config_.layers.empty()) return segment_key(segment);
   std::string text = concat(segment_key(segment), "\nlayer order ", config_.layer_order);
@@ -293,7 +268,7 @@ std::string TciaJob::composite_key(const TciaSegment& segment) const {
 bool TciaJob::is_current(std::size_t index) const {
   std::vector<std::string> files;
   for (int f : segments_[index].writes) files.push_back(frames_.output_path(f));
-  return record_current(record_path(index), composite_key(segments_[index]), files);
+  return record_current(record_path(index), kTciaRecordFormat, composite_key(segments_[index]), files);
 }
 
 Shot TciaJob::load_shot(const TciaSegment& segment, std::deque<Image>& keep) const {
@@ -371,7 +346,7 @@ SegmentResult TciaJob::run_segment(std::size_t index, const SegmentProgress& pro
     files.push_back(frames_.output_path(f));
     write_image(files.back(), images[std::size_t(f - segment.first)].view());  // atomic
   }
-  write_record(record_path(index), composite_key(segment), files);
+  write_record(record_path(index), kTciaRecordFormat, composite_key(segment), files);
   result.status = "stylized";
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;

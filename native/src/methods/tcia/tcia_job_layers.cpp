@@ -12,6 +12,7 @@
 #include "tempera/app/file_keys.hpp"
 #include "tempera/app/image_io.hpp"
 #include "tempera/methods/tcia/tcia_job.hpp"
+#include "tempera/app/record.hpp"
 #include "tempera/methods/tcia/tcia_layers.hpp"
 
 namespace fs = std::filesystem;
@@ -184,7 +185,9 @@ std::vector<Image> TciaJob::run_layers(std::size_t index, const Shot& shot, cons
   for (std::size_t l = 0; l < n; ++l) {
     std::vector<std::string> files;
     for (int f : segment.writes) files.push_back(layer_path(l, f));
-    if (config_.frames.resume && record_current(layer_record_path(index, l), layer_key(segment, l), files)) continue;
+    if (config_.frames.resume &&
+        record_current(layer_record_path(index, l), kTciaRecordFormat, layer_key(segment, l), files))
+      continue;
     ShotLayer layer{config_.layers[l].name, {}, layer_paintings_[l].view(), layer_style_masks_[l].view()};
     for (const Image& m : masks[l]) layer.masks.push_back(m.view());
     std::deque<Image> keep;
@@ -203,7 +206,7 @@ std::vector<Image> TciaJob::run_layers(std::size_t index, const Shot& shot, cons
       const std::size_t t = std::size_t(segment.writes[i] - segment.first);
       write_image(files[i], with_alpha(images[t].view(), masks[l][t].view()).view());  // atomic
     }
-    write_record(layer_record_path(index, l), layer_key(segment, l), files);
+    write_record(layer_record_path(index, l), kTciaRecordFormat, layer_key(segment, l), files);
   }
   // The composite, from the layers' files.
   std::vector<Image> out(std::size_t(segment.last - segment.first + 1));

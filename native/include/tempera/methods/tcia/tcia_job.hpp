@@ -106,6 +106,9 @@ struct TciaJobConfig {
   TciaOrientationOptions orientation;
 };
 
+// The format line of a segment's and a layer's resume record (app/record.hpp).
+inline constexpr const char* kTciaRecordFormat = "tempera-tcia-segment 1";
+
 // Frames first..last (inclusive) are solved together; the segment writes
 // `writes` (first..last - 1, and last too for the shot's last segment), so a
 // key shared by two segments has one writer.
@@ -148,9 +151,6 @@ class TciaJob {
   Shot load_shot(const TciaSegment& segment, std::deque<Image>& keep) const;
   std::string composite_key(const TciaSegment& segment) const;  // segment_key and the layers
   std::string layer_key(const TciaSegment& segment, std::size_t layer) const;
-  // A record (format line, key, then "file size checksum" per file) is current when all three match.
-  static bool record_current(const std::string& record, const std::string& key, const std::vector<std::string>& files);
-  static void write_record(const std::string& record, const std::string& key, const std::vector<std::string>& files);
 
   // Layers (tcia_job_layers.cpp): checked up front; each solved (or skipped
   // when its record is current) and written, then composited from the files.
