@@ -1,7 +1,10 @@
 // Python binding of the guide building blocks (motion, orientation, line
 // distance). Arrays are viewed in place and the GIL is released while the
 // native code runs; tempera.engine.guides wraps these with numpy-friendly shapes.
+#include <pybind11/stl.h>
+
 #include "numpy_bridge.hpp"
+#include "tempera/app/guide_cache.hpp"
 #include "tempera/engine/distance_transform.hpp"
 #include "tempera/engine/motion.hpp"
 #include "tempera/methods/tcia/orientation.hpp"
@@ -26,6 +29,20 @@ py::array_t<float> without_gil(Fn&& fn) {
 }  // namespace
 
 void bind_guides(py::module_& m) {
+  m.def(
+      "cache_guides",
+      [] {
+        py::list out;
+        for (const CacheGuide& g : cache_guides()) {
+          py::dict d;
+          d["name"] = g.name;
+          d["components"] = g.components;
+          d["meaning"] = g.meaning;
+          out.append(d);
+        }
+        return out;
+      },
+      "The guide cache's guides besides the light paths: name, channel components, meaning (app/guide_cache.hpp).");
   m.def(
       "occlusion_backward",
       [](const FloatArray& v_minus_t, const FloatArray& v_plus_prev, float epsilon) {

@@ -18,6 +18,21 @@ def test_channel_names_of_the_documented_guides():
         guide_cache.channel_names("NOPE")
 
 
+def test_the_documented_table_is_the_native_one():
+    """docs/guide_cache.md's guide table lists exactly the guides and channels
+    of the native tables (light paths and app/guide_cache.hpp), in order."""
+    from pathlib import Path
+    import re
+
+    text = (Path(__file__).resolve().parents[2] / "docs" / "guide_cache.md").read_text()
+    text = text.split("| guide | channels | what it is |", 1)[1].split("\n\n", 1)[0]
+    rows = re.findall(r"^\| `([A-Za-z0-9_]+)` \| `([^`]+)` \|", text, flags=re.M)
+    documented = {name: channels for name, channels in rows}
+    native = {name: f"{name}." + "/".join(components) for name, components in guide_cache.GUIDES.items()}
+    assert list(documented) == list(native)
+    assert documented == native
+
+
 def test_lpe_guide_names_are_exr_safe_and_distinct():
     assert guide_cache.lpe_guide("LDE") == "lpe_LDE"
     assert guide_cache.channel_names("lpe_LDE") == ["lpe_LDE.R", "lpe_LDE.G", "lpe_LDE.B"]

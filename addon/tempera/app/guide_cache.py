@@ -36,22 +36,14 @@ from .. import _native
 MANIFEST_NAME = "manifest.json"
 FORMAT_VERSION = 1
 
-# guide name -> channel components, in the order they are written.
+# guide name -> channel components, in the order they are written: StyLit's
+# light paths (RGB radiance; how each is made from Cycles' passes:
+# tempera.blender.guide_render.light_path_guides), then the native job core's
+# table of the others (native/include/tempera/app/guide_cache.hpp, with what
+# each holds: _native.cache_guides()).
 GUIDES = {
-    # StyLit's light paths (the native guide table), RGB radiance; how each is
-    # made from Cycles' passes: tempera.blender.guide_render.light_path_guides.
     **{g["name"]: "RGB" for g in _native.light_path_guides()},
-    "velocity_forward": "XY",  # V+: pixel p moves to p + V+ in the next frame
-    "velocity_backward": "XY",  # V-: pixel p came from p - V- in the previous frame
-    "fluid_velocity": "XY",  # screen velocity of fluids: p moves to p + F in the next frame
-    "occlusion_backward": "V",  # chi-: 1 visible in the previous frame, 0 disoccluded
-    "occlusion_forward": "V",  # chi+: 1 still visible in the next frame, 0 about to be occluded
-    "tensor": ("XX", "XY", "YY"),  # structure tensor of the grayscale render (interpolates)
-    "alpha": "A",  # coverage (film transparent)
-    "depth": "Z",  # Cycles Depth pass (distance to the camera; huge on the background)
-    "normal": "XYZ",  # world-space shading normal
-    "lines": "V",  # 1 on depth / normal discontinuities
-    "line_distance": "V",  # min(distance to lines, d_max) / d_max
+    **{g["name"]: tuple(g["components"]) for g in _native.cache_guides()},
 }
 
 # Defaults of the parameters that change the guides; they are part of each frame's key.

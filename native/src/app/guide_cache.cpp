@@ -67,6 +67,23 @@ GuideFrame GuideFrame::read(const std::string& path, const std::vector<std::stri
   return frame;
 }
 
+const std::vector<CacheGuide>& cache_guides() {
+  static const std::vector<CacheGuide> table = {
+      {"velocity_forward", {"X", "Y"}, "V+: pixel p moves to p + V+ in the next frame (pixels, x right, y down)"},
+      {"velocity_backward", {"X", "Y"}, "V-: pixel p came from p - V- in the previous frame"},
+      {"fluid_velocity", {"X", "Y"}, "screen velocity of fluids: p moves to p + F in the next frame"},
+      {"occlusion_backward", {"V"}, "chi-: 1 visible in the previous frame, 0 disoccluded"},
+      {"occlusion_forward", {"V"}, "chi+: 1 still visible in the next frame, 0 about to be occluded"},
+      {"tensor", {"XX", "XY", "YY"}, "structure tensor of the grayscale render (it interpolates, angles do not)"},
+      {"alpha", {"A"}, "coverage (film transparent)"},
+      {"depth", {"Z"}, "Cycles' Depth pass (distance to the camera; huge on the background)"},
+      {"normal", {"X", "Y", "Z"}, "world-space shading normal"},
+      {"lines", {"V"}, "1 on depth and normal discontinuities"},
+      {"line_distance", {"V"}, "min(distance to lines, d_max) / d_max"},
+  };
+  return table;
+}
+
 std::string guide_cache_frame(const std::string& folder, int frame) {
   return (fs::path(folder) / frame_file("frame_", frame, "exr")).string();
 }

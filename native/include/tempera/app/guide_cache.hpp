@@ -25,6 +25,19 @@ struct GuideFrame {
   static GuideFrame read(const std::string& path, const std::vector<std::string>& names);
 };
 
+// A guide of the cache besides StyLit's light paths (RGB radiance, named by
+// methods/stylit's table): its name, its channel components in the order they
+// are written ("<name>.<component>"), and what it holds.
+struct CacheGuide {
+  std::string name;
+  std::vector<std::string> components;
+  std::string meaning;
+};
+
+// The one table of those guides; Python's tempera.app.guide_cache.GUIDES is
+// made from it and the light-path table (docs/guide_cache.md).
+const std::vector<CacheGuide>& cache_guides();
+
 // <folder>/frame_0001.exr for frame 1.
 std::string guide_cache_frame(const std::string& folder, int frame);
 
