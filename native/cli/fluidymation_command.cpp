@@ -103,11 +103,8 @@ int run_stylize_fluidymation(const Args& args) {
   FluidymationJob job(config);  // bad inputs: ValueError, exit status 2
   for (const auto& w : job.warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
   catch_interrupts();
-  FrameRun frames;
-  frames.count = job.frames().size();
-  frames.run = [&](std::size_t i, const ProgressCallback& progress) { return job.run_frame(i, progress); };
   std::vector<FrameResult> results;
-  if (!run_frames(frames, results)) return report_interrupted("stylize");
+  if (!run_frames(job, results)) return report_interrupted("stylize");
   const FrameTally t = tally(results);
   const fs::path sheet = fs::path(config.out) / "contact_sheet.png";
   job.write_contact_sheet(sheet.string());

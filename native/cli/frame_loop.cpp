@@ -43,18 +43,18 @@ std::string clock_text(double seconds) {
   return out.str();
 }
 
-bool run_frames(const FrameRun& frames, std::vector<FrameResult>& results) {
-  const std::size_t n = frames.count;
+bool run_frames(FrameJob& job, std::vector<FrameResult>& results, const FrameLine& line) {
+  const std::size_t n = job.frames().size();
   double spent = 0;
   int made = 0;
   for (std::size_t i = 0; i < n; ++i) {
     try {
-      results.push_back(frames.run(i, until_interrupted()));
+      results.push_back(job.run_frame(i, until_interrupted()));
     } catch (const CancelledError&) {
       return false;
     }
     const FrameResult& r = results.back();
-    std::cout << frames.label << " " << i + 1 << "/" << n << " (#" << r.frame << "): ";
+    std::cout << line.label << " " << i + 1 << "/" << n << " (#" << r.frame << "): ";
     if (r.status == "skipped") {
       std::cout << "skipped, already current";
     } else {
@@ -62,8 +62,8 @@ bool run_frames(const FrameRun& frames, std::vector<FrameResult>& results) {
       ++made;
       std::cout << std::fixed << std::setprecision(2) << r.seconds << " s" << std::defaultfloat;
     }
-    if (frames.details) frames.details(std::cout, r);
-    if (frames.eta && made > 0 && i + 1 < n) std::cout << ", ETA " << clock_text(spent / made * double(n - i - 1));
+    if (line.details) line.details(std::cout, r);
+    if (line.eta && made > 0 && i + 1 < n) std::cout << ", ETA " << clock_text(spent / made * double(n - i - 1));
     std::cout << std::defaultfloat << std::endl;
   }
   return true;

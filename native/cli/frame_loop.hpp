@@ -14,8 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "tempera/app/frame_result.hpp"
-#include "tempera/engine/synthesis.hpp"
+#include "tempera/app/frame_job.hpp"
 
 namespace tempera::cli {
 
@@ -36,20 +35,18 @@ int report_interrupted(const std::string& command, const std::string& unit = "fr
 // "1:05" for 65 seconds.
 std::string clock_text(double seconds);
 
-// A job's frames as the loop runs them: run(i, progress) makes frame i of count.
-struct FrameRun {
+// How the loop prints a job's frames.
+struct FrameLine {
   std::string label = "frame";  // the line's start: "frame 3/24 (#3): "
-  std::size_t count = 0;
-  std::function<FrameResult(std::size_t, const ProgressCallback&)> run;
   // Figures of the method after the time (", flicker 0.0123"), for made and skipped frames alike.
   std::function<void(std::ostream&, const FrameResult&)> details;
   bool eta = false;  // ", ETA 1:05" once a frame was made
 };
 
-// Runs every frame, one line each, "frame 3/24 (#3): 1.23 s" or "frame 3/24
-// (#3): skipped, already current", and appends its result to `results`.
-// False if interrupted (the frames finished before are kept).
-bool run_frames(const FrameRun& frames, std::vector<FrameResult>& results);
+// Runs every frame of `job`, one line each, "frame 3/24 (#3): 1.23 s" or
+// "frame 3/24 (#3): skipped, already current", and appends its result to
+// `results`. False if interrupted (the frames finished before are kept).
+bool run_frames(FrameJob& job, std::vector<FrameResult>& results, const FrameLine& line = {});
 
 // Seconds spent on frames made, and how many were made and skipped.
 struct FrameTally {

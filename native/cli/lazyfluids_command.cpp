@@ -93,14 +93,12 @@ Options parse(const Args& args) {
 
 // Every frame, one line each with the source coverage; false if interrupted.
 bool run_frames(LazyFluidsJob& job) {
-  FrameRun frames;
-  frames.count = job.frames().size();
-  frames.run = [&](std::size_t i, const ProgressCallback& progress) { return job.run_frame(i, progress); };
-  frames.details = [](std::ostream& out, const FrameResult& r) {
+  FrameLine line;
+  line.details = [](std::ostream& out, const FrameResult& r) {
     if (r.status != "skipped") out << ", source coverage " << r.source_coverage;
   };
   std::vector<FrameResult> results;
-  if (!cli::run_frames(frames, results)) return false;
+  if (!cli::run_frames(job, results, line)) return false;
   const FrameTally t = tally(results);
   std::cout << "tempera stylize: " << t.made << " frame(s) stylized, " << t.skipped
             << " skipped (already current) in " << std::fixed << std::setprecision(1) << t.seconds << " s"

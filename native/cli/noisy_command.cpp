@@ -74,11 +74,8 @@ int run_noisy(const Args& args) {
   if (c.out.empty()) throw ValueError("--out is required (the output folder)");
   NoisySequence sequence(c);
   catch_interrupts();
-  FrameRun frames;
-  frames.count = sequence.frames().size();
-  frames.run = [&](std::size_t i, const ProgressCallback& progress) { return sequence.run_frame(i, progress); };
   std::vector<FrameResult> results;
-  if (!run_frames(frames, results)) return report_interrupted("noisy");
+  if (!run_frames(sequence, results)) return report_interrupted("noisy");
   const FrameTally t = tally(results);
   std::cout << "tempera noisy: " << t.made << " frame(s) made, " << t.skipped << " current; results in " << c.out
             << "\n";

@@ -309,14 +309,12 @@ bool consecutive(const std::vector<int>& frames) {
 
 // StyLit's frames, one line each with the flicker figure and an ETA; false if interrupted.
 bool run_frames(StylizeJob& job, std::vector<FrameResult>& results) {
-  FrameRun frames;
-  frames.count = job.frames().size();
-  frames.run = [&](std::size_t i, const ProgressCallback& progress) { return job.run_frame(i, progress); };
-  frames.details = [](std::ostream& out, const FrameResult& r) {
+  FrameLine line;
+  line.details = [](std::ostream& out, const FrameResult& r) {
     if (std::isfinite(r.flicker)) out << ", flicker " << std::fixed << std::setprecision(4) << r.flicker;
   };
-  frames.eta = true;
-  return cli::run_frames(frames, results);
+  line.eta = true;
+  return cli::run_frames(job, results, line);
 }
 
 void print_summary(const std::vector<FrameResult>& results, const std::string& out) {
@@ -373,12 +371,10 @@ bool run_noise_pass(const Options& o) {
   c.options.synthesis.threads = o.stylit.synthesis.threads;
   c.resume = o.resume;
   NoisySequence sequence(c);
-  FrameRun frames;
-  frames.label = "noisy frame";
-  frames.count = sequence.frames().size();
-  frames.run = [&](std::size_t i, const ProgressCallback& progress) { return sequence.run_frame(i, progress); };
+  FrameLine line;
+  line.label = "noisy frame";
   std::vector<FrameResult> results;
-  if (!cli::run_frames(frames, results)) return false;
+  if (!cli::run_frames(sequence, results, line)) return false;
   std::cout << "noisy frames: " << c.out << "\n";
   if (o.video && consecutive(o.frames)) {
     const fs::path video = fs::path(o.out) / "noisy.mp4";

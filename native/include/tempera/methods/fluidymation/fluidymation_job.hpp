@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "tempera/app/frame_result.hpp"
+#include "tempera/app/frame_job.hpp"
 #include "tempera/methods/fluidymation/fluidymation.hpp"
 
 namespace tempera {
@@ -49,15 +49,15 @@ struct FluidymationJobConfig {
   FluidymationOptions options = default_fluidymation_options();
 };
 
-class FluidymationJob {
+class FluidymationJob : public FrameJob {
  public:
   // Reads and checks every input (FileNotFoundError, ValueError).
   explicit FluidymationJob(FluidymationJobConfig config);
   ~FluidymationJob();
 
-  const std::vector<int>& frames() const { return config_.frames; }
-  const std::vector<std::string>& warnings() const { return warnings_; }
-  std::string output_path(int frame) const;
+  const std::vector<int>& frames() const override { return config_.frames; }
+  const std::vector<std::string>& warnings() const override { return warnings_; }
+  std::string output_path(int frame) const override;
   // The guide the target's flow is read from (fluid_velocity or
   // velocity_forward); empty when it is made from the masks.
   const std::string& flow_guide() const { return flow_guide_; }
@@ -65,7 +65,7 @@ class FluidymationJob {
   // Stylizes frames()[index] (solving earlier frames first when their
   // matches are not on disk), or skips it when current. progress(fraction)
   // returning false cancels: CancelledError, nothing of the frame written.
-  FrameResult run_frame(std::size_t index, const ProgressCallback& progress = {});
+  FrameResult run_frame(std::size_t index, const ProgressCallback& progress = {}) override;
 
   // The first exemplar frame followed by the frames written so far.
   void write_contact_sheet(const std::string& path, int columns = 0) const;

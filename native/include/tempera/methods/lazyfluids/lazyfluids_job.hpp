@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "tempera/methods/lazyfluids/lazyfluids.hpp"
-#include "tempera/app/frame_result.hpp"
+#include "tempera/app/frame_job.hpp"
 
 namespace tempera {
 
@@ -28,15 +28,15 @@ struct LazyFluidsJobConfig {
   LazyFluidsOptions options = default_lazyfluids_options();
 };
 
-class LazyFluidsJob {
+class LazyFluidsJob : public FrameJob {
  public:
   // Validates everything up front (files, guides, sizes, options).
   explicit LazyFluidsJob(LazyFluidsJobConfig config);
 
-  const std::vector<int>& frames() const { return config_.frames; }
-  const std::vector<std::string>& warnings() const { return warnings_; }
+  const std::vector<int>& frames() const override { return config_.frames; }
+  const std::vector<std::string>& warnings() const override { return warnings_; }
   const std::vector<Image>& exemplar() const { return exemplar_; }
-  std::string output_path(int frame) const;
+  std::string output_path(int frame) const override;
   std::string state_path(int frame) const;
   std::string record_path(int frame) const;
   std::string field_path(int frame) const;  // warm start: the frame's final matches
@@ -44,7 +44,7 @@ class LazyFluidsJob {
   // Stylizes frames()[index] (or skips it when its record is current); the
   // frame before must be done. `progress` returning false cancels:
   // CancelledError, nothing written.
-  FrameResult run_frame(std::size_t index, const ProgressCallback& progress = {});
+  FrameResult run_frame(std::size_t index, const ProgressCallback& progress = {}) override;
 
   // The exemplar followed by the frames written so far.
   void write_contact_sheet(const std::string& path, int columns = 0) const;

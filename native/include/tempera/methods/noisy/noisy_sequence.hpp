@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-#include "tempera/app/frame_result.hpp"
+#include "tempera/app/frame_job.hpp"
 #include "tempera/engine/image.hpp"
 #include "tempera/methods/noisy/noisy.hpp"
 #include "tempera/methods/stylit/stylit.hpp"
@@ -38,16 +38,16 @@ struct NoisySequenceConfig {
   bool resume = true;
 };
 
-class NoisySequence {
+class NoisySequence : public FrameJob {
  public:
   // Validates up front: options, folders, the exemplar, every reference
   // frame, the noise map (file or guide); ValueError / FileNotFoundError.
   explicit NoisySequence(NoisySequenceConfig config);
-  const std::vector<int>& frames() const { return config_.frames; }
-  std::string output_path(int frame) const;
+  const std::vector<int>& frames() const override { return config_.frames; }
+  std::string output_path(int frame) const override;
   // Makes frames()[index] (or skips it when its output is current).
   // `progress` returning false cancels: CancelledError, nothing written.
-  FrameResult run_frame(std::size_t index, const ProgressCallback& progress = {});
+  FrameResult run_frame(std::size_t index, const ProgressCallback& progress = {}) override;
 
  private:
   std::string reference_path(int frame) const;

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "tempera/app/frame_result.hpp"
+#include "tempera/app/frame_job.hpp"
 #include "tempera/app/guide_cache.hpp"
 #include "tempera/engine/image.hpp"
 #include "tempera/methods/stylit/stylit.hpp"
@@ -29,15 +29,15 @@ struct StylizeJobConfig {
   bool resume = true;
 };
 
-class StylizeJob {
+class StylizeJob : public FrameJob {
  public:
   // Validates everything up front (files, guides, sizes); see docs/cli.md.
   explicit StylizeJob(StylizeJobConfig config);
 
-  const std::vector<int>& frames() const { return config_.frames; }
+  const std::vector<int>& frames() const override { return config_.frames; }
   // What was fixed on the way: a resampled painting, a damaged resume record set aside.
-  const std::vector<std::string>& warnings() const { return warnings_; }
-  std::string output_path(int frame) const;
+  const std::vector<std::string>& warnings() const override { return warnings_; }
+  std::string output_path(int frame) const override;
   std::string report_path() const;
   // The painting at the exemplar guides' size, the exemplar's guides and their
   // file: what the coherent job (tcia_job.hpp) takes from this one.
@@ -48,7 +48,7 @@ class StylizeJob {
 
   // Stylizes frames()[index] (or skips it when its output is current).
   // `progress` returning false cancels: CancelledError, nothing written.
-  FrameResult run_frame(std::size_t index, const ProgressCallback& progress = {});
+  FrameResult run_frame(std::size_t index, const ProgressCallback& progress = {}) override;
 
   // The painting followed by the stylized frames written so far, downscaled
   // so that the sheet stays within about 2000 pixels wide. columns 0 = auto.

@@ -1,0 +1,28 @@
+#pragma once
+// A job whose unit of work is one frame: StyLit's sequence, the noise pass,
+// LazyFluids and Fluidymation. The command line's frame loop (and, through
+// their bindings, the panel's modal operators) drive every one of them the
+// same way, a frame at a time, so that progress, cancel and resume look alike.
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "tempera/app/frame_result.hpp"
+#include "tempera/engine/synthesis.hpp"  // ProgressCallback
+
+namespace tempera {
+
+class FrameJob {
+ public:
+  virtual ~FrameJob() = default;
+  // The frames to make, in order.
+  virtual const std::vector<int>& frames() const = 0;
+  virtual std::string output_path(int frame) const = 0;
+  // Makes frames()[index], or skips it when its output is current.
+  // `progress` returning false cancels: CancelledError, nothing of the frame written.
+  virtual FrameResult run_frame(std::size_t index, const ProgressCallback& progress = {}) = 0;
+  // What was fixed on the way (a resampled painting, a damaged record set aside); none by default.
+  virtual const std::vector<std::string>& warnings() const;
+};
+
+}  // namespace tempera
