@@ -122,6 +122,7 @@ int run_lazyfluids(const Args& args) {
   Options o = parse(args);  // usage errors propagate: exit status 2
   catch_interrupts();
   LazyFluidsJob job(o.job);  // bad files or values: exit status 1 or 2
+  job.inputs().refuse_folder(o.out);  // the contact sheet would join a video exemplar's frames
   for (const auto& w : job.warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
   if (!run_frames(job)) return report_interrupted("stylize");
   const fs::path sheet = fs::path(o.out) / "contact_sheet.png";

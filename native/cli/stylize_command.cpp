@@ -339,6 +339,7 @@ void write_extras(const StylizeJob& job, const Options& o) {
     return;
   }
   const fs::path video = fs::path(o.out) / "stylized.mp4";
+  job.inputs().refuse_file(video.string());
   // ffmpeg reads '%' in the folder as a pattern of its own: doubled, it is a plain '%'.
   const std::string pattern = printf_escaped((fs::path(o.out) / "frames").string()) + "/frame_%04d.png";
   if (encode_video(pattern, o.frames.front(), o.fps, video.string()))
@@ -378,6 +379,7 @@ bool run_noise_pass(const Options& o) {
   std::cout << "noisy frames: " << c.out << "\n";
   if (o.video && consecutive(o.frames)) {
     const fs::path video = fs::path(o.out) / "noisy.mp4";
+    sequence.inputs().refuse_file(video.string());
     const std::string pattern = printf_escaped(c.out) + "/frame_%04d.png";
     if (encode_video(pattern, o.frames.front(), o.fps, video.string())) std::cout << "video: " << video.string() << "\n";
   }

@@ -86,7 +86,7 @@ def test_errors_name_the_problem(cli_path, inputs):
     assert missing.returncode == 1 and "frame_0004.png" in missing.stderr
     same = run(cli_path, "--exemplar", inputs / "medium.png", "--reference", inputs / "R", "--out", inputs / "R",
                "--frames", "1")
-    assert same.returncode == 2 and "must not be the reference folder" in same.stderr
+    assert same.returncode == 2 and "is the reference folder" in same.stderr
 
 
 # --------------------------------------------------------------------------- tempera stylize --noise

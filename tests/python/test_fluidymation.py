@@ -151,7 +151,7 @@ def test_auto_flow_prefers_fluid_velocity(tmp_path):
                                            "velocity_forward": np.zeros_like(guides["velocity_forward"])})
     results = {}
     for flow in ("auto", "fluid", "guides"):
-        job = fluidymation.MediaJob(exemplar, cache, [1, 2, 3], tmp_path / flow, flow=flow, **FAST)
+        job = fluidymation.MediaJob(exemplar, cache, [1, 2, 3], tmp_path / f"out_{flow}", flow=flow, **FAST)
         assert job.flow_guide == {"guides": "velocity_forward"}.get(flow, "fluid_velocity")
         assert [job.run_frame(i)["status"] for i in range(3)] == ["stylized"] * 3
         results[flow] = read_image(job.output_path(3))

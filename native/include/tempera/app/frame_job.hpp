@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "tempera/app/frame_result.hpp"
+#include "tempera/app/job_inputs.hpp"
 #include "tempera/engine/synthesis.hpp"  // ProgressCallback
 
 namespace tempera {
@@ -21,6 +22,9 @@ class FrameJob {
   // Makes frames()[index], or skips it when its output is current.
   // `progress` returning false cancels: CancelledError, nothing of the frame written.
   virtual FrameResult run_frame(std::size_t index, const ProgressCallback& progress = {}) = 0;
+  // Every file and folder the job reads: whatever else a front end writes
+  // (a contact sheet, a video) is checked against them too.
+  virtual const JobInputs& inputs() const = 0;
   // What was fixed on the way (a resampled painting, a damaged record set aside); none by default.
   virtual const std::vector<std::string>& warnings() const;
 };

@@ -10,7 +10,6 @@
 #include "tempera/app/file_keys.hpp"
 #include "tempera/app/guide_cache.hpp"
 #include "tempera/app/image_io.hpp"
-#include "tempera/app/paths.hpp"
 #include "tempera/app/record.hpp"
 
 namespace fs = std::filesystem;
@@ -122,8 +121,19 @@ FluidymationJob::FluidymationJob(FluidymationJobConfig c) : config_(std::move(c)
     if (!flow_guide_.empty()) target_flows_.push_back(read_image_layer(path, flow_guide_));
     inputs.push_back(path);
   }
+  // Nothing may be written onto the guides, the exemplar or its masks: refuse before anything is.
+  inputs_.add_folder(config_.guides, "guide cache", "the guides");
+  inputs_.add_folder(config_.exemplar, "exemplar", "the exemplar's frames");
+  if (!config_.exemplar_masks.empty())
+    inputs_.add_folder(config_.exemplar_masks, "exemplar mask", "the exemplar's masks");
+  for (const std::string& file : files) inputs_.add_file(file, "exemplar frame");
+  for (const std::string& file : mask_files) inputs_.add_file(file, "exemplar mask");
+  for (int f : config_.frames) inputs_.add_file(guide_cache_frame(config_.guides, f), "guide frame");
+  inputs_.refuse_folder(config_.out);
+  inputs_.refuse_folder((fs::path(config_.out) / "tempera_fluidymation").string());
+  for (int f : config_.frames)
+    for (const std::string& path : {output_path(f), state_path(f), record_path(f)}) inputs_.refuse_file(path);
   fs::create_directories(fs::path(config_.out) / "tempera_fluidymation");
-  refuse_output_on_inputs(output_path(config_.frames.front()), inputs, "output");
   std::ostringstream base;
   base << settings_text(config_.options, fluidymation_option_table())
        << settings_text(config_.options.synthesis, synthesis_option_table()) << "format=" << config_.format
@@ -218,6 +228,7 @@ FrameResult FluidymationJob::run_frame(std::size_t index, const ProgressCallback
 }
 
 void FluidymationJob::write_contact_sheet(const std::string& path, int columns) const {
+  inputs_.refuse_file(path);
   std::vector<Image> images;
   Image first(exemplar_[0].width(), exemplar_[0].height(), 4);
   for (std::size_t q = 0; q < first.pixel_count(); ++q) {

@@ -132,10 +132,16 @@ LazyFluidsJob::LazyFluidsJob(LazyFluidsJobConfig config) : config_(std::move(con
     << settings_text(config_.options.synthesis, synthesis_option_table()) << "format=" << config_.format << ";";
   for (const std::string& file : exemplar_files_) s << file_stamp(file) << ";";
   settings_ = s.str();
+  // Nothing may be written onto the guides or the exemplar: refuse before anything is.
+  inputs_.add_folder(config_.guides, "guide cache", "the guides");
   std::error_code ec;
-  fs::create_directories(fs::path(config_.out) / kStateFolder, ec);
-  if (!fs::is_directory(fs::path(config_.out) / kStateFolder, ec))
-    throw IoError(concat("cannot create the output folder '", config_.out, "'"));
+  if (fs::is_directory(config_.exemplar, ec)) inputs_.add_folder(config_.exemplar, "exemplar", "the exemplar's frames");
+  for (const std::string& file : exemplar_files_) inputs_.add_file(file, "exemplar");
+  for (int f : config_.frames) inputs_.add_file(guide_path(f), "guide frame");
+  inputs_.refuse_folder(config_.out);
+  inputs_.refuse_folder((fs::path(config_.out) / kStateFolder).string());
+  for (int f : config_.frames)
+    for (const std::string& path : {output_path(f), state_path(f), field_path(f), record_path(f)}) inputs_.refuse_file(path);
 }
 
 std::string LazyFluidsJob::guide_path(int frame) const {
@@ -234,7 +240,11 @@ FrameResult LazyFluidsJob::run_frame(std::size_t index, const ProgressCallback& 
 void LazyFluidsJob::write_frame(std::size_t index, const FluidFrameResult& frame) const {
   const int f = config_.frames[index];
   const Image& state = frame.image;
+  // Made at the first write, not up front: a refused job leaves nothing behind.
   std::error_code ec;
+  fs::create_directories(fs::path(config_.out) / kStateFolder, ec);
+  if (!fs::is_directory(fs::path(config_.out) / kStateFolder, ec))
+    throw IoError(concat("cannot create the output folder '", config_.out, "'"));
   if (config_.options.warm_start && !frame.synthesis.field.x.empty())
     write_image(field_path(f), field_positions(frame.synthesis.field).view());
   else
@@ -247,8 +257,7 @@ void LazyFluidsJob::write_frame(std::size_t index, const FluidFrameResult& frame
 }
 
 void LazyFluidsJob::write_contact_sheet(const std::string& path, int columns) const {
-  for (const std::string& file : exemplar_files_)
-    if (same_path(path, file)) throw ValueError(concat("the contact sheet '", path, "' would overwrite the exemplar"));
+  inputs_.refuse_file(path);
   std::vector<std::string> files;
   std::error_code ec;
   for (int frame : config_.frames)

@@ -35,11 +35,10 @@ NoisySequence::NoisySequence(NoisySequenceConfig config) : config_(std::move(con
   if (c.out.empty()) throw ValueError("the output folder is required");
   if (!fs::is_directory(c.reference))
     throw FileNotFoundError(concat("the reference folder '", c.reference, "' does not exist"));
-  if (fs::weakly_canonical(c.out) == fs::weakly_canonical(c.reference))
-    throw ValueError("the output folder must not be the reference folder (the frames would be overwritten)");
   for (int frame : c.frames)
     if (!fs::is_regular_file(reference_path(frame)))
       throw FileNotFoundError(concat("reference frame not found: '", reference_path(frame), "'"));
+  refuse_writing_on_inputs();
   medium_ = read_image(c.exemplar);
   check_noisy_exemplar_size(c.options.noise, medium_.width(), medium_.height(), c.options.synthesis.patch_size);
   settings_ = settings_text(c.options, noisy_option_table()) + settings_text(c.options.synthesis, synthesis_option_table()) +
@@ -57,6 +56,26 @@ NoisySequence::NoisySequence(NoisySequenceConfig config) : config_(std::move(con
       settings_ += "|guide map " + c.noise_map;
       noise_map(c.frames.front());  // names a missing guide now, not after hours
     }
+  }
+}
+
+// Nothing may be written onto the reference frames, the medium, the noise
+// map or the guides: refuse before anything is.
+void NoisySequence::refuse_writing_on_inputs() {
+  const NoisySequenceConfig& c = config_;
+  inputs_.add_folder(c.reference, "reference", "the coherent frames");
+  inputs_.add_folder(c.guides, "guide cache", "the guides");
+  inputs_.add_folder(c.exemplar_guides, "exemplar guide cache", "the guides");
+  inputs_.add_file(c.exemplar, "exemplar");
+  inputs_.add_file(c.noise_map, "noise map");
+  for (int frame : c.frames) {
+    inputs_.add_file(reference_path(frame), "reference frame");
+    if (!c.guides.empty()) inputs_.add_file(guide_path(frame), "guide frame");
+  }
+  inputs_.refuse_folder(c.out);
+  for (int frame : c.frames) {
+    inputs_.refuse_file(output_path(frame));
+    inputs_.refuse_file(record_path(c.out, frame).string());
   }
 }
 

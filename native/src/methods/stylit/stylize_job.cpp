@@ -277,17 +277,15 @@ StylizeJob::StylizeJob(StylizeJobConfig config) : config_(std::move(config)) {
                                    missing, " (render them with tempera render-guides)"));
   check_target_guides(names);
 
-  // The stylized frames would replace guide frames (frame_0001.exr) or
-  // the painting: refuse before anything is written.
-  for (const auto& [folder, what] : {std::pair{config_.guides, "guide cache"},
-                                     std::pair{config_.exemplar_guides, "exemplar guide cache"}})
-    if (same_path(config_.out, folder))
-      throw ValueError(concat("the output folder '", config_.out, "' is the ", what, " folder: the stylized frames "
-                              "would overwrite the guides; choose another output folder"));
-  for (int frame : config_.frames)
-    if (same_path(output_path(frame), config_.style))
-      throw ValueError(concat("the stylized frame '", output_path(frame), "' would overwrite the painting '",
-                              config_.style, "'; choose another output folder"));
+  // Nothing may be written onto the guides or the painting: refuse before anything is.
+  inputs_.add_folder(config_.guides, "guide cache", "the guides");
+  inputs_.add_folder(config_.exemplar_guides, "exemplar guide cache", "the guides");
+  inputs_.add_file(config_.style, "painting");
+  inputs_.add_file(exemplar_path_, "exemplar guide frame");
+  for (int frame : config_.frames) inputs_.add_file(target_path(frame), "guide frame");
+  inputs_.refuse_folder(config_.out);
+  for (int frame : config_.frames) inputs_.refuse_file(output_path(frame));
+  inputs_.refuse_file(report_path());
   std::error_code ec;
   fs::create_directories(config_.out, ec);
   if (!fs::is_directory(config_.out, ec))
@@ -405,7 +403,7 @@ FrameResult StylizeJob::run_frame(std::size_t index, const ProgressCallback& pro
 // downscaled and pasted in turn: memory holds the sheet and one frame, not
 // every frame at full float resolution.
 void StylizeJob::write_contact_sheet(const std::string& path, int columns) const {
-  if (same_path(path, config_.style)) throw ValueError(concat("the contact sheet '", path, "' would overwrite the painting"));
+  inputs_.refuse_file(path);
   std::vector<std::string> files;
   std::error_code ec;
   for (int frame : config_.frames)

@@ -196,6 +196,7 @@ TciaJob::TciaJob(TciaJobConfig config)
   if (config_.orientation.from_cache && !has_guide(inspect_image(frames_.exemplar_path()), "tensor"))
     throw ValueError(concat("--orientation needs the structure tensor 'tensor' in the exemplar's guides '",
                             frames_.exemplar_path(), "'"));
+  refuse_writing_on_keys();
   read_keys(config_.keys, paintings_, masks_);
   for (const LayerFile& l : config_.layers)
     read_keys(l.keys, layer_key_paintings_.emplace_back(), layer_key_masks_.emplace_back());
@@ -224,6 +225,29 @@ TciaJobConfig TciaJob::checked(TciaJobConfig c) {
   c.keys = sorted_keys(std::move(c.keys), c.frames.frames);
   for (LayerFile& l : c.layers) l.keys = sorted_keys(std::move(l.keys), c.frames.frames);
   return c;
+}
+
+// The per-frame job refuses writing onto the guides and the painting; the
+// key paintings, their masks and the layers' paintings may sit in the output
+// folder too (a painted frame_0004.png): refuse before anything is written.
+void TciaJob::refuse_writing_on_keys() const {
+  JobInputs inputs;
+  const auto add_keys = [&](const std::vector<KeyFile>& keys) {
+    for (const KeyFile& k : keys) {
+      inputs.add_file(k.painting, concat("painting of keyframe ", k.frame));
+      inputs.add_file(k.mask, concat("mask of keyframe ", k.frame));
+    }
+  };
+  add_keys(config_.keys);
+  for (const LayerFile& l : config_.layers) {
+    add_keys(l.keys);
+    inputs.add_file(l.painting, concat("painting of layer '", l.name, "'"));
+  }
+  for (const TciaSegment& s : segments_)
+    for (int f : s.writes) {
+      inputs.refuse_file(frames_.output_path(f));
+      for (std::size_t l = 0; l < config_.layers.size(); ++l) inputs.refuse_file(layer_path(l, f));
+    }
 }
 
 void TciaJob::read_keys(const std::vector<KeyFile>& keys, std::vector<Image>& paintings,

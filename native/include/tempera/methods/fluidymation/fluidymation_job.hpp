@@ -57,6 +57,7 @@ class FluidymationJob : public FrameJob {
 
   const std::vector<int>& frames() const override { return config_.frames; }
   const std::vector<std::string>& warnings() const override { return warnings_; }
+  const JobInputs& inputs() const override { return inputs_; }
   std::string output_path(int frame) const override;
   // The guide the target's flow is read from (fluid_velocity or
   // velocity_forward); empty when it is made from the masks.
@@ -79,6 +80,7 @@ class FluidymationJob : public FrameJob {
 
   FluidymationJobConfig config_;
   std::vector<std::string> warnings_;
+  JobInputs inputs_;
   std::vector<Image> exemplar_, exemplar_masks_, target_masks_, target_flows_;
   std::string flow_guide_;
   std::vector<std::string> keys_;  // per frame index, chained

@@ -35,6 +35,7 @@ class LazyFluidsJob : public FrameJob {
 
   const std::vector<int>& frames() const override { return config_.frames; }
   const std::vector<std::string>& warnings() const override { return warnings_; }
+  const JobInputs& inputs() const override { return inputs_; }
   const std::vector<Image>& exemplar() const { return exemplar_; }
   std::string output_path(int frame) const override;
   std::string state_path(int frame) const;
@@ -58,6 +59,7 @@ class LazyFluidsJob : public FrameJob {
 
   LazyFluidsJobConfig config_;
   std::vector<std::string> warnings_, exemplar_files_;
+  JobInputs inputs_;
   std::vector<Image> exemplar_;
   std::vector<std::string> flow_guide_;  // per frame index: the guide read as flow ("" = zero)
   std::string settings_;

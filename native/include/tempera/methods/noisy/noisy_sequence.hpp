@@ -44,12 +44,14 @@ class NoisySequence : public FrameJob {
   // frame, the noise map (file or guide); ValueError / FileNotFoundError.
   explicit NoisySequence(NoisySequenceConfig config);
   const std::vector<int>& frames() const override { return config_.frames; }
+  const JobInputs& inputs() const override { return inputs_; }
   std::string output_path(int frame) const override;
   // Makes frames()[index] (or skips it when its output is current).
   // `progress` returning false cancels: CancelledError, nothing written.
   FrameResult run_frame(std::size_t index, const ProgressCallback& progress = {}) override;
 
  private:
+  void refuse_writing_on_inputs();
   std::string reference_path(int frame) const;
   std::string guide_path(int frame) const;
   bool map_is_guide() const { return !config_.noise_map.empty() && !map_file_; }
@@ -60,6 +62,7 @@ class NoisySequence : public FrameJob {
   std::string key(int frame) const;
 
   NoisySequenceConfig config_;
+  JobInputs inputs_;
   Image medium_;
   bool map_file_ = false;
   Image file_map_;

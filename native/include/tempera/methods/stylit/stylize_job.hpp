@@ -37,6 +37,7 @@ class StylizeJob : public FrameJob {
   const std::vector<int>& frames() const override { return config_.frames; }
   // What was fixed on the way: a resampled painting, a damaged resume record set aside.
   const std::vector<std::string>& warnings() const override { return warnings_; }
+  const JobInputs& inputs() const override { return inputs_; }
   std::string output_path(int frame) const override;
   std::string report_path() const;
   // The painting at the exemplar guides' size, the exemplar's guides and their
@@ -62,6 +63,7 @@ class StylizeJob : public FrameJob {
 
   StylizeJobConfig config_;
   std::vector<std::string> warnings_;
+  JobInputs inputs_;
   Image style_;  // the painting at the exemplar guides' size
   GuideFrame exemplar_;
   std::string exemplar_path_;

@@ -158,6 +158,7 @@ class TciaJob {
   Image exemplar_mask(const LayerFile& layer) const;
   std::vector<Image> run_layers(std::size_t index, const Shot& shot, const SweepCallback& sweeps);
 
+  void refuse_writing_on_keys() const;
   static TciaJobConfig checked(TciaJobConfig config);  // frames consecutive, keys sorted and in the shot
   bool is_read(int frame) const;                       // in the frames this job reads
   // Each key's painting and mask (empty outside the frames read, and for a whole key).
