@@ -207,6 +207,32 @@ Image read_image_layer(const std::string& path, const std::string& layer) {
   return read_image(path, selected);
 }
 
+namespace {
+
+// A written file that does not read back whole (a full disk or a file size
+// limit that the format's writer did not report) is never moved into place.
+// Read in bands of rows: memory stays a small part of the image.
+std::string unreadable_reason(const fs::path& file, const OIIO::ImageSpec& written) {
+  auto input = OIIO::ImageInput::open(file.string());
+  if (!input) {
+    const std::string why = OIIO::geterror();
+    return why.empty() ? "it does not read back" : why;
+  }
+  const OIIO::ImageSpec& spec = input->spec();
+  if (spec.width != written.width || spec.height != written.height || spec.nchannels != written.nchannels)
+    return "its header does not match what was written";
+  constexpr int kBand = 64;
+  std::vector<float> band(std::size_t(spec.width) * spec.nchannels * kBand);
+  for (int y = spec.y; y < spec.y + spec.height; y += kBand) {
+    const int end = std::min(y + kBand, spec.y + spec.height);
+    if (!input->read_scanlines(0, 0, y, end, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, band.data()))
+      return concat("it does not read back: ", input->geterror());
+  }
+  return "";
+}
+
+}  // namespace
+
 void write_image(const std::string& path, const ImageView& image,
                  const std::vector<std::string>& channel_names) {
   require_nonempty(image, concat("image to write to '", path, "'"));
@@ -244,10 +270,12 @@ void write_image(const std::string& path, const ImageView& image,
   }
   const bool ok = output->open(temp.string(), spec) &&
                   output->write_image(OIIO::TypeDesc::FLOAT, pixels) && output->close();
-  if (!ok) {
-    std::string why = output->geterror();
+  const std::string output_error = ok ? "" : output->geterror();
+  output.reset();  // the file is closed before it is read back
+  std::string why = ok ? unreadable_reason(temp, spec) : output_error;
+  if (!why.empty()) {
     fs::remove(temp, ec);
-    throw IoError(concat("cannot write '", path, "': ", why));
+    throw IoError(concat("cannot write '", path, "': ", why, ok ? " (is the disk full?)" : ""));
   }
   fs::rename(temp, target, ec);
   if (ec) {

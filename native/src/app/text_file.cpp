@@ -16,7 +16,8 @@ void write_text_atomically(const std::string& path, const std::string& text, con
     std::ofstream out(temp);
     out << text;
     out.close();
-    if (!out) {
+    // A full disk may only show as a short file: the size is checked too.
+    if (!out || fs::file_size(temp, ec) != text.size() || ec) {
       fs::remove(temp, ec);
       throw IoError(concat("cannot write ", what, " '", path, "'"));
     }

@@ -46,8 +46,9 @@ Image read_image(const std::string& path, const std::vector<std::string>& channe
 // the file has when there is no such layer.
 Image read_image_layer(const std::string& path, const std::string& layer);
 
-// Writes atomically: a temporary file in the same folder, then a rename, so a
-// crash or cancel never leaves a half-written `path`. 8-bit formats (PNG, JPEG)
+// Writes atomically: a temporary file in the same folder, read back whole,
+// then a rename, so a crash, a cancel or a full disk never leaves a
+// half-written `path` (IoError, and the earlier file stays). 8-bit formats (PNG, JPEG)
 // get values clamped to [0, 1]; EXR and TIFF keep float.
 void write_image(const std::string& path, const ImageView& image,
                  const std::vector<std::string>& channel_names = {});
