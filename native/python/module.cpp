@@ -5,6 +5,7 @@
 
 #include "numpy_bridge.hpp"
 #include "tempera/app/image_io.hpp"
+#include "tempera/app/record.hpp"
 
 namespace py = pybind11;
 using namespace tempera;
@@ -73,6 +74,24 @@ void bind_io(py::module_& m) {
       "Images declaring more pixels than this are refused (OSError) before their pixels are read; "
       "default 50 Mpix or $TEMPERA_MAX_IMAGE_PIXELS.");
   m.def("max_image_pixels", &max_image_pixels, "The current image size limit in pixels.");
+  m.def(
+      "write_record",
+      [](const std::string& record, const std::string& format, const std::string& key,
+         const std::vector<std::string>& files) {
+        py::gil_scoped_release release;  // checksums every file
+        write_record(record, format, key, files);
+      },
+      py::arg("record"), py::arg("format"), py::arg("key"), py::arg("files"),
+      "The job core's resume record (app/record.hpp): format, key, and each file's size and checksum; atomic.");
+  m.def(
+      "record_current",
+      [](const std::string& record, const std::string& format, const std::string& key,
+         const std::vector<std::string>& files) {
+        py::gil_scoped_release release;
+        return record_current(record, format, key, files);
+      },
+      py::arg("record"), py::arg("format"), py::arg("key"), py::arg("files"),
+      "True when the record has this format and key and every file is unchanged.");
 }
 
 }  // namespace

@@ -160,3 +160,64 @@ def test_native_cli_names_where_rigid_runs(cli_path, inputs):
     result = subprocess.run([str(cli_path), "stylize", "--method", "rigid", "--guides", str(inputs / "cache"),
                              "--k", "2"], capture_output=True, text=True)
     assert result.returncode == 2 and "python -m tempera stylize --method rigid" in result.stderr
+
+
+# --------------------------------------------------------------------------- issue 31, items 2 and 5
+
+def test_no_file_is_deleted_by_a_new_folder_or_new_settings(inputs, capsys):
+    """With no record yet, or other settings, `tempera rigid` deleted every
+    frame_*.png in --out, even outside --frames (18 of a user's 20 files)."""
+    out = inputs / "out"
+    out.mkdir()
+    rng = np.random.default_rng(3)
+    for f in range(1, 21):
+        _native.write_image(str(out / f"frame_{f:04d}.png"), rng.random((8, 8, 4)).astype(np.float32), [])
+    theirs = {p.name: p.read_bytes() for p in out.glob("frame_*.png")}
+    assert _run(inputs, "--k", "2", "--frames", "3-4") == 0
+    assert "2 frames written" in capsys.readouterr().out
+    ours = {f"frame_{f:04d}.png" for f in (3, 4)}
+    assert {n: b for n, b in theirs.items() if n not in ours} == {
+        p.name: p.read_bytes() for p in out.glob("frame_*.png") if p.name not in ours}
+    made = {n: (out / n).read_bytes() for n in ours}
+    # Other settings, other frames: the frames of the first settings stay too.
+    assert _run(inputs, "--k", "1", "--frames", "5-6") == 0
+    assert {n: (out / n).read_bytes() for n in ours} == made
+    assert all((out / n).read_bytes() == theirs[n] for n in theirs if n not in ours | {"frame_0005.png", "frame_0006.png"})
+    # Back to the first settings: their frames are still current.
+    assert _run(inputs, "--k", "2", "--frames", "3-4") == 0
+    assert "0 frames written, 2 kept" in capsys.readouterr().out
+
+
+def test_frames_are_on_disk_as_they_are_drawn_and_kill_9_resumes(inputs):
+    """The frames used to be kept in memory and written at the end: kill -9
+    at frame 154 of 200 left none. Now each chunk is written and recorded as
+    soon as it is drawn, and the rerun equals an uninterrupted run."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    def command(out):
+        return [sys.executable, "-m", "tempera", "rigid", "--cache", str(inputs / "cache"), "--exemplar",
+                str(inputs / "ex"), "--out", str(out), "--k", "2"]
+
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[2] / "addon"))
+    whole = subprocess.run(command(inputs / "whole"), capture_output=True, text=True, env=env, timeout=300)
+    assert whole.returncode == 0, whole.stderr
+    process = subprocess.Popen(command(inputs / "killed"), stderr=subprocess.PIPE, stdout=subprocess.DEVNULL,
+                               text=True, env=env)
+    for line in process.stderr:  # "tempera rigid: frame N" as each frame is drawn
+        if line.strip() == "tempera rigid: frame 13":  # the second chunk is being drawn
+            process.send_signal(signal.SIGKILL)
+            break
+    process.wait(timeout=60)
+    assert process.returncode == -signal.SIGKILL
+    kept = sorted(p.name for p in (inputs / "killed").glob("frame_*.png"))
+    assert len(kept) >= 8 and kept[:8] == [f"frame_{f:04d}.png" for f in range(1, 9)]
+    again = subprocess.run(command(inputs / "killed"), capture_output=True, text=True, env=env, timeout=300)
+    assert again.returncode == 0, again.stderr
+    assert f"{24 - len(kept)} frames written, {len(kept)} kept" in again.stdout
+    for f in range(1, 25):
+        name = f"frame_{f:04d}.png"
+        assert (inputs / "killed" / name).read_bytes() == (inputs / "whole" / name).read_bytes(), name

@@ -11,17 +11,19 @@ CACHE holds tracks.json (tempera.methods.rigid.rigid_tracks) of the target simul
 its manifest (the frame size). Each EXEMPLAR folder holds the source
 simulation's tracks.json and its drawn frames, drawn/0001.png ... (RGBA ink,
 numbered from the tracks' frame_start; every frame drawn). OUT receives
-frame_0001.png ... (RGBA, straight alpha; --paper: opaque, on paper) and
-rigid.json, the settings key: a rerun with the same inputs and options keeps
-the frames already written (resume), Ctrl-C stops between frames with every
-written frame complete (each is written to a temporary file, then renamed).
+frame_0001.png ... (RGBA, straight alpha; --paper: opaque, on paper), each
+written as soon as it is drawn (to a temporary file, then renamed), then its
+record (the job core's format, OUT/tempera_rigid/frame_0001.txt: the key of
+the inputs and options, the file's size and checksum). A rerun keeps every
+frame whose record is current (resume, also after kill -9) and makes the
+others; Ctrl-C stops between frames. No file is ever deleted: frames of other
+settings are replaced only when their frame is made again.
 """
 from __future__ import annotations
 
 import argparse
 import hashlib
 import json
-import os
 import sys
 from pathlib import Path
 
@@ -29,10 +31,14 @@ import numpy as np
 
 from ... import _native
 from . import rigid, rigid_strokes, rigid_tracks
+from ...app import record
 from ...app.command import run_command
 from ...app.frames import parse_frames
 
 PAPER = (0.97, 0.96, 0.92)
+CHUNK = 8  # frames drawn at once: memory holds this many, and Esc or kill -9 loses at most these
+RECORDS_DIR = "tempera_rigid"
+RECORD_FORMAT = "tempera-rigid 1"
 OPTION_TABLES = (rigid.RigidOptions.table(), rigid.QuadraticFitOptions.table())
 
 
@@ -123,14 +129,8 @@ def strokes_stamp(spec):
     return spec if spec in (None, "", rigid_strokes.GENERATED) else _stamp(spec)
 
 
-def _write_atomic(path, write):
-    tmp = path.with_name(f".{path.stem}.partial{path.suffix}")
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+def chunks(items, size):
+    return [items[i:i + size] for i in range(0, len(items), size)]
 
 
 def _frame_indices(text, start, count):
@@ -156,31 +156,32 @@ def run(args):
     strokes = rigid_strokes.load_stroke_exemplar(args.strokes) if args.strokes else None
     exemplars = [_read_exemplar(d, args.shape, fit_values) for d in args.exemplar]
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    key = _settings_key(args, [d for _, d in exemplars], {**rigid_values, **fit_values})
-    state = out / "rigid.json"
-    previous = json.loads(state.read_text()).get("settings") if state.is_file() else None
+    settings = _settings_key(args, [d for _, d in exemplars], {**rigid_values, **fit_values})
     wanted = _frame_indices(args.frames, tracks["frame_start"], len(target["centre"]))
-    paths = {i: out / f"frame_{tracks['frame_start'] + i:04d}.png" for i in wanted}
-    todo = [i for i in wanted if previous != key or not paths[i].is_file()]
-    if previous != key:  # frames of other settings must not pass for these on a later run
-        for stale in out.glob("frame_*.png"):
-            stale.unlink()
-    _write_atomic(state, lambda p: p.write_text(json.dumps({"settings": key, "object": name}, indent=1)))
+    frame_of = {i: tracks["frame_start"] + i for i in wanted}
+    paths = {i: out / f"frame_{frame_of[i]:04d}.png" for i in wanted}
+    records = {i: out / RECORDS_DIR / f"frame_{frame_of[i]:04d}.txt" for i in wanted}
+    keys = {i: record.unit_key(settings, name, frame_of[i]) for i in wanted}
+    todo = [i for i in wanted if not record.is_current(records[i], RECORD_FORMAT, keys[i], [paths[i]])]
+    out.mkdir(parents=True, exist_ok=True)
 
     def progress(f):
         print(f"tempera rigid: frame {tracks['frame_start'] + f}", file=sys.stderr, flush=True)
         return True
 
-    frames = rigid.stylize([e for e, _ in exemplars], target, width, height, progress=progress, only=todo,
-                           **rigid_values) if todo else []
-    for i in todo:
-        rgba = frames[i][0] if strokes is None else rigid_strokes.restyle(frames[i][0], strokes, rigid_values)
-        if args.paper:
-            a = rgba[:, :, 3:4]
-            rgba = np.concatenate([rgba[:, :, :3] * a + np.asarray(PAPER, np.float32) * (1 - a),
-                                   np.ones_like(a)], axis=2)
-        _write_atomic(paths[i], lambda p, img=np.ascontiguousarray(rgba, np.float32): _native.write_image(str(p), img, []))
+    # A chunk at a time: memory holds a few frames, and each is on disk (and
+    # recorded) as soon as it is drawn. A chunk's frames equal an unchunked run's.
+    for chunk in chunks(todo, CHUNK):
+        frames = rigid.stylize([e for e, _ in exemplars], target, width, height, progress=progress, only=chunk,
+                               **rigid_values)
+        for i in chunk:
+            rgba = frames[i][0] if strokes is None else rigid_strokes.restyle(frames[i][0], strokes, rigid_values)
+            if args.paper:
+                a = rgba[:, :, 3:4]
+                rgba = np.concatenate([rgba[:, :, :3] * a + np.asarray(PAPER, np.float32) * (1 - a),
+                                       np.ones_like(a)], axis=2)
+            _native.write_image(str(paths[i]), np.ascontiguousarray(rgba, np.float32), [])
+            record.write(records[i], RECORD_FORMAT, keys[i], [paths[i]])
     print(f"tempera rigid: {len(todo)} frames written, {len(paths) - len(todo)} kept, in {out}")
     return 0
 

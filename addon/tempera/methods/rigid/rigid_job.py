@@ -1,6 +1,6 @@
 """The rigid-body method (tempera.methods.rigid.rigid) as a job of steps, for the panel's
 "Rigid Bodies (hand-drawn)" method; no bpy. OUT is the method's own folder
-(the panel's Output Folder/rigid): files of other settings there are removed.
+(the panel's Output Folder/rigid).
 
     job = RigidJob(cache, examples, out, frames, objects=None, shape="circle", paper=False, strokes=None,
                    **rigid_options)
@@ -15,9 +15,11 @@ RigidOptions keywords (k, augment, damp, stroke_weight...). The steps: one per t
 (the object's layer, OUT/layers/<object>/frame_NNNN.png, RGBA), then one per
 chunk compositing the layers by depth, far to near, into OUT/frames (RGBA
 to lay over the render, or opaque on paper). Every file is written to a
-temporary name and renamed; a step whose files exist with the same settings
-(OUT/rigid.json) is skipped, so a rerun resumes where a stopped run ended,
-and a step stopped by its progress callback writes nothing.
+temporary name and renamed, then the step's record (the job core's format,
+OUT/tempera_rigid/): a step whose record is current (same settings, files
+unchanged) is kept, so a rerun resumes where a stopped run ended, and a step
+stopped by its progress callback writes nothing. Files of other settings are
+never deleted; a step of these settings replaces them.
 """
 from __future__ import annotations
 
@@ -29,13 +31,11 @@ import numpy as np
 
 from ... import _native
 from . import rigid, rigid_cli, rigid_strokes, rigid_tracks
+from ...app import record
 
-CHUNK = 8  # frames per step: Esc and resume lose at most this many frames of one object
+CHUNK = rigid_cli.CHUNK
 LAYERS_DIR = "layers"
 FRAMES_DIR = "frames"
-STATE = "rigid.json"
-
-
 def exemplar_folders(examples):
     """The exemplar folders of EXAMPLES: itself when it holds tracks.json,
     else its subfolders that do (sorted); none is an error naming the folder."""
@@ -49,10 +49,6 @@ def exemplar_folders(examples):
         raise ValueError(f"'{root}' holds no example: an example is a folder with the source simulation's "
                          f"{rigid_tracks.TRACKS_NAME} and its drawn frames drawn/NNNN.png")
     return found
-
-
-def _chunks(items, size):
-    return [items[i:i + size] for i in range(0, len(items), size)]
 
 
 def _over(below, rgba):
@@ -89,10 +85,9 @@ class RigidJob:
         self.strokes = strokes or None
         self._stroke_exemplar = rigid_strokes.load_stroke_exemplar(strokes) if self.strokes else None
         self.key = self._settings_key()
-        self.steps = [(name, c) for name in self.objects for c in _chunks(self.frames, chunk)]
-        self.steps += [(None, c) for c in _chunks(self.frames, chunk)]  # None: composite
+        self.steps = [(name, c) for name in self.objects for c in rigid_cli.chunks(self.frames, chunk)]
+        self.steps += [(None, c) for c in rigid_cli.chunks(self.frames, chunk)]  # None: composite
         self._exemplars = None  # fitted once, by the first step that needs them
-        self._keep = self._resumable()
 
     @property
     def total(self):
@@ -115,20 +110,14 @@ class RigidJob:
             parts += sorted(rigid_cli._stamp(p) for p in (d / "drawn").glob("*.png"))
         return hashlib.sha256("\n".join(parts).encode()).hexdigest()
 
-    def _resumable(self):
-        """True when OUT holds files of these settings (they are kept); else
-        the settings are recorded, and every file is made anew."""
-        state = self.out / STATE
-        previous = json.loads(state.read_text()).get("settings") if state.is_file() else None
-        if previous == self.key:
-            return True
-        # Files of other settings go first: a run stopped after recording
-        # these settings must not keep them on resume.
-        for stale in [*self.out.glob(f"{LAYERS_DIR}/*/frame_*.png"), *self.out.glob(f"{FRAMES_DIR}/frame_*.png")]:
-            stale.unlink()
-        self.out.mkdir(parents=True, exist_ok=True)
-        rigid_cli._write_atomic(state, lambda p: p.write_text(json.dumps({"settings": self.key}, indent=1)))
-        return False
+    def record_path(self, step):
+        name, frames = self.steps[step]
+        unit = "composite" if name is None else "layer_" + name.replace("/", "_")
+        return self.out / rigid_cli.RECORDS_DIR / f"{unit}_{frames[0]:04d}-{frames[-1]:04d}.txt"
+
+    def _step_key(self, step):
+        name, frames = self.steps[step]
+        return record.unit_key(self.key, name, frames)
 
     def _paths(self, step):
         name, frames = self.steps[step]
@@ -141,7 +130,7 @@ class RigidJob:
         name, frames = self.steps[step]
         paths = self._paths(step)
         result = {"object": name, "frames": frames, "status": "kept"}
-        if self._keep and all(p.is_file() for p in paths):
+        if record.is_current(self.record_path(step), rigid_cli.RECORD_FORMAT, self._step_key(step), paths):
             return result
         if name is None:
             self._composite(frames, paths)
@@ -149,6 +138,7 @@ class RigidJob:
         else:
             self._stylize(name, frames, paths, progress)
             result["status"] = "stylized"
+        record.write(self.record_path(step), rigid_cli.RECORD_FORMAT, self._step_key(step), paths)
         return result
 
     def _fitted(self):
@@ -177,7 +167,7 @@ class RigidJob:
         paths[0].parent.mkdir(parents=True, exist_ok=True)
         for layer, path in zip(layers, paths):
             rgba = np.ascontiguousarray(layer, np.float32)
-            rigid_cli._write_atomic(path, lambda p, img=rgba: _native.write_image(str(p), img, []))
+            _native.write_image(str(path), rgba, [])
 
     def depth_order(self, frame):
         """The objects far to near at `frame` (the tracks' camera depth;
@@ -195,4 +185,4 @@ class RigidJob:
             for name in self.depth_order(frame):
                 layer = _native.read_image(str(self.layer_path(name, frame)), None)
                 img = _over(img, np.asarray(layer, np.float32))
-            rigid_cli._write_atomic(path, lambda p, im=np.ascontiguousarray(img): _native.write_image(str(p), im, []))
+            _native.write_image(str(path), np.ascontiguousarray(img), [])
