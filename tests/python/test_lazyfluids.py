@@ -119,9 +119,22 @@ def test_job_checks_its_inputs(cache):
         lazyfluids.FluidJob(cache / "rgb.png", cache / "cache", [1, 2], cache / "o")
     with pytest.raises(FileNotFoundError):
         lazyfluids.FluidJob(cache / "missing.png", cache / "cache", [1, 2], cache / "o")
-    job = lazyfluids.FluidJob(cache / "smoke.png", cache / "cache", [1, 2], cache / "o", **FAST)
-    with pytest.raises(ValueError, match="not done yet"):
-        job.run_frame(1)
+
+
+def test_a_frame_asked_for_first_makes_its_predecessors_like_fluidymation(cache):
+    """Frames are chained (app/frame_job.hpp ChainedFrameJob): asking for the
+    last frame of a fresh job makes the ones before it first, in order, as
+    Fluidymation does, and the result equals an in-order run."""
+    job = lazyfluids.FluidJob(cache / "smoke.png", cache / "cache", [1, 2, 3], cache / "o", **FAST)
+    calls = []
+    assert job.run_frame(2, progress=lambda f: calls.append(f) or True)["status"] == "stylized"
+    assert calls == sorted(calls) and calls[-1] <= 1.0 and calls[0] < 1 / 3  # one bar over the three frames
+    assert [job.run_frame(i)["status"] for i in range(3)] == ["skipped"] * 3
+    in_order = lazyfluids.FluidJob(cache / "smoke.png", cache / "cache", [1, 2, 3], cache / "in_order", **FAST)
+    assert run_all(in_order) == ["stylized"] * 3
+    for f in (1, 2, 3):
+        name = f"frame_{f:04d}.png"
+        assert (cache / "o" / name).read_bytes() == (cache / "in_order" / name).read_bytes()
 
 
 def test_video_exemplar_folder(cache):

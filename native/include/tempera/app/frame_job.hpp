@@ -29,4 +29,26 @@ class FrameJob {
   virtual const std::vector<std::string>& warnings() const;
 };
 
+// The unit "chained frame": a frame that continues the one before
+// (LazyFluids advects the previous state, Fluidymation starts from the
+// previous matches). The core makes a frame's missing predecessors first, in
+// order, so that any frame may be asked for (the panel's "this frame", a
+// script, a resumed run) and the result equals an uninterrupted run's.
+class ChainedFrameJob : public FrameJob {
+ public:
+  // Skips frames()[index] when current; else makes the frames before it that
+  // are neither current nor made by this job, then it. Cancelling in any of
+  // them cancels the call (CancelledError); the frames finished stay.
+  FrameResult run_frame(std::size_t index, const ProgressCallback& progress = {}) final;
+
+ protected:
+  // The frame's output and record are current on disk (and resume is on).
+  virtual bool is_current(std::size_t index) const = 0;
+  // Makes frames()[index], whose predecessor is current or was just made.
+  virtual FrameResult make_frame(std::size_t index, const ProgressCallback& progress) = 0;
+
+ private:
+  std::vector<bool> made_;  // per index: made by this job, so usable whatever resume says
+};
+
 }  // namespace tempera

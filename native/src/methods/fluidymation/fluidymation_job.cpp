@@ -159,15 +159,17 @@ bool FluidymationJob::is_current(std::size_t index) const {
   return config_.resume && record_current(record_path(f), kRecordFormat, keys_[index], {output_path(f), state_path(f)});
 }
 
+FluidSequence FluidymationJob::sequence() const {
+  FluidSequence seq;
+  for (const Image& i : exemplar_) seq.exemplar.push_back(i.view());
+  for (const Image& i : exemplar_masks_) seq.exemplar_masks.push_back(i.view());
+  for (const Image& i : target_masks_) seq.target_masks.push_back(i.view());
+  for (const Image& i : target_flows_) seq.target_flows.push_back(i.view());
+  return seq;
+}
+
 const Fluidymation& FluidymationJob::method() {
-  if (!method_) {
-    FluidSequence seq;
-    for (const Image& i : exemplar_) seq.exemplar.push_back(i.view());
-    for (const Image& i : exemplar_masks_) seq.exemplar_masks.push_back(i.view());
-    for (const Image& i : target_masks_) seq.target_masks.push_back(i.view());
-    for (const Image& i : target_flows_) seq.target_flows.push_back(i.view());
-    method_ = std::make_unique<Fluidymation>(seq, config_.options);
-  }
+  if (!method_) method_ = std::make_unique<Fluidymation>(sequence(), config_.options);
   return *method_;
 }
 
@@ -184,39 +186,19 @@ void FluidymationJob::write_frame(std::size_t index, const FluidFrame& r) {
   write_record(record_path(f), kRecordFormat, keys_[index], {output_path(f), state_path(f)});
 }
 
-FrameResult FluidymationJob::run_frame(std::size_t index, const ProgressCallback& progress) {
-  if (index >= config_.frames.size())
-    throw ValueError(concat("frame index ", index, " is outside the job's ", config_.frames.size(), " frames"));
+FrameResult FluidymationJob::make_frame(std::size_t index, const ProgressCallback& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   FrameResult result;
   result.frame = config_.frames[index];
   result.path = output_path(result.frame);
-  result.status = "skipped";
-  if (is_current(index)) return result;
   if (config_.options.bidirectional) {
-    if (both_ways_.empty()) {
-      FluidSequence seq;
-      for (const Image& i : exemplar_) seq.exemplar.push_back(i.view());
-      for (const Image& i : exemplar_masks_) seq.exemplar_masks.push_back(i.view());
-      for (const Image& i : target_masks_) seq.target_masks.push_back(i.view());
-      for (const Image& i : target_flows_) seq.target_flows.push_back(i.view());
-      both_ways_ = stylize_fluid_sequence(seq, config_.options, progress);
-    }
+    if (both_ways_.empty()) both_ways_ = stylize_fluid_sequence(sequence(), config_.options, progress);
     write_frame(index, both_ways_[index]);
   } else {
-    const FluidNnf* previous = nullptr;
     FluidNnf loaded;
-    if (index > 0) {
-      if (last_index_ == index - 1) {
-        previous = &last_nnf_;
-      } else if (is_current(index - 1)) {
-        loaded = read_image(state_path(config_.frames[index - 1]), {"i", "x", "y", "phi"});
-        previous = &loaded;
-      } else {
-        run_frame(index - 1, progress);  // the frames before, in order; cancelling there cancels this one too
-        previous = &last_nnf_;
-      }
-    }
+    if (index > 0 && last_index_ != index - 1)  // the predecessor is current on disk (ChainedFrameJob)
+      loaded = read_image(state_path(config_.frames[index - 1]), {"i", "x", "y", "phi"});
+    const FluidNnf* previous = index == 0 ? nullptr : last_index_ == index - 1 ? &last_nnf_ : &loaded;
     FluidFrame r = method().solve_frame(int(index), previous, progress);
     write_frame(index, r);
     last_nnf_ = std::move(r.nnf);

@@ -183,7 +183,8 @@ std::string LazyFluidsJob::frame_key(std::size_t index) const {
 
 bool LazyFluidsJob::is_current(std::size_t index) const {
   const int f = config_.frames[index];
-  return record_current(record_path(f), kRecordFormat, frame_key(index), {output_path(f), state_path(f)});
+  return config_.resume &&
+         record_current(record_path(f), kRecordFormat, frame_key(index), {output_path(f), state_path(f)});
 }
 
 Image LazyFluidsJob::read_flow(int frame) const {
@@ -196,19 +197,11 @@ Image LazyFluidsJob::read_flow(int frame) const {
   return Image::copy_of(GuideFrame::read(guide_path(frame), {guide}).get(guide).view());
 }
 
-FrameResult LazyFluidsJob::run_frame(std::size_t index, const ProgressCallback& progress) {
-  if (index >= config_.frames.size())
-    throw ValueError(concat("frame index ", index, " is out of range (", config_.frames.size(), " frames)"));
+FrameResult LazyFluidsJob::make_frame(std::size_t index, const ProgressCallback& progress) {
   const int f = config_.frames[index];
   FrameResult result;
   result.frame = f;
   result.path = output_path(f);
-  if (index > 0 && !is_current(index - 1))
-    throw ValueError(concat("frame ", f, " continues frame ", f - 1, ", which is not done yet: run it first"));
-  if (config_.resume && is_current(index)) {
-    result.status = "skipped";
-    return result;
-  }
   const auto t0 = std::chrono::steady_clock::now();
   const Image alpha = Image::copy_of(GuideFrame::read(guide_path(f), {"alpha"}).get("alpha").view());
   // The exact float state, never the 8-bit output: resumed == uninterrupted.

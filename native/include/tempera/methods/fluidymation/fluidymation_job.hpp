@@ -49,7 +49,7 @@ struct FluidymationJobConfig {
   FluidymationOptions options = default_fluidymation_options();
 };
 
-class FluidymationJob : public FrameJob {
+class FluidymationJob : public ChainedFrameJob {
  public:
   // Reads and checks every input (FileNotFoundError, ValueError).
   explicit FluidymationJob(FluidymationJobConfig config);
@@ -63,18 +63,18 @@ class FluidymationJob : public FrameJob {
   // velocity_forward); empty when it is made from the masks.
   const std::string& flow_guide() const { return flow_guide_; }
 
-  // Stylizes frames()[index] (solving earlier frames first when their
-  // matches are not on disk), or skips it when current. progress(fraction)
-  // returning false cancels: CancelledError, nothing of the frame written.
-  FrameResult run_frame(std::size_t index, const ProgressCallback& progress = {}) override;
-
   // The first exemplar frame followed by the frames written so far.
   void write_contact_sheet(const std::string& path, int columns = 0) const;
 
  private:
   std::string state_path(int frame) const;
   std::string record_path(int frame) const;
-  bool is_current(std::size_t index) const;
+  bool is_current(std::size_t index) const override;
+  // Stylizes frames()[index] from the previous frame's matches (in memory, or
+  // read back). progress(fraction) returning false cancels: CancelledError,
+  // nothing of the frame written.
+  FrameResult make_frame(std::size_t index, const ProgressCallback& progress) override;
+  FluidSequence sequence() const;  // views of the exemplar and the target
   const Fluidymation& method();
   void write_frame(std::size_t index, const FluidFrame& frame);
 

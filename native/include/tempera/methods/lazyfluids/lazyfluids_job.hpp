@@ -1,5 +1,5 @@
 #pragma once
-// LazyFluids (lazyfluids.hpp) as a job over a guide cache: `tempera stylize
+// LazyFluids (lazyfluids.hpp) as a job of chained frames over a guide cache: `tempera stylize
 // --method lazyfluids` and the Python FluidJob. The target alpha of frame f
 // is the cache's `alpha`, its flow `fluid_velocity` (falling back to
 // `velocity_forward`, else zero, with a warning). The exemplar is an RGBA
@@ -28,7 +28,7 @@ struct LazyFluidsJobConfig {
   LazyFluidsOptions options = default_lazyfluids_options();
 };
 
-class LazyFluidsJob : public FrameJob {
+class LazyFluidsJob : public ChainedFrameJob {
  public:
   // Validates everything up front (files, guides, sizes, options).
   explicit LazyFluidsJob(LazyFluidsJobConfig config);
@@ -42,18 +42,16 @@ class LazyFluidsJob : public FrameJob {
   std::string record_path(int frame) const;
   std::string field_path(int frame) const;  // warm start: the frame's final matches
 
-  // Stylizes frames()[index] (or skips it when its record is current); the
-  // frame before must be done. `progress` returning false cancels:
-  // CancelledError, nothing written.
-  FrameResult run_frame(std::size_t index, const ProgressCallback& progress = {}) override;
-
   // The exemplar followed by the frames written so far.
   void write_contact_sheet(const std::string& path, int columns = 0) const;
 
  private:
   std::string guide_path(int frame) const;
   std::string frame_key(std::size_t index) const;
-  bool is_current(std::size_t index) const;
+  bool is_current(std::size_t index) const override;
+  // Stylizes frames()[index] from the previous frame's state. `progress`
+  // returning false cancels: CancelledError, nothing written.
+  FrameResult make_frame(std::size_t index, const ProgressCallback& progress) override;
   Image read_flow(int frame) const;
   void write_frame(std::size_t index, const FluidFrameResult& frame) const;
 
