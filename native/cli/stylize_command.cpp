@@ -454,7 +454,7 @@ int run_stylize(const Args& args) {
       return 0;
     }
     StylizeJobConfig config;
-    config.style = o.exemplar;
+    config.exemplar = o.exemplar;
     config.exemplar_guides = o.exemplar_guides;
     config.exemplar_frame = o.exemplar_frame;
     config.guides = o.guides;

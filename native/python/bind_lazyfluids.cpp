@@ -61,7 +61,9 @@ void bind_lazyfluids(py::module_& m) {
       .def(py::init([](const std::string& exemplar, const std::string& guides, const std::vector<int>& frames,
                        const std::string& out, const std::string& format, bool resume,
                        const LazyFluidsOptions& options) {
-             LazyFluidsJobConfig c{exemplar, guides, frames, out, format, resume, options};
+             LazyFluidsJobConfig c;
+             c.exemplar = exemplar, c.guides = guides, c.frames = frames, c.out = out, c.format = format;
+             c.resume = resume, c.options = options;
              py::gil_scoped_release release;  // reads the exemplar and cache headers
              return std::make_unique<LazyFluidsJob>(std::move(c));
            }),

@@ -109,7 +109,7 @@ StylizeJobConfig parse_job_config(const py::dict& d) {
     if (!d.contains(key)) throw ValueError(concat("StylizeJob config needs '", key, "'"));
   StylizeJobConfig c;
   const std::string what = "StylizeJob config";
-  c.style = get<std::string>(d, "style", what);
+  c.exemplar = get<std::string>(d, "style", what);
   c.exemplar_guides = get<std::string>(d, "exemplar_guides", what);
   if (d.contains("exemplar_frame") && !d["exemplar_frame"].is_none()) c.exemplar_frame = get<int>(d, "exemplar_frame", what);
   c.guides = get<std::string>(d, "guides", what);

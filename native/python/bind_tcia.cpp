@@ -26,7 +26,7 @@ ImageView keep_view(const py::handle& array, const std::string& what, std::vecto
 TciaJobConfig job_config(const py::dict& d, const TciaOptions& options) {
   TciaJobConfig c;
   StylizeJobConfig& f = c.frames;
-  f.style = d["style"].cast<std::string>();
+  f.exemplar = d["style"].cast<std::string>();
   f.exemplar_guides = d["exemplar_guides"].cast<std::string>();
   if (!d["exemplar_frame"].is_none()) f.exemplar_frame = d["exemplar_frame"].cast<int>();
   f.guides = d["guides"].cast<std::string>();

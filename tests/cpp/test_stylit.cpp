@@ -122,7 +122,7 @@ struct JobFiles {
   ~JobFiles() { fs::remove_all(root); }
   StylizeJobConfig config(const std::string& out = "out") const {
     StylizeJobConfig c;
-    c.style = (root / "paint.png").string();
+    c.exemplar = (root / "paint.png").string();
     c.exemplar_guides = (root / "exemplar").string();
     c.guides = (root / "cache").string();
     c.frames = {1, 2, 3};
@@ -324,7 +324,7 @@ TEST(StylizeJob, PaintingSizeIsCheckedAndResampledWhenTheAspectFits) {
   nan_paint.at(3, 4, 1) = NAN;
   write_image((files.root / "paint.exr").string(), nan_paint.view());
   StylizeJobConfig c = files.config();
-  c.style = (files.root / "paint.exr").string();
+  c.exemplar = (files.root / "paint.exr").string();
   EXPECT_THROW(StylizeJob{c}, ValueError);
 }
 
@@ -339,7 +339,7 @@ TEST(StylizeJob, MissingInputsAreNamed) {
     EXPECT_NE(std::string(e.what()).find("frame(s) 9"), std::string::npos) << e.what();
   }
   c = files.config();
-  c.style = (files.root / "none.png").string();
+  c.exemplar = (files.root / "none.png").string();
   EXPECT_THROW(StylizeJob{c}, FileNotFoundError);
   c = files.config();
   c.stylit.weights.back().second = 1.0f;  // LD12E, not in this cache

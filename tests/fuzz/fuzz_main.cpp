@@ -217,7 +217,7 @@ void fuzz_sidecar(FuzzRng& rng, const std::function<bool()>& more) {
   write_image((root / "guides" / "frame_0001.exr").string(), test_image(12, 10, int(names.size())).view(), names);
   write_image((root / "paint.png").string(), test_image(12, 10, 3).view());
   StylizeJobConfig config;
-  config.style = (root / "paint.png").string();
+  config.exemplar = (root / "paint.png").string();
   config.exemplar_guides = (root / "exemplar").string();
   config.guides = (root / "guides").string();
   config.frames = {1};

@@ -77,13 +77,9 @@ std::string pick_flow_guide(FlowSource flow, const ImageFileInfo& info, const st
 
 FluidymationJob::FluidymationJob(FluidymationJobConfig c) : config_(std::move(c)) {
   validate(config_.options);
-  if (config_.format != "png" && config_.format != "exr")
-    throw ValueError(concat("unknown format '", config_.format, "' (choose png or exr)"));
+  check_job_config(config_, FrameOrder::Consecutive,
+                   "Fluidymation needs consecutive frames (each starts from the one before)");
   if (config_.frames.size() < 2) throw ValueError("Fluidymation needs at least 2 consecutive frames");
-  for (std::size_t i = 1; i < config_.frames.size(); ++i)
-    if (config_.frames[i] != config_.frames[i - 1] + 1)
-      throw ValueError(concat("Fluidymation needs consecutive frames (each starts from the one before); frame ",
-                              config_.frames[i - 1], " is followed by ", config_.frames[i]));
   if (config_.target_mask != "alpha" && config_.target_mask.rfind("mask.OB_", 0) != 0 &&
       config_.target_mask.rfind("mask.CO_", 0) != 0)
     throw ValueError(concat("target mask '", config_.target_mask, "' must be alpha, mask.OB_<object> or mask.CO_<collection>"));

@@ -81,13 +81,8 @@ OffsetField field_from_positions(const Image& positions) {
 
 void check_config(const LazyFluidsJobConfig& c) {
   validate(c.options);
-  if (c.format != "png" && c.format != "exr") throw ValueError(concat("format must be png or exr, got '", c.format, "'"));
-  if (c.frames.empty()) throw ValueError("no frames to stylize");
-  for (std::size_t i = 1; i < c.frames.size(); ++i)
-    if (c.frames[i] != c.frames[i - 1] + 1)
-      throw ValueError(concat("LazyFluids needs consecutive frames (each is advected from the one before); frame ",
-                              c.frames[i - 1], " is followed by ", c.frames[i]));
-  if (c.out.empty()) throw ValueError("the output folder is required");
+  check_job_config(c, FrameOrder::Consecutive,
+                   "LazyFluids needs consecutive frames (each is advected from the one before)");
   std::error_code ec;
   if (!fs::is_directory(c.guides, ec)) throw FileNotFoundError(concat("guide cache folder not found: '", c.guides, "'"));
 }

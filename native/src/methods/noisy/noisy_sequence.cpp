@@ -29,10 +29,10 @@ NoisySequence::NoisySequence(NoisySequenceConfig config) : config_(std::move(con
   const NoisySequenceConfig& c = config_;
   validate_noisy_options(c.options);
   validate(c.options.synthesis);
-  if (c.frames.empty()) throw ValueError("no frames to make (give a frame range)");
+  check_job_config(c);
+  if (c.format != "png") throw ValueError(concat("the noise pass writes PNG frames, not '", c.format, "'"));
   if (c.exemplar.empty()) throw ValueError("the exemplar (a sample of the medium) is required");
   if (c.reference.empty()) throw ValueError("the folder of coherent reference frames is required");
-  if (c.out.empty()) throw ValueError("the output folder is required");
   if (!fs::is_directory(c.reference))
     throw FileNotFoundError(concat("the reference folder '", c.reference, "' does not exist"));
   for (int frame : c.frames)

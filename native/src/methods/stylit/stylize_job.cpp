@@ -213,18 +213,8 @@ void remove_stale_temporaries(const std::string& folder) {
 }
 
 void validate_config(const StylizeJobConfig& c) {
-  if (c.format != "png" && c.format != "exr")
-    throw ValueError(concat("unknown output format '", c.format, "' (choose png or exr)"));
+  check_job_config(c);
   if (c.prefix.find('/') != std::string::npos) throw ValueError(concat("prefix '", c.prefix, "' must not contain '/'"));
-  if (c.frames.empty()) throw ValueError("no frames to stylize");
-  for (int frame : c.frames)
-    if (frame < 0 || frame > kMaxFrame)
-      throw ValueError(concat("frame numbers must be from 0 to ", kMaxFrame, " (Blender's last frame), got ", frame));
-  std::vector<int> sorted = c.frames;  // n log n: a million frames are checked at once
-  std::sort(sorted.begin(), sorted.end());
-  const auto twice = std::adjacent_find(sorted.begin(), sorted.end());
-  if (twice != sorted.end()) throw ValueError(concat("frame ", *twice, " is listed twice"));
-  if (c.out.empty()) throw ValueError("no output folder given");
   const SynthesisOptions& o = c.stylit.synthesis;
   if (o.patch_size < 3 || o.patch_size % 2 == 0)
     throw ValueError(concat("patch size must be odd and >= 3, got ", o.patch_size));
@@ -255,16 +245,16 @@ StylizeJob::StylizeJob(StylizeJobConfig config) : config_(std::move(config)) {
   std::vector<std::string> names;
   for (const auto& [name, weight] : guides) names.push_back(name);
 
-  require_file(config_.style, "painting");
+  require_file(config_.exemplar, "painting");
   require_folder(config_.exemplar_guides, "exemplar guide");
   exemplar_path_ =
       guide_cache_frame(config_.exemplar_guides, exemplar_guide_frame(config_.exemplar_guides, config_.exemplar_frame));
   require_file(exemplar_path_, "exemplar guide frame");
   exemplar_ = GuideFrame::read(exemplar_path_, names);
   const Image& first = exemplar_.get(names.front());
-  Image painting = read_image(config_.style);
-  require_finite(painting.view(), concat("the painting '", config_.style, "'"));
-  style_ = fit_painting(std::move(painting), config_.style, first.width(), first.height(), warnings_);
+  Image painting = read_image(config_.exemplar);
+  require_finite(painting.view(), concat("the painting '", config_.exemplar, "'"));
+  style_ = fit_painting(std::move(painting), config_.exemplar, first.width(), first.height(), warnings_);
 
   require_folder(config_.guides, "guide cache");
   std::string missing;
@@ -280,7 +270,7 @@ StylizeJob::StylizeJob(StylizeJobConfig config) : config_(std::move(config)) {
   // Nothing may be written onto the guides or the painting: refuse before anything is.
   inputs_.add_folder(config_.guides, "guide cache", "the guides");
   inputs_.add_folder(config_.exemplar_guides, "exemplar guide cache", "the guides");
-  inputs_.add_file(config_.style, "painting");
+  inputs_.add_file(config_.exemplar, "painting");
   inputs_.add_file(exemplar_path_, "exemplar guide frame");
   for (int frame : config_.frames) inputs_.add_file(target_path(frame), "guide frame");
   inputs_.refuse_folder(config_.out);
@@ -292,7 +282,7 @@ StylizeJob::StylizeJob(StylizeJobConfig config) : config_(std::move(config)) {
     throw IoError(concat("cannot create the output folder '", config_.out, "'", ec ? ": " + ec.message() : ""));
   remove_stale_temporaries(config_.out);
   settings_ = settings_text(config_);
-  const std::string base = hash_hex(settings_ + "\n" + file_stamp(config_.style) + "\n" + file_stamp(exemplar_path_));
+  const std::string base = hash_hex(settings_ + "\n" + file_stamp(config_.exemplar) + "\n" + file_stamp(exemplar_path_));
   // The predecessor's result is deliberately not part of a frame's key: frames
   // made on several machines (each chain starting at its own first frame) stay
   // current when one run over the whole range assembles the sheet and video.

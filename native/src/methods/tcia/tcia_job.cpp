@@ -69,14 +69,6 @@ std::vector<std::size_t> select(const std::vector<TciaSegment>& segments,
   return out;
 }
 
-void check_frames(const std::vector<int>& frames) {
-  if (frames.empty()) throw ValueError("no frames to stylize");
-  for (std::size_t i = 1; i < frames.size(); ++i)
-    if (frames[i] != frames[i - 1] + 1)
-      throw ValueError(concat("the coherent method needs consecutive frames (the motion links frame f to f - 1 and "
-                              "f + 1); frame ", frames[i - 1], " is followed by ", frames[i]));
-}
-
 std::vector<KeyFile> sorted_keys(std::vector<KeyFile> keys, const std::vector<int>& frames) {
   std::sort(keys.begin(), keys.end(), [](const KeyFile& a, const KeyFile& b) { return a.frame < b.frame; });
   for (std::size_t i = 0; i < keys.size(); ++i) {
@@ -207,7 +199,7 @@ TciaJob::TciaJob(TciaJobConfig config)
     << settings_text(config_.tcia.synthesis, synthesis_option_table())
     << settings_text(config_.lines, tcia_line_option_table())
     << settings_text(config_.orientation, tcia_orientation_option_table()) << "format=" << config_.frames.format << ";"
-    << file_stamp(config_.frames.style) << ";" << file_stamp(frames_.exemplar_path());
+    << file_stamp(config_.frames.exemplar) << ";" << file_stamp(frames_.exemplar_path());
   settings_ = s.str();
   check_layers();
   std::error_code ec;
@@ -215,7 +207,8 @@ TciaJob::TciaJob(TciaJobConfig config)
 }
 
 TciaJobConfig TciaJob::checked(TciaJobConfig c) {
-  check_frames(c.frames.frames);
+  check_job_config(c.frames, FrameOrder::Consecutive,
+                   "the coherent method needs consecutive frames (the motion links frame f to f - 1 and f + 1)");
   validate_fields(c.tcia, tcia_option_table());
   validate_fields(c.lines, tcia_line_option_table());
   validate_fields(c.orientation, tcia_orientation_option_table());

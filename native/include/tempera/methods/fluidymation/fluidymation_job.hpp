@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "tempera/app/frame_job.hpp"
+#include "tempera/app/job_config.hpp"
 #include "tempera/methods/fluidymation/fluidymation.hpp"
 
 namespace tempera {
@@ -36,16 +37,12 @@ struct EnumNames<FlowSource> {
   static constexpr std::array<const char*, 4> names = {"auto", "fluid", "guides", "masks"};
 };
 
-struct FluidymationJobConfig {
-  std::string exemplar;        // folder of exemplar frames (PNG, EXR, ...), in name order
+// exemplar: a folder of exemplar frames (PNG, EXR, ...), in name order;
+// guides: the guide cache; frames: consecutive.
+struct FluidymationJobConfig : JobConfig {
   std::string exemplar_masks;  // optional folder of mask frames (first channel), as many
-  std::string guides;          // guide cache folder
-  std::vector<int> frames;     // consecutive
-  std::string out;
   std::string target_mask = "alpha";  // alpha | mask.OB_<name> | mask.CO_<name>
   FlowSource flow = FlowSource::Auto;  // auto: fluid_velocity, else velocity_forward, else masks
-  std::string format = "png";         // png | exr
-  bool resume = true;
   FluidymationOptions options = default_fluidymation_options();
 };
 

@@ -15,16 +15,14 @@
 
 #include "tempera/methods/lazyfluids/lazyfluids.hpp"
 #include "tempera/app/frame_job.hpp"
+#include "tempera/app/job_config.hpp"
 
 namespace tempera {
 
-struct LazyFluidsJobConfig {
-  std::string exemplar;      // RGBA image, or a folder of RGBA frames (sorted by name)
-  std::string guides;        // guide cache folder (frame_####.exr)
-  std::vector<int> frames;   // consecutive
-  std::string out;           // output folder: OUT/frame_0001.png ...
-  std::string format = "png";  // png | exr
-  bool resume = true;
+// exemplar: an RGBA image, or a folder of RGBA frames (sorted by name);
+// guides: the guide cache (frame_####.exr); frames: consecutive; out: the
+// output folder, OUT/frame_0001.png ...
+struct LazyFluidsJobConfig : JobConfig {
   LazyFluidsOptions options = default_lazyfluids_options();
 };
 

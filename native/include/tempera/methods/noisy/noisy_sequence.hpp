@@ -12,30 +12,29 @@
 #include <vector>
 
 #include "tempera/app/frame_job.hpp"
+#include "tempera/app/job_config.hpp"
 #include "tempera/engine/image.hpp"
 #include "tempera/methods/noisy/noisy.hpp"
 #include "tempera/methods/stylit/stylit.hpp"
 
 namespace tempera {
 
-struct NoisySequenceConfig {
-  std::string exemplar;           // the medium S: the painting, or a scan of the paper
+// exemplar: the medium S (the painting, or a scan of the paper); out: the
+// output folder (created), <prefix>0001.png ...; format: png only; guides:
+// the guide cache, for a guide noise map and guided noise.
+struct NoisySequenceConfig : JobConfig {
   std::string reference;          // folder of the coherent frames R: <prefix>0001.png ...
-  std::vector<int> frames;        // frames to make, in order
-  std::string out;                // output folder (created): <prefix>0001.png ...
   std::string prefix = "frame_";  // of the reference and the output frames
   // Optional local noise map (§3.3), f_p = noise * map: an image file (R's
   // size), or the name of a guide in the guide cache `guides` ("alpha",
   // "mask.OB_Cube", an AOV), read per frame. 0 keeps R, 1 is the full amount.
   std::string noise_map;
-  std::string guides;             // guide cache folder, for a guide noise map and guided noise
   // Guided noise (options.noise_guides > 0): the exemplar render's guide
   // cache (its frame as in StylizeJobConfig) and StyLit's guide weights.
   std::string exemplar_guides;
   std::optional<int> exemplar_frame;
   std::vector<std::pair<std::string, float>> guide_weights = default_guide_weights();
   NoisyOptions options = default_noisy_options();
-  bool resume = true;
 };
 
 class NoisySequence : public FrameJob {

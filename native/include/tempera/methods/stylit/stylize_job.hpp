@@ -11,22 +11,19 @@
 
 #include "tempera/app/frame_job.hpp"
 #include "tempera/app/guide_cache.hpp"
+#include "tempera/app/job_config.hpp"
 #include "tempera/engine/image.hpp"
 #include "tempera/methods/stylit/stylit.hpp"
 
 namespace tempera {
 
-struct StylizeJobConfig {
-  std::string style;                  // the painting (PNG, EXR, ...)
+// exemplar: the painting (PNG, EXR, ...); guides: the animation's guide
+// cache; out: the output folder (created).
+struct StylizeJobConfig : JobConfig {
   std::string exemplar_guides;        // guide cache folder of the exemplar render
   std::optional<int> exemplar_frame;  // default: the folder's only frame_*.exr
-  std::string guides;                 // guide cache folder of the animation
-  std::vector<int> frames;            // frames to stylize, in order
-  std::string out;                    // output folder (created)
-  std::string format = "png";         // png | exr
   std::string prefix = "frame_";      // OUT/<prefix>0001.<format>
   StylitOptions stylit;
-  bool resume = true;
 };
 
 class StylizeJob : public FrameJob {
