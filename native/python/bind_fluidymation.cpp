@@ -123,4 +123,5 @@ void bind_fluidymation(py::module_& m) {
            py::arg("config"), py::arg("options"))
       .def_property_readonly("flow_guide", &FluidymationJob::flow_guide);
   py_bridge::def_frame_job<FluidymationJob>(job_class);
+  py_bridge::def_contact_sheet<FluidymationJob>(job_class);
 }

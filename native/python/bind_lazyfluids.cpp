@@ -70,4 +70,5 @@ void bind_lazyfluids(py::module_& m) {
            py::arg("exemplar"), py::arg("guides"), py::arg("frames"), py::arg("out"), py::arg("format"),
            py::arg("resume"), py::arg("options"));
   py_bridge::def_frame_job<LazyFluidsJob>(job_class);
+  py_bridge::def_contact_sheet<LazyFluidsJob>(job_class);
 }

@@ -4,6 +4,7 @@
 
 #include <tuple>
 
+#include "bind_frame_job.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
 #include "tempera/methods/noisy/noisy_sequence.hpp"
@@ -33,32 +34,14 @@ NoisySequenceConfig sequence_config(const py::dict& d, const NoisyOptions& optio
 }
 
 void bind_sequence(py::module_& m) {
-  py::class_<NoisySequence>(m, "NoisySequence", "Color Me Noisy over a folder of frames; use tempera.methods.noisy.noisy.NoisySequence.")
+  auto sequence_class = py::class_<NoisySequence>(m, "NoisySequence", "Color Me Noisy over a folder of frames; use tempera.methods.noisy.noisy.NoisySequence.")
       .def(py::init([](const py::dict& config, const NoisyOptions& options) {
              NoisySequenceConfig c = sequence_config(config, options);
              py::gil_scoped_release release;  // reads the medium, checks every frame
              return std::make_unique<NoisySequence>(std::move(c));
            }),
-           py::arg("config"), py::arg("options"))
-      .def_property_readonly("frames", &NoisySequence::frames)
-      .def("output_path", &NoisySequence::output_path, py::arg("frame"))
-      .def(
-          "run_frame",
-          [](NoisySequence& s, std::size_t index, const std::function<bool(double)>& progress) {
-            ProgressCallback callback = py_bridge::with_gil([&](double f) { return progress ? progress(f) : true; });
-            FrameResult r;
-            {
-              py::gil_scoped_release release;
-              r = s.run_frame(index, callback);
-            }
-            py::dict out;
-            out["frame"] = r.frame;
-            out["path"] = r.path;
-            out["status"] = r.status;
-            out["seconds"] = r.seconds;
-            return out;
-          },
-          py::arg("index"), py::arg("progress") = nullptr);
+           py::arg("config"), py::arg("options"));
+  py_bridge::def_frame_job<NoisySequence>(sequence_class);
 }
 
 }  // namespace

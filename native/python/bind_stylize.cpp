@@ -8,6 +8,7 @@
 #include <cmath>
 #include <set>
 
+#include "bind_frame_job.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
 #include "tempera/app/contact_sheet.hpp"
@@ -122,25 +123,6 @@ StylizeJobConfig parse_job_config(const py::dict& d) {
   return c;
 }
 
-// Progress for code running without the GIL (py_bridge::with_gil); anything
-// but an explicit False from the Python callable means "go on".
-ProgressCallback python_progress(const py::object& progress) {
-  return py_bridge::with_gil([progress](double fraction) {
-    return progress.is_none() || !progress(fraction).is(py::bool_(false));
-  });
-}
-
-py::dict frame_result(const FrameResult& r) {
-  py::dict d;
-  d["frame"] = r.frame;
-  d["path"] = r.path;
-  d["status"] = r.status;
-  d["seconds"] = r.seconds;
-  d["flicker"] = r.flicker;
-  d["source_coverage"] = r.source_coverage;
-  return d;
-}
-
 // Arrays stay referenced by `keep` while the frame views them.
 GuideFrame guide_frame(const py::dict& arrays, const char* what, std::vector<FloatArray>& keep) {
   GuideFrame frame;
@@ -173,7 +155,7 @@ py::tuple stylize_frame_py(const FloatArray& style, const py::dict& exemplar, co
          py_bridge::view_of(keep[n - 1], "occlusion_backward")};
   }
   const ImageView style_view = py_bridge::view_of(style, "style");
-  const ProgressCallback callback = python_progress(progress);
+  const ProgressCallback callback = py_bridge::python_progress(progress);
   SynthesisResult result;
   {
     py::gil_scoped_release release;
@@ -187,36 +169,16 @@ py::tuple stylize_frame_py(const FloatArray& style, const py::dict& exemplar, co
 }
 
 void bind_job(py::module_& m) {
-  py::class_<StylizeJob>(m, "StylizeJob", "Stylization of a frame sequence; use tempera.methods.stylit.stylize.StylizeJob.")
+  auto job_class = py::class_<StylizeJob>(m, "StylizeJob", "Stylization of a frame sequence; use tempera.methods.stylit.stylize.StylizeJob.")
       .def(py::init([](const py::dict& config) {
              StylizeJobConfig c = parse_job_config(config);
              py::gil_scoped_release release;  // reads the painting and checks every cache frame
              return std::make_unique<StylizeJob>(std::move(c));
            }),
            py::arg("config"))
-      .def_property_readonly("frames", &StylizeJob::frames)
-      .def_property_readonly("warnings", &StylizeJob::warnings)
-      .def_property_readonly("report_path", &StylizeJob::report_path)
-      .def("output_path", &StylizeJob::output_path, py::arg("frame"))
-      .def(
-          "run_frame",
-          [](StylizeJob& job, std::size_t index, const py::object& progress) {
-            const ProgressCallback callback = python_progress(progress);
-            FrameResult r;
-            {
-              py::gil_scoped_release release;
-              r = job.run_frame(index, callback);
-            }
-            return frame_result(r);
-          },
-          py::arg("index"), py::arg("progress") = py::none())
-      .def(
-          "write_contact_sheet",
-          [](const StylizeJob& job, const std::string& path, int columns) {
-            py::gil_scoped_release release;
-            job.write_contact_sheet(path, columns);
-          },
-          py::arg("path"), py::arg("columns") = 0);
+      .def_property_readonly("report_path", &StylizeJob::report_path);
+  py_bridge::def_frame_job<StylizeJob>(job_class);
+  py_bridge::def_contact_sheet<StylizeJob>(job_class);
 }
 
 }  // namespace

@@ -512,8 +512,7 @@ class RgbaRun(StylizeRun):
         result = self.job.run_frame(i, progress)
         if result["status"] == "stylized":
             self.stylize_seconds += result["seconds"]
-        path = str(self.job.output_path(self.frames[i]))
-        self.results.append({"frame": self.frames[i], "path": path, "status": result["status"]})
+        self.results.append(result)
         if bpy.app.background:
             print(f"Tempera: {self.method_label} frame {self.frames[i]} {result['status']} "
                   f"in {result['seconds']:.1f} s", flush=True)

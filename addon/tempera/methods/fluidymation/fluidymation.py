@@ -13,7 +13,7 @@ import os
 import numpy as np
 
 from ... import _native
-from ..stylit.stylize import SequenceJob
+from ...app.frame_job import SheetFrameJob
 from ...engine.synthesis import method_options
 
 FluidymationOptions = _native.FluidymationOptions
@@ -79,7 +79,7 @@ def stylize_sequence(exemplar_frames, exemplar_masks, target_masks, target_flows
                                           flows, options(**values), report)
 
 
-class MediaJob(SequenceJob):
+class MediaJob(SheetFrameJob):
     """Fluidymation over a guide cache, frame by frame.
 
     exemplar        folder of the exemplar's frames (RGBA, or RGB with exemplar_masks)

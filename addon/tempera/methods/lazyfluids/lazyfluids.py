@@ -16,7 +16,7 @@ import os
 import numpy as np
 
 from ... import _native
-from ..stylit.stylize import SequenceJob
+from ...app.frame_job import SheetFrameJob
 from ...engine.synthesis import method_options
 
 LazyFluidsOptions = _native.LazyFluidsOptions
@@ -66,7 +66,7 @@ def temporal_weights(target_alpha, advected, lam: float):
     return _native.lazyfluids_temporal_weights(_image(target_alpha, 1, "target alpha"), _image(advected), float(lam))
 
 
-class FluidJob(SequenceJob):
+class FluidJob(SheetFrameJob):
     """LazyFluids over a guide cache, frame by frame.
 
     exemplar  an RGBA image file, or a folder of RGBA frames (a video exemplar)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ... import _native
+from ...app.frame_job import FrameJob
 from ...engine.synthesis import method_options
 
 NoisyOptions = _native.NoisyOptions
@@ -58,7 +59,7 @@ def noise_width(level: int) -> float:
     return 0.0 if int(level) == 0 else TESTED_NOISE[int(level) - 1]
 
 
-class NoisySequence:
+class NoisySequence(FrameJob):
     """The noise pass over a folder of coherent frames (native/src/methods/noisy/noisy_sequence.cpp),
     what ``tempera stylize --noise`` and the panel run after the coherent pass.
 
@@ -95,20 +96,7 @@ class NoisySequence:
             config["exemplar_frame"] = int(exemplar_frame)
         if guide_weights is not None:
             config["guide_weights"] = [(str(k), float(v)) for k, v in dict(guide_weights).items()]
-        self._sequence = _native.NoisySequence(config, options(**values))
-
-    @property
-    def frames(self) -> list:
-        return self._sequence.frames
-
-    def output_path(self, frame: int) -> str:
-        return self._sequence.output_path(int(frame))
-
-    def run_frame(self, index: int, progress=None) -> dict:
-        """dict(frame, path, status "made" | "skipped", seconds); the GIL is
-        released meanwhile; ``progress(fraction)`` returning False cancels."""
-        report = None if progress is None else (lambda f: progress(f) is not False)
-        return self._sequence.run_frame(int(index), report)
+        self._job = _native.NoisySequence(config, options(**values))
 
 
 # Where the panel's noise map comes from: (enum item, label, description).

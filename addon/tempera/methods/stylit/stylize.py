@@ -8,18 +8,16 @@ native/src/methods/stylit/stylize_job.cpp); see docs/cli.md for the job's files 
 from __future__ import annotations
 
 import os
-from typing import Callable, Iterable, Mapping, Optional
+from typing import Iterable, Mapping, Optional
 
 import numpy as np
 
 from ... import _native
+from ...app.frame_job import ProgressFn, SheetFrameJob
 from ...app.settings import DEFAULT_GUIDE_WEIGHTS as DEFAULT_WEIGHTS
 from ...app.settings import LIGHT_PATH_GUIDES, QUALITY_PRESETS as QUALITIES
 
 GUIDES = tuple(g["name"] for g in LIGHT_PATH_GUIDES)
-
-ProgressFn = Optional[Callable[[float], Optional[bool]]]
-
 
 def tonemap(linear):
     """Linear radiance -> guide values in [0, 1) as StyLit matches them:
@@ -44,41 +42,7 @@ def _stylit_options(weights, temporal_weight, quality, engine):
     return options
 
 
-class FrameJob:
-    """What every per-frame job wrapper exposes of its native job (``_job``):
-    the frames, the warnings of its checks and the output path of a frame."""
-
-    @property
-    def frames(self) -> list:
-        return self._job.frames
-
-    @property
-    def warnings(self) -> list:
-        return self._job.warnings
-
-    def output_path(self, frame: int) -> str:
-        return self._job.output_path(int(frame))
-
-    def write_contact_sheet(self, path, columns: int = 0) -> None:
-        """The exemplar followed by the frames written so far, on one image under ~2000 px wide."""
-        self._job.write_contact_sheet(os.fspath(path), int(columns))
-
-
-class SequenceJob(FrameJob):
-    """A job whose frames follow one another (the fluid methods: each frame
-    starts from the one before)."""
-
-    def run_frame(self, index: int, progress=None) -> dict:
-        """Stylizes frames[index] (solving the frames before it first where
-        the method needs them), or skips it when current. ``progress(fraction)``
-        returning False cancels (tempera.Cancelled), nothing written. Returns
-        dict(status "stylized" | "skipped", seconds)."""
-        report = None if progress is None else (lambda x: progress(x) is not False)
-        status, seconds = self._job.run_frame(int(index), report)
-        return {"status": status, "seconds": seconds}
-
-
-class StylizeJob(FrameJob):
+class StylizeJob(SheetFrameJob):
     """Stylization of the frames of a guide cache with one painted exemplar.
 
     style            the painting (PNG/EXR/...), made on the exemplar render
@@ -116,15 +80,6 @@ class StylizeJob(FrameJob):
         """The job's sidecar (out/tempera_stylize.json): settings, key and flicker per frame."""
         return self._job.report_path
 
-    def run_frame(self, index: int, progress: ProgressFn = None) -> dict:
-        """Stylizes frames[index], or skips it when its output is current.
-
-        Returns dict(frame, path, status "stylized" | "skipped", seconds,
-        flicker (NaN without a previous frame), source_coverage). The GIL is
-        released meanwhile; ``progress(fraction)`` returning False cancels
-        (tempera.Cancelled) and nothing is written.
-        """
-        return self._job.run_frame(int(index), progress)
 
 
 def stylize_frame(style, exemplar: Mapping, target: Mapping, *, previous=None, velocity_backward=None,

@@ -1,0 +1,52 @@
+"""The job core's per-frame jobs look alike from Python (tempera.app.frame_job):
+every method's run_frame returns the one FrameResult as the same dict, and a
+progress callback that returns None goes on while False cancels."""
+import numpy as np
+import pytest
+
+import tempera
+from tempera.app import guide_cache
+from tempera.app.frame_job import FrameJob
+from tempera.methods.fluidymation import fluidymation
+from tempera.methods.lazyfluids import lazyfluids
+from tempera.methods.noisy import noisy
+from tempera.methods.stylit.stylize import StylizeJob
+
+from synthetic_cache import make_cache, make_exemplar
+from test_fluidymation import make_inputs
+
+KEYS = {"frame", "path", "status", "seconds", "flicker", "source_coverage"}
+
+
+def jobs(p):
+    make_cache(p / "cache")
+    make_exemplar(p / "exemplar", p / "paint.png")
+    yield StylizeJob(p / "paint.png", p / "exemplar", p / "cache", [1, 2], p / "stylit", threads=1, levels=1)
+    rgba = np.dstack([np.random.default_rng(1).random((16, 16, 3)), np.ones((16, 16))]).astype(np.float32)
+    tempera.write_image(str(p / "smoke.png"), rgba)
+    for f in (1, 2):
+        guide_cache.write_frame(p / "fluid", f, {"alpha": np.ones((20, 24), np.float32)})
+    yield lazyfluids.FluidJob(p / "smoke.png", p / "fluid", [1, 2], p / "lazy", em_iterations=1, threads=1)
+    (p / "fluidymation").mkdir()
+    exemplar, cache = make_inputs(p / "fluidymation", frames=2)
+    yield fluidymation.MediaJob(exemplar, cache, [1, 2], p / "media", levels=1, threads=1)
+    medium = np.random.default_rng(4).random((64, 64, 3)).astype(np.float32)
+    tempera.write_image(str(p / "medium.png"), medium)
+    (p / "R").mkdir()
+    for f in (1, 2):
+        tempera.write_image(str(p / "R" / f"frame_{f:04d}.png"), medium[4:44, 6:54])
+    yield noisy.NoisySequence(p / "medium.png", p / "R", [1, 2], p / "noisy", noise=2.2, threads=1)
+
+
+def test_every_per_frame_job_returns_the_one_result(tmp_path):
+    seen = []
+    for job in jobs(tmp_path):
+        assert isinstance(job, FrameJob) and job.frames == [1, 2]
+        with pytest.raises(tempera.Cancelled):
+            job.run_frame(0, progress=lambda f: False)
+        first = job.run_frame(0, progress=lambda f: None)  # None goes on
+        assert set(first) == KEYS and first["frame"] == 1 and first["status"] in ("stylized", "made")
+        assert first["path"] == job.output_path(1) and first["seconds"] > 0
+        assert job.run_frame(0)["status"] == "skipped"
+        seen.append(type(job).__name__)
+    assert seen == ["StylizeJob", "FluidJob", "MediaJob", "NoisySequence"]
