@@ -4,6 +4,7 @@
 #include <pybind11/stl.h>
 
 #include "bind_frame_job.hpp"
+#include "bind_job_config.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
 #include "tempera/methods/fluidymation/fluidymation.hpp"
@@ -36,15 +37,10 @@ py::list to_list(std::vector<Image>&& images) {
 
 FluidymationJobConfig job_config(const py::dict& d, const FluidymationOptions& options) {
   FluidymationJobConfig c;
-  c.exemplar = d["exemplar"].cast<std::string>();
+  py_bridge::read_job_config(d, c, "MediaJob config");
   if (!d["exemplar_masks"].is_none()) c.exemplar_masks = d["exemplar_masks"].cast<std::string>();
-  c.guides = d["guides"].cast<std::string>();
-  c.frames = d["frames"].cast<std::vector<int>>();
-  c.out = d["out"].cast<std::string>();
   c.target_mask = d["target_mask"].cast<std::string>();
   if (!d["flow"].is_none()) c.flow = parse_enum<FlowSource>(d["flow"].cast<std::string>(), "flow");
-  c.format = d["format"].cast<std::string>();
-  c.resume = d["resume"].cast<bool>();
   c.options = options;
   return c;
 }

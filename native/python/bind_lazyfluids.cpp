@@ -4,6 +4,7 @@
 #include <pybind11/stl.h>
 
 #include "bind_frame_job.hpp"
+#include "bind_job_config.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
 #include "tempera/methods/lazyfluids/lazyfluids.hpp"
@@ -58,17 +59,14 @@ void bind_lazyfluids(py::module_& m) {
       },
       py::arg("target_alpha"), py::arg("advected"), py::arg("lam"), "λ_q of eq. 5.6.");
   auto job_class = py::class_<LazyFluidsJob>(m, "LazyFluidsJob", "LazyFluids over a guide cache; use tempera.methods.lazyfluids.lazyfluids.FluidJob.")
-      .def(py::init([](const std::string& exemplar, const std::string& guides, const std::vector<int>& frames,
-                       const std::string& out, const std::string& format, bool resume,
-                       const LazyFluidsOptions& options) {
+      .def(py::init([](const py::dict& config, const LazyFluidsOptions& options) {
              LazyFluidsJobConfig c;
-             c.exemplar = exemplar, c.guides = guides, c.frames = frames, c.out = out, c.format = format;
-             c.resume = resume, c.options = options;
+             py_bridge::read_job_config(config, c, "FluidJob config");
+             c.options = options;
              py::gil_scoped_release release;  // reads the exemplar and cache headers
              return std::make_unique<LazyFluidsJob>(std::move(c));
            }),
-           py::arg("exemplar"), py::arg("guides"), py::arg("frames"), py::arg("out"), py::arg("format"),
-           py::arg("resume"), py::arg("options"));
+           py::arg("config"), py::arg("options"));
   py_bridge::def_frame_job<LazyFluidsJob>(job_class);
   py_bridge::def_contact_sheet<LazyFluidsJob>(job_class);
 }

@@ -5,6 +5,7 @@
 #include <tuple>
 
 #include "bind_frame_job.hpp"
+#include "bind_job_config.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
 #include "tempera/methods/noisy/noisy_sequence.hpp"
@@ -18,14 +19,10 @@ namespace {
 // The paths and frames of a NoisySequenceConfig; the options come set.
 NoisySequenceConfig sequence_config(const py::dict& d, const NoisyOptions& options) {
   NoisySequenceConfig c;
-  c.exemplar = d["exemplar"].cast<std::string>();
+  py_bridge::read_job_config(d, c, "NoisySequence config");
   c.reference = d["reference"].cast<std::string>();
-  c.frames = d["frames"].cast<std::vector<int>>();
-  c.out = d["out"].cast<std::string>();
   if (d.contains("prefix")) c.prefix = d["prefix"].cast<std::string>();
   if (d.contains("noise_map")) c.noise_map = d["noise_map"].cast<std::string>();
-  if (d.contains("guides")) c.guides = d["guides"].cast<std::string>();
-  if (d.contains("resume")) c.resume = d["resume"].cast<bool>();
   if (d.contains("exemplar_guides")) c.exemplar_guides = d["exemplar_guides"].cast<std::string>();
   if (d.contains("exemplar_frame")) c.exemplar_frame = d["exemplar_frame"].cast<int>();
   if (d.contains("guide_weights")) c.guide_weights = d["guide_weights"].cast<std::vector<std::pair<std::string, float>>>();

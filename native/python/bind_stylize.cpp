@@ -9,6 +9,7 @@
 #include <set>
 
 #include "bind_frame_job.hpp"
+#include "bind_job_config.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
 #include "tempera/app/contact_sheet.hpp"
@@ -20,6 +21,7 @@
 namespace py = pybind11;
 using namespace tempera;
 using py_bridge::FloatArray;
+using py_bridge::get;
 
 namespace {
 
@@ -31,7 +33,7 @@ std::set<std::string> stylit_keys() {
   for_each_field(synthesis_option_table(), [&](const auto& f) { keys.insert(f.name); });
   return keys;
 }
-const std::set<std::string> kJobKeys = {"style", "exemplar_guides", "exemplar_frame", "guides", "frames",
+const std::set<std::string> kJobKeys = {"exemplar", "exemplar_guides", "exemplar_frame", "guides", "frames",
                                         "out", "format", "prefix", "resume"};
 
 void reject_unknown(const py::dict& d, const std::set<std::string>& a, const std::set<std::string>& b,
@@ -42,34 +44,6 @@ void reject_unknown(const py::dict& d, const std::set<std::string>& a, const std
     if (!a.count(k) && !b.count(k)) unknown += (unknown.empty() ? "'" : ", '") + k + "'";
   }
   if (!unknown.empty()) throw ValueError(concat("unknown ", what, " key(s) ", unknown));
-}
-
-template <typename T> constexpr const char* kind_name() {
-  if constexpr (std::is_same_v<T, std::string>) return "a string";
-  else if constexpr (std::is_same_v<T, bool>) return "True or False";
-  else if constexpr (std::is_integral_v<T>) return "a whole number";
-  else if constexpr (std::is_floating_point_v<T>) return "a number";
-  else if constexpr (std::is_same_v<T, std::vector<int>>) return "a list of whole numbers";
-  else if constexpr (std::is_same_v<T, py::dict>) return "a dict";
-  else return "another type";
-}
-
-// d[key] as T; a value of the wrong type is a ValueError naming the key
-// ("StylizeJob config 'frames' must be a list of whole numbers, got 'x'"),
-// not pybind11's anonymous "Unable to cast Python instance".
-template <typename T>
-T get(const py::dict& d, const char* key, const std::string& what) {
-  const py::object value = d[key];
-  try {
-    if constexpr (std::is_same_v<T, std::string>) {
-      if (!py::isinstance<py::str>(value)) throw py::cast_error("");
-    }
-    return value.cast<T>();
-  } catch (const py::cast_error&) {
-  } catch (const py::error_already_set&) {  // e.g. an int too large for C++
-  }
-  throw ValueError(concat(what, " '", key, "' must be ", kind_name<T>(), ", got ",
-                          std::string(py::repr(value)).substr(0, 80)));
 }
 
 // Named weights replace the defaults of those guides; the others keep theirs.
@@ -105,20 +79,14 @@ StylitOptions parse_stylit(const py::dict& d) {
 }
 
 StylizeJobConfig parse_job_config(const py::dict& d) {
-  reject_unknown(d, kJobKeys, stylit_keys(), "StylizeJob config");
-  for (const char* key : {"style", "exemplar_guides", "guides", "frames", "out"})
-    if (!d.contains(key)) throw ValueError(concat("StylizeJob config needs '", key, "'"));
-  StylizeJobConfig c;
   const std::string what = "StylizeJob config";
-  c.exemplar = get<std::string>(d, "style", what);
+  reject_unknown(d, kJobKeys, stylit_keys(), what.c_str());
+  StylizeJobConfig c;
+  py_bridge::read_job_config(d, c, what);
+  c.guides = get<std::string>(d, "guides", what);  // required here
   c.exemplar_guides = get<std::string>(d, "exemplar_guides", what);
-  if (d.contains("exemplar_frame") && !d["exemplar_frame"].is_none()) c.exemplar_frame = get<int>(d, "exemplar_frame", what);
-  c.guides = get<std::string>(d, "guides", what);
-  c.frames = get<std::vector<int>>(d, "frames", what);
-  c.out = get<std::string>(d, "out", what);
-  if (d.contains("format")) c.format = get<std::string>(d, "format", what);
+  if (py_bridge::given(d, "exemplar_frame")) c.exemplar_frame = get<int>(d, "exemplar_frame", what);
   if (d.contains("prefix")) c.prefix = get<std::string>(d, "prefix", what);
-  if (d.contains("resume")) c.resume = get<bool>(d, "resume", what);
   c.stylit = parse_stylit(d);
   return c;
 }

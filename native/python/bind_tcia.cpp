@@ -5,6 +5,7 @@
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
+#include "bind_job_config.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
 #include "tempera/methods/tcia/tcia.hpp"
@@ -26,14 +27,9 @@ ImageView keep_view(const py::handle& array, const std::string& what, std::vecto
 TciaJobConfig job_config(const py::dict& d, const TciaOptions& options) {
   TciaJobConfig c;
   StylizeJobConfig& f = c.frames;
-  f.exemplar = d["style"].cast<std::string>();
+  py_bridge::read_job_config(d, f, "ShotJob config");
   f.exemplar_guides = d["exemplar_guides"].cast<std::string>();
   if (!d["exemplar_frame"].is_none()) f.exemplar_frame = d["exemplar_frame"].cast<int>();
-  f.guides = d["guides"].cast<std::string>();
-  f.frames = d["frames"].cast<std::vector<int>>();
-  f.out = d["out"].cast<std::string>();
-  f.format = d["format"].cast<std::string>();
-  f.resume = d["resume"].cast<bool>();
   std::string weights;
   for (const auto& [name, weight] : d["weights"].cast<py::dict>())
     weights += concat(weights.empty() ? "" : ",", std::string(py::str(name)), "=", py::str(weight).cast<std::string>());

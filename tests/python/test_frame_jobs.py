@@ -50,3 +50,24 @@ def test_every_per_frame_job_returns_the_one_result(tmp_path):
         assert job.run_frame(0)["status"] == "skipped"
         seen.append(type(job).__name__)
     assert seen == ["StylizeJob", "FluidJob", "MediaJob", "NoisySequence"]
+
+
+def native_constructors():
+    from tempera import _native
+    from tempera.methods.tcia import tcia
+
+    return {"StylizeJob": lambda c: _native.StylizeJob(c),
+            "FluidJob": lambda c: _native.LazyFluidsJob(c, lazyfluids.options()),
+            "MediaJob": lambda c: _native.FluidymationJob(c, fluidymation.options()),
+            "NoisySequence": lambda c: _native.NoisySequence(c, noisy.options()),
+            "ShotJob": lambda c: _native.TciaJob(c, tcia.options())}
+
+
+@pytest.mark.parametrize("name", ["StylizeJob", "FluidJob", "MediaJob", "NoisySequence", "ShotJob"])
+def test_every_job_binding_reads_the_job_config_one_way(name):
+    """One dict convention for the core's JobConfig fields (bind_job_config.hpp)."""
+    make = native_constructors()[name]
+    with pytest.raises(ValueError, match=f"{name} config needs 'exemplar'"):
+        make({"frames": [1], "out": "o"})
+    with pytest.raises(ValueError, match=f"{name} config 'frames' must be a list of whole numbers"):
+        make({"exemplar": "e", "frames": "1-3", "out": "o"})

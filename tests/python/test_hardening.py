@@ -493,7 +493,7 @@ def test_huge_frame_number_in_a_file_name_is_no_stoi_error(caches):
 
 
 def test_conversion_errors_name_the_option(caches):
-    config = {"style": str(caches / "paint.png"), "exemplar_guides": str(caches / "exemplar"),
+    config = {"exemplar": str(caches / "paint.png"), "exemplar_guides": str(caches / "exemplar"),
               "guides": str(caches / "cache"), "frames": [1], "out": str(caches / "out")}
     for key, value, kind in (("frames", "1-3", "list of whole numbers"), ("patch_size", "five", "whole number"),
                              ("format", 5, "string"), ("temporal_weight", "high", "number")):

@@ -63,9 +63,9 @@ def test_changed_settings_redo_the_frames(inputs):
 
 def test_unknown_config_keys_are_named():
     with pytest.raises(ValueError, match="'colour'.*'speed'|'speed'.*'colour'"):
-        _native.StylizeJob(dict(style="a", exemplar_guides="b", guides="c", frames=[1], out="d", colour=1, speed=2))
+        _native.StylizeJob(dict(exemplar="a", exemplar_guides="b", guides="c", frames=[1], out="d", colour=1, speed=2))
     with pytest.raises(ValueError, match="unknown guide 'DIFFUSE'"):
-        _native.StylizeJob(dict(style="a", exemplar_guides="b", guides="c", frames=[1], out="d",
+        _native.StylizeJob(dict(exemplar="a", exemplar_guides="b", guides="c", frames=[1], out="d",
                                 weights={"DIFFUSE": 1.0}))
 
 

@@ -82,5 +82,6 @@ class FluidJob(SheetFrameJob):
     """
 
     def __init__(self, exemplar, guides, frames, out, *, format="png", resume=True, **values):
-        self._job = _native.LazyFluidsJob(os.fspath(exemplar), os.fspath(guides), [int(f) for f in frames],
-                                          os.fspath(out), str(format), bool(resume), options(**values))
+        config = dict(exemplar=os.fspath(exemplar), guides=os.fspath(guides), frames=[int(f) for f in frames],
+                      out=os.fspath(out), format=str(format), resume=bool(resume))
+        self._job = _native.LazyFluidsJob(config, options(**values))

@@ -68,7 +68,7 @@ class StylizeJob(SheetFrameJob):
     def __init__(self, style, exemplar_guides, guides, frames: Iterable[int], out, *, exemplar_frame=None,
                  format="png", prefix="frame_", weights: Optional[Mapping[str, float]] = None,
                  temporal_weight=None, quality=None, resume=True, **engine):
-        config = dict(style=os.fspath(style), exemplar_guides=os.fspath(exemplar_guides),
+        config = dict(exemplar=os.fspath(style), exemplar_guides=os.fspath(exemplar_guides),
                       guides=os.fspath(guides), frames=[int(f) for f in frames], out=os.fspath(out),
                       exemplar_frame=None if exemplar_frame is None else int(exemplar_frame),
                       format=str(format), prefix=str(prefix), resume=bool(resume),

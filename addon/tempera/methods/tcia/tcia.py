@@ -128,7 +128,7 @@ class ShotJob:
     def __init__(self, style, exemplar_guides, guides, frames, out, *, exemplar_frame=None, keys=(), segment=None,
                  weights=None, format="png", resume=True, lines=None, layers=(), layer_order="depth", orientation=False,
                  **values):
-        config = dict(style=os.fspath(style), exemplar_guides=os.fspath(exemplar_guides), guides=os.fspath(guides),
+        config = dict(exemplar=os.fspath(style), exemplar_guides=os.fspath(exemplar_guides), guides=os.fspath(guides),
                       frames=[int(f) for f in frames], out=os.fspath(out), format=str(format), resume=bool(resume),
                       exemplar_frame=None if exemplar_frame is None else int(exemplar_frame),
                       weights={str(k): float(v) for k, v in dict(weights or {}).items()},
