@@ -43,18 +43,22 @@ std::string clock_text(double seconds) {
   return out.str();
 }
 
-bool run_frames(FrameJob& job, std::vector<FrameResult>& results, const FrameLine& line) {
-  const std::size_t n = job.frames().size();
+bool run_units(const std::vector<std::size_t>& units, std::size_t total,
+               const std::function<FrameResult(std::size_t, const ProgressCallback&)>& run,
+               std::vector<FrameResult>& results, const FrameLine& line) {
   double spent = 0;
   int made = 0;
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t k = 0; k < units.size(); ++k) {
+    const std::size_t i = units[k];
+    if (interrupted()) return false;
     try {
-      results.push_back(job.run_frame(i, until_interrupted()));
+      results.push_back(run(i, until_interrupted()));
     } catch (const CancelledError&) {
       return false;
     }
     const FrameResult& r = results.back();
-    std::cout << line.label << " " << i + 1 << "/" << n << " (#" << r.frame << "): ";
+    std::cout << line.label << " " << i + 1 << "/" << total << " ("
+              << (line.which ? line.which(i, r) : concat("#", r.frame)) << "): ";
     if (r.status == "skipped") {
       std::cout << "skipped, already current";
     } else {
@@ -63,10 +67,18 @@ bool run_frames(FrameJob& job, std::vector<FrameResult>& results, const FrameLin
       std::cout << std::fixed << std::setprecision(2) << r.seconds << " s" << std::defaultfloat;
     }
     if (line.details) line.details(std::cout, r);
-    if (line.eta && made > 0 && i + 1 < n) std::cout << ", ETA " << clock_text(spent / made * double(n - i - 1));
+    const std::size_t left = units.size() - k - 1;
+    if (line.eta && made > 0 && left > 0) std::cout << ", ETA " << clock_text(spent / made * double(left));
     std::cout << std::defaultfloat << std::endl;
   }
   return true;
+}
+
+bool run_frames(FrameJob& job, std::vector<FrameResult>& results, const FrameLine& line) {
+  std::vector<std::size_t> all(job.frames().size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+  return run_units(all, all.size(), [&](std::size_t i, const ProgressCallback& cancel) { return job.run_frame(i, cancel); },
+                   results, line);
 }
 
 FrameTally tally(const std::vector<FrameResult>& results) {

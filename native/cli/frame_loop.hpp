@@ -35,17 +35,26 @@ int report_interrupted(const std::string& command, const std::string& unit = "fr
 // "1:05" for 65 seconds.
 std::string clock_text(double seconds);
 
-// How the loop prints a job's frames.
+// How the loop prints a job's units of work.
 struct FrameLine {
   std::string label = "frame";  // the line's start: "frame 3/24 (#3): "
+  // Which unit, in the brackets: "#3" by default (the result's frame); a segment says "frames 1-8".
+  std::function<std::string(std::size_t unit, const FrameResult&)> which;
   // Figures of the method after the time (", flicker 0.0123"), for made and skipped frames alike.
   std::function<void(std::ostream&, const FrameResult&)> details;
   bool eta = false;  // ", ETA 1:05" once a frame was made
 };
 
-// Runs every frame of `job`, one line each, "frame 3/24 (#3): 1.23 s" or
-// "frame 3/24 (#3): skipped, already current", and appends its result to
-// `results`. False if interrupted (the frames finished before are kept).
+// The one loop over a job's units of work (frames, tcia's segments): runs
+// `run(unit)` for each of `units` in order, with until_interrupted() as its
+// cancel, one line each, "frame 3/24 (#3): 1.23 s" or "frame 3/24 (#3):
+// skipped, already current" (24 = `total`), and appends its result to
+// `results`. False if interrupted (the units finished before are kept).
+bool run_units(const std::vector<std::size_t>& units, std::size_t total,
+               const std::function<FrameResult(std::size_t unit, const ProgressCallback&)>& run,
+               std::vector<FrameResult>& results, const FrameLine& line = {});
+
+// run_units over every frame of `job`.
 bool run_frames(FrameJob& job, std::vector<FrameResult>& results, const FrameLine& line = {});
 
 // Seconds spent on frames made, and how many were made and skipped.

@@ -400,29 +400,31 @@ bool report_sweep(const SweepProgress& p, std::size_t index, std::size_t count, 
   return !interrupted();
 }
 
-// The coherent method's segments (all, or the one of --segment); false if interrupted.
+// The coherent method's segments (all, or the one of --segment) through the
+// one unit loop; the sweep lines come from the segment's progress. False if interrupted.
 bool run_segments(TciaJob& job, const Options& o) {
-  int stylized = 0, skipped = 0;
-  double seconds = 0;
-  for (std::size_t i : job.selected()) {
-    if (interrupted()) return false;
+  const std::size_t count = job.segments().size();
+  const auto segment = [&](std::size_t i, const ProgressCallback&) {
     const TciaSegment& s = job.segments()[i];
     const auto start = std::chrono::steady_clock::now();
-    SegmentResult r;
-    try {
-      r = job.run_segment(i, [&](const SweepProgress& p) { return report_sweep(p, i, job.segments().size(), s, start); });
-    } catch (const CancelledError&) {
-      return false;
-    }
-    std::cout << "segment " << i + 1 << "/" << job.segments().size() << " (frames " << s.first << "-" << s.last
-              << "): ";
-    if (r.status == "skipped") std::cout << "skipped, already current\n";
-    else std::cout << std::fixed << std::setprecision(2) << r.seconds << " s\n" << std::defaultfloat;
-    (r.status == "skipped" ? skipped : stylized)++;
-    seconds += r.seconds;
-  }
-  std::cout << "tempera stylize: " << stylized << " segment(s) stylized, " << skipped
-            << " skipped (already current) in " << std::fixed << std::setprecision(1) << seconds << " s"
+    const SegmentResult r =
+        job.run_segment(i, [&](const SweepProgress& p) { return report_sweep(p, i, count, s, start); });
+    FrameResult unit;
+    unit.frame = s.first;
+    unit.status = r.status;
+    unit.seconds = r.seconds;
+    return unit;
+  };
+  FrameLine line;
+  line.label = "segment";
+  line.which = [&](std::size_t i, const FrameResult&) {
+    return concat("frames ", job.segments()[i].first, "-", job.segments()[i].last);
+  };
+  std::vector<FrameResult> results;
+  if (!run_units(job.selected(), count, segment, results, line)) return false;
+  const FrameTally t = tally(results);
+  std::cout << "tempera stylize: " << t.made << " segment(s) stylized, " << t.skipped
+            << " skipped (already current) in " << std::fixed << std::setprecision(1) << t.seconds << " s"
             << std::defaultfloat << "; results in " << o.out << "\n";
   return true;
 }
