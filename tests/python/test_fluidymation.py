@@ -195,3 +195,21 @@ def test_cli_runs_and_exits_2_on_bad_input(tmp_path, cli_path):
         assert message in bad.stderr
     helptext = subprocess.run(base[:4] + ["--help"], capture_output=True, text=True).stdout
     assert "--exemplar-masks" in helptext and "--boundary-weight" in helptext
+
+
+@pytest.mark.parametrize("bidirectional", [False, True])
+def test_an_empty_target_mask_gives_a_transparent_frame(tmp_path, bidirectional):
+    """Issue 31, item 12: an object off screen for a frame stopped the shot
+    ("target mask is empty", no frame named). Now that frame is transparent,
+    as in LazyFluids, and the frame after it starts afresh."""
+    exemplar, cache = make_inputs(tmp_path, frames=3)
+    guide_cache.write_frame(cache, 2, {"alpha": np.zeros((SIZE, SIZE), np.float32),
+                                       "velocity_forward": np.zeros((SIZE, SIZE, 2), np.float32)})
+    job = fluidymation.MediaJob(exemplar, cache, [1, 2, 3], tmp_path / "out", bidirectional=bidirectional, **FAST)
+    assert [job.run_frame(i)["status"] for i in range(3)] == ["stylized"] * 3
+    empty = read_image(job.output_path(2))
+    assert empty[..., 3].max() == 0
+    after = read_image(job.output_path(3))
+    inside = disc(7 + 3.0) > 0.5
+    assert np.allclose(after[..., 3], disc(7 + 3.0), atol=1 / 255)
+    assert after[inside, :3].std() > 0.02  # painted, not blank

@@ -423,10 +423,33 @@ void Fluidymation::Data::read_matches(int j, const Solver& solver, const LevelRe
   }
 }
 
+namespace {
+
+bool any_inside(const ImageView& mask) {  // as the solver counts a target pixel
+  for (std::size_t i = 0; i < mask.size(); ++i)
+    if (mask.data[i] > 0.5f) return true;
+  return false;
+}
+
+FluidFrame empty_frame(int width, int height, int channels) {
+  FluidFrame out;
+  out.image = Image(width, height, channels, 0.0f);
+  out.nnf = Image(width, height, 4, 0.0f);
+  out.time_shift = Image(width, height, 1, 0.0f);
+  out.distance = Image(width, height, 1, 0.0f);
+  return out;
+}
+
+}  // namespace
+
 FluidFrame Fluidymation::solve_frame(int j, const FluidNnf* previous, const ProgressCallback& progress) const {
   const Data& d = *d_;
   if (j < 0 || j >= frames()) throw ValueError(concat("frame ", j, " is outside the target's 0 to ", frames() - 1));
   if (previous && j == 0) throw ValueError("the first frame has no previous frame");
+  // An empty target mask (the object off screen) gives a transparent frame,
+  // as in LazyFluids; the frame after it starts afresh, as the first does.
+  if (!any_inside(d.seq.target_masks[std::size_t(j)])) return empty_frame(d.tw, d.th, d.seq.exemplar[0].channels);
+  if (previous && !any_inside(d.seq.target_masks[std::size_t(j - 1)])) previous = nullptr;
   FluidFrame out;
   std::optional<FluidNnf> shifted;
   if (previous) shifted = shift_nnf(j, *previous, &out.time_shift);
