@@ -123,3 +123,27 @@ def test_a_hard_link_to_an_input_is_the_input(cli_path, tmp_path):
     assert result.returncode == 2, result.stderr
     assert "would overwrite the exemplar" in result.stderr
     assert (tmp_path / "paint.png").read_bytes() == before
+
+
+def test_rigid_refuses_an_output_that_links_to_a_drawing(tmp_path, capsys):
+    """The rigid-body method keeps the rule too, from the CLI and the panel's job."""
+    from tempera.__main__ import main
+    from tempera.methods.rigid.rigid_job import RigidJob
+    from test_cli_rigid import _cache, _exemplar
+
+    (tmp_path / "ex").mkdir()
+    (tmp_path / "cache").mkdir()
+    _exemplar(tmp_path / "ex")
+    _cache(tmp_path / "cache")
+    drawing = tmp_path / "ex" / "drawn" / "0001.png"
+    before = drawing.read_bytes()
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "frame_0001.png").symlink_to(drawing)
+    assert main(["rigid", "--cache", str(tmp_path / "cache"), "--exemplar", str(tmp_path / "ex"), "--out",
+                 str(tmp_path / "out"), "--frames", "1-2"]) == 2
+    assert "would overwrite the drawn exemplar frame" in capsys.readouterr().err
+    (tmp_path / "panel" / "frames").mkdir(parents=True)
+    (tmp_path / "panel" / "frames" / "frame_0002.png").symlink_to(drawing)
+    with pytest.raises(ValueError, match="would overwrite the drawn exemplar frame"):
+        RigidJob(tmp_path / "cache", tmp_path / "ex", tmp_path / "panel", [1, 2])
+    assert drawing.read_bytes() == before

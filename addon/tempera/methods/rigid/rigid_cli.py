@@ -124,6 +124,18 @@ def _settings_key(args, exemplar_dirs, values):
     return hashlib.sha256("\n".join(parts).encode()).hexdigest()
 
 
+def input_files(cache, exemplar_dirs, strokes):
+    """Every file the method reads, as (path, what): no output may replace one
+    (the job core's rule, docs/cli.md "Inputs are never written")."""
+    files = [(Path(cache) / rigid_tracks.TRACKS_NAME, "target tracks"), (Path(cache) / "manifest.json", "manifest")]
+    for d in map(Path, exemplar_dirs):
+        files.append((d / rigid_tracks.TRACKS_NAME, "exemplar tracks"))
+        files += [(p, "drawn exemplar frame") for p in sorted((d / "drawn").glob("*.png"))]
+    if strokes not in (None, "", rigid_strokes.GENERATED):
+        files.append((Path(strokes), "stroke exemplar"))
+    return [(str(p), what) for p, what in files]
+
+
 def strokes_stamp(spec):
     """The stroke exemplar in a settings key ('' for none)."""
     return spec if spec in (None, "", rigid_strokes.GENERATED) else _stamp(spec)
@@ -162,6 +174,8 @@ def run(args):
     paths = {i: out / f"frame_{frame_of[i]:04d}.png" for i in wanted}
     records = {i: out / RECORDS_DIR / f"frame_{frame_of[i]:04d}.txt" for i in wanted}
     keys = {i: record.unit_key(settings, name, frame_of[i]) for i in wanted}
+    _native.refuse_writing_on_inputs([str(p) for p in [*paths.values(), *records.values()]],
+                                     input_files(args.cache, [d for _, d in exemplars], args.strokes))
     todo = [i for i in wanted if not record.is_current(records[i], RECORD_FORMAT, keys[i], [paths[i]])]
     out.mkdir(parents=True, exist_ok=True)
 

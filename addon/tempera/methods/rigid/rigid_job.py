@@ -88,6 +88,9 @@ class RigidJob:
         self.steps = [(name, c) for name in self.objects for c in rigid_cli.chunks(self.frames, chunk)]
         self.steps += [(None, c) for c in rigid_cli.chunks(self.frames, chunk)]  # None: composite
         self._exemplars = None  # fitted once, by the first step that needs them
+        outputs = [p for step in range(len(self.steps)) for p in (*self._paths(step), self.record_path(step))]
+        _native.refuse_writing_on_inputs([str(p) for p in outputs],
+                                         rigid_cli.input_files(self.cache, self.examples, self.strokes))
 
     @property
     def total(self):
