@@ -107,10 +107,11 @@ int run_stylize_fluidymation(const Args& args) {
   if (!run_frames(job, results)) return report_interrupted("stylize");
   const FrameTally t = tally(results);
   const fs::path sheet = fs::path(config.out) / "contact_sheet.png";
-  job.write_contact_sheet(sheet.string());
+  const bool sheet_written =
+      write_beside_frames("stylize", "the contact sheet", [&] { job.write_contact_sheet(sheet.string()); });
   std::cout << "tempera stylize: " << t.made << " frame(s) stylized in " << std::fixed << std::setprecision(1)
             << t.seconds << " s" << std::defaultfloat << "; flow from " << (job.flow_guide().empty() ? "masks" : job.flow_guide())
-            << "; contact sheet " << sheet.string() << "\n";
+            << (sheet_written ? "; contact sheet " + sheet.string() : std::string()) << "\n";
   return 0;
 }
 

@@ -81,6 +81,17 @@ bool run_frames(FrameJob& job, std::vector<FrameResult>& results, const FrameLin
                    results, line);
 }
 
+bool write_beside_frames(const std::string& command, const std::string& what, const std::function<void()>& write) {
+  try {
+    write();
+    return true;
+  } catch (const IoError& e) {
+    std::cerr << "tempera " << command << ": warning: " << what << " was not written (" << e.what()
+              << "); the frames are done\n";
+    return false;
+  }
+}
+
 FrameTally tally(const std::vector<FrameResult>& results) {
   FrameTally t;
   for (const auto& r : results) {

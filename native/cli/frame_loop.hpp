@@ -57,6 +57,12 @@ bool run_units(const std::vector<std::size_t>& units, std::size_t total,
 // run_units over every frame of `job`.
 bool run_frames(FrameJob& job, std::vector<FrameResult>& results, const FrameLine& line = {});
 
+// Writes what a command makes beside its frames (the contact sheet, the
+// video). The frames are the product: a file that cannot be written there
+// (a read-only or full folder) is a warning on stderr, not a failed job.
+// True if `write` finished.
+bool write_beside_frames(const std::string& command, const std::string& what, const std::function<void()>& write);
+
 // Seconds spent on frames made, and how many were made and skipped.
 struct FrameTally {
   int made = 0, skipped = 0;

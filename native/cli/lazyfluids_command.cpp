@@ -126,8 +126,9 @@ int run_lazyfluids(const Args& args) {
   for (const auto& w : job.warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
   if (!run_frames(job)) return report_interrupted("stylize");
   const fs::path sheet = fs::path(o.out) / "contact_sheet.png";
-  job.write_contact_sheet(sheet.string());
-  std::cout << "contact sheet: " << sheet.string() << "\nresults in " << o.out << "\n";
+  if (write_beside_frames("stylize", "the contact sheet", [&] { job.write_contact_sheet(sheet.string()); }))
+    std::cout << "contact sheet: " << sheet.string() << "\n";
+  std::cout << "results in " << o.out << "\n";
   return 0;
 }
 

@@ -331,8 +331,8 @@ void print_summary(const std::vector<FrameResult>& results, const std::string& o
 
 void write_extras(const StylizeJob& job, const Options& o) {
   const fs::path sheet = fs::path(o.out) / "contact_sheet.png";
-  job.write_contact_sheet(sheet.string());
-  std::cout << "contact sheet: " << sheet.string() << "\n";
+  if (write_beside_frames("stylize", "the contact sheet", [&] { job.write_contact_sheet(sheet.string()); }))
+    std::cout << "contact sheet: " << sheet.string() << "\n";
   if (!o.video) return;
   if (o.format != "png" || !consecutive(o.frames)) {
     std::cout << "no video: it needs consecutive PNG frames\n";
@@ -342,10 +342,11 @@ void write_extras(const StylizeJob& job, const Options& o) {
   job.inputs().refuse_file(video.string());
   // ffmpeg reads '%' in the folder as a pattern of its own: doubled, it is a plain '%'.
   const std::string pattern = printf_escaped((fs::path(o.out) / "frames").string()) + "/frame_%04d.png";
-  if (encode_video(pattern, o.frames.front(), o.fps, video.string()))
-    std::cout << "video: " << video.string() << "\n";
-  else
-    std::cout << "no video: ffmpeg is not on PATH\n";
+  bool encoded = false;
+  if (!write_beside_frames("stylize", "the video",
+                           [&] { encoded = encode_video(pattern, o.frames.front(), o.fps, video.string()); }))
+    return;
+  std::cout << (encoded ? "video: " + video.string() : std::string("no video: ffmpeg is not on PATH")) << "\n";
 }
 
 int interrupted_frames(const std::vector<FrameResult>& results) {
@@ -381,7 +382,11 @@ bool run_noise_pass(const Options& o) {
     const fs::path video = fs::path(o.out) / "noisy.mp4";
     sequence.inputs().refuse_file(video.string());
     const std::string pattern = printf_escaped(c.out) + "/frame_%04d.png";
-    if (encode_video(pattern, o.frames.front(), o.fps, video.string())) std::cout << "video: " << video.string() << "\n";
+    bool encoded = false;
+    if (write_beside_frames("stylize", "the video of the noisy frames",
+                            [&] { encoded = encode_video(pattern, o.frames.front(), o.fps, video.string()); }) &&
+        encoded)
+      std::cout << "video: " << video.string() << "\n";
   }
   return true;
 }

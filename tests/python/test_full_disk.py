@@ -75,3 +75,22 @@ def test_noisy_fails_on_a_full_disk_and_the_next_run_heals(cli_path, tmp_path):
     for f in (1, 2):
         image = tempera.read_image(str(tmp_path / "out" / f"frame_{f:04d}.png"))
         assert image.shape == (120, 160, 3)
+
+
+def test_a_finished_job_is_not_failed_by_its_contact_sheet(cli_path, tmp_path):
+    """Issue 31, smaller: a folder that cannot take the contact sheet (read-only,
+    or full) failed a job whose frames were all done. Now that is a warning."""
+    from synthetic_cache import make_cache, make_exemplar
+
+    make_cache(tmp_path / "cache")
+    make_exemplar(tmp_path / "exemplar", tmp_path / "paint.png")
+    args = [str(cli_path), "stylize", "--guides", str(tmp_path / "cache"), "--exemplar", str(tmp_path / "paint.png"),
+            "--exemplar-guides", str(tmp_path / "exemplar"), "--frames", "1-3", "--out", str(tmp_path / "out"),
+            "--no-video", "--levels", "2"]
+    assert subprocess.run(args, capture_output=True, text=True, timeout=300).returncode == 0
+    frames = {p.name: p.read_bytes() for p in (tmp_path / "out" / "frames").glob("frame_*.png")}
+    again = subprocess.run(args, capture_output=True, text=True, timeout=300, preexec_fn=limit_file_size(256))
+    assert again.returncode == 0, again.stderr
+    assert "warning: the contact sheet was not written" in again.stderr and "the frames are done" in again.stderr
+    assert "0 frame(s) stylized, 3 skipped" in again.stdout
+    assert {p.name: p.read_bytes() for p in (tmp_path / "out" / "frames").glob("frame_*.png")} == frames
