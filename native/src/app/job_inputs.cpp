@@ -27,22 +27,25 @@ void JobInputs::add_folder(const std::string& path, const std::string& what, con
   if (identify(path, in)) folders_.push_back(std::move(in));
 }
 
-void JobInputs::refuse_folder(const std::string& out) const {
+// The input among `inputs` that `path` is on disk, or nullptr.
+const JobInputs::Input* JobInputs::find(const std::vector<Input>& inputs, const std::string& path) {
   Input o;
-  if (!identify(out, o)) return;
-  for (const Input& in : folders_)
-    if (in.device == o.device && in.inode == o.inode)
-      throw ValueError(concat("the output folder '", out, "' is the ", in.what, " folder ('", in.path,
-                              "'): the outputs would overwrite ", in.contents, "; choose another output folder"));
+  if (!identify(path, o)) return nullptr;
+  for (const Input& in : inputs)
+    if (in.device == o.device && in.inode == o.inode) return &in;
+  return nullptr;
+}
+
+void JobInputs::refuse_folder(const std::string& out) const {
+  if (const Input* in = find(folders_, out))
+    throw ValueError(concat("the output folder '", out, "' is the ", in->what, " folder ('", in->path,
+                            "'): the outputs would overwrite ", in->contents, "; choose another output folder"));
 }
 
 void JobInputs::refuse_file(const std::string& output) const {
-  Input o;
-  if (!identify(output, o)) return;
-  for (const Input& in : files_)
-    if (in.device == o.device && in.inode == o.inode)
-      throw ValueError(concat("'", output, "' would overwrite the ", in.what, " '", in.path,
-                              "', an input; choose another output folder"));
+  if (const Input* in = find(files_, output))
+    throw ValueError(concat("'", output, "' would overwrite the ", in->what, " '", in->path,
+                            "', an input; choose another output folder"));
 }
 
 }  // namespace tempera

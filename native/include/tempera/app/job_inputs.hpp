@@ -31,6 +31,7 @@ class JobInputs {
     std::string path, what, contents;
   };
   static bool identify(const std::string& path, Input& input);
+  static const Input* find(const std::vector<Input>& inputs, const std::string& path);
   std::vector<Input> files_, folders_;
 };
 
