@@ -84,5 +84,5 @@ def test_cli_strokes_option(tmp_path, capsys):
         assert outside <= 0.03 and 0.5 <= mass <= 2.0
         assert np.abs(colour - rigid_strokes.STROKE_COLOUR).max() < 0.05
     capsys.readouterr()
-    assert run("bad", "--strokes", str(tmp_path / "none.png")) == 2
+    assert run("bad", "--strokes", str(tmp_path / "none.png")) == 1
     assert "none.png' does not exist" in capsys.readouterr().err
