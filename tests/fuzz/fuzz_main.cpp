@@ -8,12 +8,15 @@
 // Targets: image (decoding PNG, JPEG, TIFF, EXR bytes), cache (multilayer
 // guide-cache EXR read by layer and as a GuideFrame), lpe (the light path
 // expression compiler), sidecar (the stylize resume record), options (the
-// CLI's option and frame-range parsing). Every input must either work or be
+// option and frame-range parsing of every method's command: synth, stylize
+// with each --method, noisy, render-guides). The rigid-body method's tracks
+// reader and options are Python: tests/fuzz/fuzz_rigid.py. Every input must either work or be
 // refused with one of Tempera's error types; anything else is a finding and
 // the exit status is 1. Each finding's input is saved in the work folder.
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -22,6 +25,9 @@
 #include <functional>
 #include <iostream>
 #include <random>
+#include <regex>
+#include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -240,38 +246,108 @@ void fuzz_sidecar(FuzzRng& rng, const std::function<bool()>& more) {
   }
 }
 
+// One command line of a method: its entry point and the words before the options.
+struct MethodCommand {
+  const char* name;
+  int (*run)(const cli::Args&);
+  cli::Args prefix;
+};
+
+const std::vector<MethodCommand>& method_commands() {
+  static const std::vector<MethodCommand> commands = {
+      {"synth", cli::run_synth, {}},
+      {"stylize", cli::run_stylize, {}},
+      {"stylize --method tcia", cli::run_stylize, {"--method", "tcia"}},
+      {"stylize --method lazyfluids", cli::run_stylize, {"--method", "lazyfluids"}},
+      {"stylize --method fluidymation", cli::run_stylize, {"--method", "fluidymation"}},
+      {"noisy", cli::run_noisy, {}},
+      {"render-guides", cli::run_render_guides, {}},
+  };
+  return commands;
+}
+
+// Every flag a command's --help names, so that a new option is fuzzed as soon as it is documented.
+std::vector<std::string> documented_flags(const MethodCommand& command) {
+  cli::Args args = command.prefix;
+  args.push_back("--help");
+  std::ostringstream help;
+  std::streambuf* out = std::cout.rdbuf(help.rdbuf());
+  command.run(args);
+  std::cout.rdbuf(out);
+  std::vector<std::string> flags;
+  const std::regex flag("--[a-z][a-z0-9-]*");
+  const std::string text = help.str();
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), flag); it != std::sregex_iterator(); ++it)
+    if (it->str() != "--help" && std::find(flags.begin(), flags.end(), it->str()) == flags.end())
+      flags.push_back(it->str());  // --help only prints
+  return flags;
+}
+
+// Option parsing of every method's command (issue 31): random lines of the
+// command's documented flags and of awkward values. Nothing may run: the
+// current folder is empty, every path given is missing and Blender cannot
+// be found, so each line ends in a usage error or a missing file.
 void fuzz_options(FuzzRng& rng, const std::function<bool()>& more) {
-  const std::vector<std::string> words = {
-      "--frames", "1-24", "1-10,15", "--out", "--exemplar", "--guides", "--weights", "FULL=1,LDE=2", "LDE=",
-      "=3", "--temporal", "0.5", "nan", "1e40", "--patch-size", "4", "--seed", "-1", "18446744073709551616",
-      "--threads", "100000", "--fps", "0", "--format", "exr", "--quality", "preview", "--usage", "budget",
-      "--levels", "99999", "--max-image-pixels", "0", "--exemplar-frame", "2147483648", "--samples", "-5",
-      "--style", "--guide", "--weight", "--output", "--help-not", "-", ",", "1-", "-3", "5-1", "2147483647",
-      "1048574-1048575", "9999999999", "%s%n", ""};
+  const std::vector<std::string> values = {
+      "1-24", "1-10,15", "FULL=1,LDE=2", "LDE=", "=3", "0.5", "nan", "-nan", "inf", "1e40", "-1e-40", "4", "-1",
+      "0", "18446744073709551616", "100000", "exr", "png", "preview", "budget", "99999", "2147483648", "-5",
+      "stylit", "tcia", "lazyfluids", "fluidymation", "rigid", "true", "false", "-", ",", "1-", "-3", "5-1",
+      "2147483647", "1048574-1048575", "9999999999", "%s%n", "", "4=key.png,mask.png", "A:4=k.png", "A=m.png",
+      "1-4", "0x10", " 3", "3 ", "1,1,1", "3.5", "LDE", "velocity_backward"};
+  const std::set<std::string> path_flags = {"--out", "--exemplar", "--guides", "--style", "--output",
+                                            "--exemplar-guides", "--exemplar-scene", "--noise-reference",
+                                            "--noise-map", "--mask", "--masks", "--key", "--blender"};
+  std::vector<std::vector<std::string>> flags;
+  for (const auto& command : method_commands()) flags.push_back(documented_flags(command));
+  const fs::path cwd = g_work / "empty_cwd";
+  fs::create_directories(cwd);
+  const fs::path before = fs::current_path();
+  fs::current_path(cwd);  // relative paths name nothing
+  const char* blender = std::getenv("TEMPERA_BLENDER");
+  const std::string saved_blender = blender ? blender : "";
+  setenv("TEMPERA_BLENDER", (g_work / "no_blender").c_str(), 1);
   const fs::path missing = g_work / "no_such_dir";
+  long usage_errors = 0, file_errors = 0, done = 0;  // how far the lines got: a harness that only
+                                                     // ever reached the first usage error tests little
   while (more()) {
-    cli::Args args;
-    const std::size_t n = below(rng, 14);
+    const std::size_t which = below(rng, method_commands().size());
+    const MethodCommand& command = method_commands()[which];
+    cli::Args args = command.prefix;
+    const std::size_t n = below(rng, 16);
     for (std::size_t i = 0; i < n; ++i) {
-      std::string w = words[below(rng, words.size())];
-      if (rng() % 5 == 0) w = mutate(rng, w, {});
-      if (w == "--out" || w == "--exemplar" || w == "--guides" || w == "--style") {
-        args.push_back(w);
-        w = (missing / concat("p", i)).string();  // never an existing file: nothing runs Blender
-      }
+      const bool flag = rng() % 2 == 0 && !flags[which].empty();
+      std::string w = flag ? flags[which][below(rng, flags[which].size())] : values[below(rng, values.size())];
+      if (rng() % 6 == 0) w = mutate(rng, w, {});
+      if (!w.empty() && w[0] == '/') w[0] = 'x';  // no absolute path to an existing file
       args.push_back(w);
+      if (path_flags.count(w)) args.push_back((missing / concat("p", i)).string());
     }
-    Bytes input;
+    Bytes input = concat(command.name, "\n");
     for (const auto& a : args) input += a + '\n';
-    attempt("options", input, [&] { (void)cli::parse_frames(args.empty() ? "" : args[0]); });
-    for (auto* run : {&cli::run_synth, &cli::run_stylize}) {
-      const std::int64_t cap = max_image_pixels();
-      std::streambuf* out = std::cout.rdbuf(nullptr);  // help texts are not findings
-      attempt("options", input, [&] { (void)(*run)(args); });
-      std::cout.rdbuf(out);
-      if (max_image_pixels() != cap) set_max_image_pixels(cap);
-    }
+    attempt("options", input, [&] { (void)cli::parse_frames(args.empty() ? "" : args.back()); });
+    const std::int64_t cap = max_image_pixels();
+    std::streambuf* out = std::cout.rdbuf(nullptr);  // help texts are not findings
+    attempt("options", input, [&] {
+      Quiet quiet;
+      try {
+        (void)command.run(args);
+        ++done;
+      } catch (const ValueError&) {
+        ++usage_errors;
+        throw;
+      } catch (const IoError&) {
+        ++file_errors;
+        throw;
+      }
+    });
+    std::cout.rdbuf(out);
+    if (max_image_pixels() != cap) set_max_image_pixels(cap);
   }
+  std::cout << "tempera_fuzz: options: " << usage_errors << " usage errors, " << file_errors
+            << " missing files, " << done << " returned\n";
+  fs::current_path(before);
+  if (blender) setenv("TEMPERA_BLENDER", saved_blender.c_str(), 1);
+  else unsetenv("TEMPERA_BLENDER");
 }
 
 }  // namespace
