@@ -111,19 +111,30 @@ function optionValues(args, name) {
     return values;
 }
 
-// The coherent method's segments (tempera.app.farm.tcia_segments): from key to key
-// and to the shot's ends; null for per-frame StyLit.
+// The frame of a --key text "F=PATH[,MASK]".
+function keyFrame(text) {
+    const number = text.split("=")[0];
+    if (!/^-?[0-9]+$/.test(number)) throw `--key expects FRAME=PAINTING[,MASK], got '${text}'`;
+    return parseInt(number, 10);
+}
+
+// The coherent method's segments: from key to key (the shot's --key and the layers'
+// --layer-key NAME:F=PATH) and to the shot's ends; null for per-frame StyLit. The one copy
+// of the job core's rule (native/include/tempera/app/segments.hpp) that cannot call it:
+// the Flamenco manager runs no Tempera. tests/python/test_farm.py holds it to
+// tempera.app.farm.tcia_segments, which does.
 function tciaSegments(frames, args) {
     const methods = optionValues(args, "--method");
     if (methods[methods.length - 1] !== "tcia") return null;
     const first = frames[0], last = frames[frames.length - 1];
     const bounds = new Set([first, last]);
-    for (const text of optionValues(args, "--key")) {
-        const number = text.split("=")[0];
-        if (!/^-?[0-9]+$/.test(number)) throw `--key expects FRAME=PAINTING[,MASK], got '${text}'`;
-        const k = parseInt(number, 10);
-        if (k > first && k < last) bounds.add(k);
+    const keys = optionValues(args, "--key").map(keyFrame);
+    for (const text of optionValues(args, "--layer-key")) {
+        const colon = text.indexOf(":");
+        if (colon <= 0) throw `--layer-key expects NAME:FRAME=PAINTING[,MASK], got '${text}'`;
+        keys.push(keyFrame(text.slice(colon + 1)));
     }
+    for (const k of keys) if (k > first && k < last) bounds.add(k);
     const sorted = [...bounds].sort((a, b) => a - b);
     if (sorted.length === 1) return [frames];
     const out = [];

@@ -392,7 +392,7 @@ bool run_noise_pass(const Options& o) {
 }
 
 // One line per finished sweep: "segment 1/2 (frames 1-8): level 4/4 forward sweep, 12%, ETA 0:40".
-bool report_sweep(const SweepProgress& p, std::size_t index, std::size_t count, const TciaSegment& s,
+bool report_sweep(const SweepProgress& p, std::size_t index, std::size_t count, const Segment& s,
                   std::chrono::steady_clock::time_point start) {
   const bool sweep_done = p.direction > 0 ? p.frame == s.last : p.frame == s.first;
   if (sweep_done) {
@@ -410,7 +410,7 @@ bool report_sweep(const SweepProgress& p, std::size_t index, std::size_t count, 
 bool run_segments(TciaJob& job, const Options& o) {
   const std::size_t count = job.segments().size();
   const auto segment = [&](std::size_t i, const ProgressCallback&) {
-    const TciaSegment& s = job.segments()[i];
+    const Segment& s = job.segments()[i];
     const auto start = std::chrono::steady_clock::now();
     const SegmentResult r =
         job.run_segment(i, [&](const SweepProgress& p) { return report_sweep(p, i, count, s, start); });

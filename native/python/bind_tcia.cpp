@@ -151,6 +151,17 @@ void bind_tcia(py::module_& m) {
       .def_readwrite("synthesis", &TciaOptions::synthesis, "engine options (defaults: tcia_defaults())");
   m.def("tcia_defaults", &tcia_defaults, "The engine options of the coherent method.");
   m.def(
+      "tcia_key_frames",
+      [](const std::vector<std::string>& keys, const std::vector<std::string>& layer_keys) {
+        std::vector<int> frames;
+        for (const auto& text : keys) frames.push_back(parse_key(text).frame);
+        for (const auto& text : layer_keys) frames.push_back(parse_layer_key(text).second.frame);
+        return frames;
+      },
+      py::arg("keys"), py::arg("layer_keys"),
+      "The frames of the CLI's --key F=PATH[,MASK] and --layer-key NAME:F=PATH[,MASK] texts, read as the CLI "
+      "reads them (ValueError naming a bad one): with key_segments, the farm's segments are the job's.");
+  m.def(
       "stylize_shot",
       [](const FloatArray& style, const py::list& guides, const py::list& frames, const py::list& keys,
          const TciaOptions& options, const std::function<bool(double)>& progress, const py::object& style_orientation) {

@@ -7,6 +7,7 @@
 #include "tempera/app/image_io.hpp"
 #include "tempera/app/job_inputs.hpp"
 #include "tempera/app/record.hpp"
+#include "tempera/app/segments.hpp"
 
 namespace py = pybind11;
 using namespace tempera;
@@ -103,6 +104,16 @@ void bind_io(py::module_& m) {
       },
       py::arg("record"), py::arg("format"), py::arg("key"), py::arg("files"),
       "True when the record has this format and key and every file is unchanged.");
+  m.def(
+      "key_segments",
+      [](const std::vector<int>& frames, const std::vector<int>& key_frames) {
+        py::list out;
+        for (const Segment& s : key_segments(frames, key_frames)) out.append(py::make_tuple(s.first, s.last, s.writes));
+        return out;
+      },
+      py::arg("frames"), py::arg("key_frames"),
+      "The job core's segments of a shot of consecutive frames (app/segments.hpp): [(first, last, frames it "
+      "writes), ...] from key to key and to the shot's ends.");
 }
 
 }  // namespace

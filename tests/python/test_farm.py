@@ -9,6 +9,7 @@ import sys
 import pytest
 
 from tempera.app import farm
+from tempera.methods.tcia import tcia
 from conftest import ROOT
 
 SHOT = dict(frames="1-48", out="/shared/out", exemplar="/shared/style.png", scene="/shared/shot010.blend",
@@ -80,6 +81,32 @@ def test_flamenco_plans_the_same_segments():
     result = subprocess.run(["node", "-e", script, str(ROOT / "farm" / "flamenco" / "standin.js"),
                              json.dumps(settings)], capture_output=True, text=True, check=True)
     ours = farm.plan(**dict(SHOT, stylize_args=TCIA))
+    assert [t["argv"] for t in json.loads(result.stdout)] == [t.command for t in ours]
+
+
+LAYERED = ["--method", "tcia", "--key", "12=/shared/k12.png", "--layer", "suit=mask.CO_Suit",
+           "--layer-key", "suit:30=/shared/suit30.png", "--layer-key=suit:40=/shared/suit40.png,/shared/m40.png"]
+
+
+def test_layer_keys_bound_segments_as_in_the_job():
+    """The farm's copy of the segment rule ignored --layer-key, so its --segment
+    values were not the job's segments and the CLI refused them. Now it uses the
+    job core's rule (_native.key_segments), as ShotJob does."""
+    stylize = [t for t in farm.plan(**dict(SHOT, stylize_args=LAYERED)) if t.kind == "stylize"]
+    assert [(t.frames[0], t.frames[-1]) for t in stylize] == [(1, 12), (12, 30), (30, 40), (40, 48)]
+    assert [(t.frames[0], t.frames[-1]) for t in stylize] == tcia.segments(range(1, 49), [12, 30, 40])
+    with pytest.raises(farm.FarmError, match="--layer-key expects NAME:FRAME"):
+        farm.plan(**dict(SHOT, stylize_args=["--method", "tcia", "--layer-key", "30=/k.png"]))
+
+
+@pytest.mark.skipif(shutil.which("node") is None, reason="node not installed")
+def test_flamenco_plans_the_same_layered_segments():
+    settings = dict(FLAMENCO_SETTINGS, temporal=0.5, stylize_args=" ".join(LAYERED))
+    script = ("const {compile, summary} = require(process.argv[1]);"
+              "console.log(JSON.stringify(summary(compile(JSON.parse(process.argv[2])).job)));")
+    result = subprocess.run(["node", "-e", script, str(ROOT / "farm" / "flamenco" / "standin.js"),
+                             json.dumps(settings)], capture_output=True, text=True, check=True)
+    ours = farm.plan(**dict(SHOT, stylize_args=LAYERED))
     assert [t["argv"] for t in json.loads(result.stdout)] == [t.command for t in ours]
 
 

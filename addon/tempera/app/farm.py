@@ -103,20 +103,19 @@ def _option_values(args, name):
 
 def tcia_segments(frames, stylize_args):
     """The coherent method's segments [first, ..., last] of a shot: from key
-    to key and to the shot's ends, as `tempera stylize --method tcia` solves
-    them (native/src/methods/tcia/tcia_job.cpp); None for per-frame StyLit."""
+    to key (the shot's --key and every layer's --layer-key) and to the shot's
+    ends, by the rule `tempera stylize --method tcia` solves them with
+    (native/include/tempera/app/segments.hpp); None for per-frame StyLit."""
     if _option_values(stylize_args, "--method")[-1:] != ["tcia"]:
         return None
-    keys = set()
-    for text in _option_values(stylize_args, "--key"):
-        number = text.split("=", 1)[0]
-        if not number.lstrip("-").isdigit():
-            raise FarmError(f"--key expects FRAME=PAINTING[,MASK], got {text!r}")
-        keys.add(int(number))
-    bounds = sorted({frames[0], frames[-1]} | {k for k in keys if frames[0] < k < frames[-1]})
-    if len(bounds) == 1:
-        return [frames]
-    return [list(range(a, b + 1)) for a, b in zip(bounds, bounds[1:])]
+    from .. import _native  # here: planning per-frame shots needs no native module
+    from ..methods.tcia import tcia
+    try:
+        keys = _native.tcia_key_frames(_option_values(stylize_args, "--key"),
+                                       _option_values(stylize_args, "--layer-key"))
+    except ValueError as e:
+        raise FarmError(str(e)) from None
+    return [list(range(first, last + 1)) for first, last in tcia.segments(frames, keys)]
 
 
 def plan(frames, out, exemplar, *, scene=None, guides=None, exemplar_guides=None, exemplar_scene=None,

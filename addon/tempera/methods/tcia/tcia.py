@@ -95,13 +95,10 @@ def composite(images, masks, depth=None):
 
 def segments(frames, key_frames=()):
     """The segments [(first, last), ...] of a shot of consecutive `frames`:
-    from key to key and to the shot's ends, as the job solves them."""
+    from key to key and to the shot's ends, by the job core's one rule
+    (native/include/tempera/app/segments.hpp), as the job solves them."""
     frames = sorted(int(f) for f in frames)
-    inner = sorted({int(k) for k in key_frames if frames[0] < int(k) < frames[-1]})
-    bounds = [frames[0], *inner] + ([frames[-1]] if frames[-1] != frames[0] else [])
-    if len(bounds) == 1:
-        return [(frames[0], frames[0])]
-    return list(zip(bounds, bounds[1:]))
+    return [(first, last) for first, last, _ in _native.key_segments(frames, [int(k) for k in key_frames])]
 
 
 class ShotJob:

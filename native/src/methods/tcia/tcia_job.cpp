@@ -23,50 +23,13 @@ namespace {
 
 const char* const kMotion[] = {"velocity_backward", "occlusion_backward", "velocity_forward", "occlusion_forward"};
 
-std::vector<int> segment_bounds(const std::vector<int>& frames, const std::vector<KeyFile>& keys) {
-  std::vector<int> bounds = {frames.front()};
-  for (const KeyFile& k : keys)
-    if (k.frame > frames.front() && k.frame < frames.back()) bounds.push_back(k.frame);
-  if (frames.back() != frames.front()) bounds.push_back(frames.back());
-  return bounds;
-}
-
-// The shot's keys and the layers' own, sorted by frame (one per frame): the segments' bounds.
-std::vector<KeyFile> all_keys(const TciaJobConfig& c) {
-  std::vector<KeyFile> keys = c.keys;
-  for (const LayerFile& l : c.layers) keys.insert(keys.end(), l.keys.begin(), l.keys.end());
-  std::sort(keys.begin(), keys.end(), [](const KeyFile& a, const KeyFile& b) { return a.frame < b.frame; });
-  keys.erase(std::unique(keys.begin(), keys.end(), [](const KeyFile& a, const KeyFile& b) { return a.frame == b.frame; }),
-             keys.end());
-  return keys;
-}
-
-std::vector<TciaSegment> make_segments(const std::vector<int>& frames, const std::vector<KeyFile>& keys) {
-  const std::vector<int> bounds = segment_bounds(frames, keys);
-  std::vector<TciaSegment> out;
-  if (bounds.size() == 1) return {TciaSegment{bounds[0], bounds[0], {bounds[0]}}};
-  for (std::size_t i = 0; i + 1 < bounds.size(); ++i) {
-    TciaSegment s{bounds[i], bounds[i + 1], {}};
-    const int end = i + 2 == bounds.size() ? s.last : s.last - 1;
-    for (int f = s.first; f <= end; ++f) s.writes.push_back(f);
-    out.push_back(s);
-  }
-  return out;
-}
-
-// The segments to run: all, or the one of `segment`.
-std::vector<std::size_t> select(const std::vector<TciaSegment>& segments,
-                                const std::optional<std::pair<int, int>>& segment) {
-  std::vector<std::size_t> out;
-  std::string list;
-  for (std::size_t i = 0; i < segments.size(); ++i) {
-    if (!segment || (segments[i].first == segment->first && segments[i].last == segment->second)) out.push_back(i);
-    list += concat(i ? ", " : "", segments[i].first, "-", segments[i].last);
-  }
-  if (out.empty())
-    throw ValueError(concat("segment ", segment->first, "-", segment->second, " is not one of the shot's segments (",
-                            list, "; they run from key to key)"));
-  return out;
+// The frames of the shot's keys and of the layers' own: the segments' bounds.
+std::vector<int> key_frames(const TciaJobConfig& c) {
+  std::vector<int> frames;
+  for (const KeyFile& k : c.keys) frames.push_back(k.frame);
+  for (const LayerFile& l : c.layers)
+    for (const KeyFile& k : l.keys) frames.push_back(k.frame);
+  return frames;
 }
 
 std::vector<KeyFile> sorted_keys(std::vector<KeyFile> keys, const std::vector<int>& frames) {
@@ -165,13 +128,13 @@ KeyFile parse_key(const std::string& text) {
 // Options, keys and segments are checked before the per-frame job reads any file.
 TciaJob::TciaJob(TciaJobConfig config)
     : config_(checked(std::move(config))),
-      segments_(make_segments(config_.frames.frames, all_keys(config_))),
-      selected_(select(segments_, config_.segment)),
+      segments_(key_segments(config_.frames.frames, key_frames(config_))),
+      selected_(select_segments(segments_, config_.segment)),
       frames_(per_frame(config_)) {
   // Motion: a segment's frames link to their neighbours inside it; its first
   // frame needs no V-, its last no V+.
   for (std::size_t i : selected_) {
-    const TciaSegment& s = segments_[i];
+    const Segment& s = segments_[i];
     for (int f = s.first; f <= s.last; ++f) {
       const std::string path = frames_.target_guides_path(f);
       const ImageFileInfo info = inspect_image(path);
@@ -236,7 +199,7 @@ void TciaJob::refuse_writing_on_keys() const {
     add_keys(l.keys);
     inputs.add_file(l.painting, concat("painting of layer '", l.name, "'"));
   }
-  for (const TciaSegment& s : segments_)
+  for (const Segment& s : segments_)
     for (int f : s.writes) {
       inputs.refuse_file(frames_.output_path(f));
       for (std::size_t l = 0; l < config_.layers.size(); ++l) inputs.refuse_file(layer_path(l, f));
@@ -259,14 +222,14 @@ bool TciaJob::is_read(int frame) const {
 }
 
 std::string TciaJob::record_path(std::size_t index) const {
-  const TciaSegment& s = segments_.at(index);
+  const Segment& s = segments_.at(index);
   return (fs::path(config_.frames.out) / "tempera_tcia" / concat("segment_", s.first, "-", s.last, ".txt")).string();
 }
 
 // Everything the segment's frames depend on: the settings, the painting and
 // exemplar, its own guide frames and its bounding keys; nothing of the
 // other segments.
-std::string TciaJob::segment_key(const TciaSegment& segment) const {
+std::string TciaJob::segment_key(const Segment& segment) const {
   std::string text = concat(settings_, "\nsegment ", segment.first, "-", segment.last);
   for (int f = segment.first; f <= segment.last; ++f) text += "\n" + file_stamp(frames_.target_guides_path(f));
   for (const KeyFile& k : config_.keys)
@@ -275,7 +238,7 @@ std::string TciaJob::segment_key(const TciaSegment& segment) const {
   return hash_hex(text);
 }
 
-std::string TciaJob::composite_key(const TciaSegment& segment) const {
+std::string TciaJob::composite_key(const Segment& segment) const {
   if (config_.layers.empty()) return segment_key(segment);
   std::string text = concat(segment_key(segment), "\nlayer order ", config_.layer_order);
   for (std::size_t l = 0; l < config_.layers.size(); ++l) text += "\n" + layer_key(segment, l);
@@ -288,7 +251,7 @@ bool TciaJob::is_current(std::size_t index) const {
   return record_current(record_path(index), kTciaRecordFormat, composite_key(segments_[index]), files);
 }
 
-Shot TciaJob::load_shot(const TciaSegment& segment, std::deque<Image>& keep) const {
+Shot TciaJob::load_shot(const Segment& segment, std::deque<Image>& keep) const {
   std::vector<std::string> names;
   for (const auto& [name, weight] : active_guides(config_.frames.stylit)) names.push_back(name);
   Shot shot;
@@ -340,7 +303,7 @@ Shot TciaJob::load_shot(const TciaSegment& segment, std::deque<Image>& keep) con
 SegmentResult TciaJob::run_segment(std::size_t index, const SegmentProgress& progress) {
   if (std::find(selected_.begin(), selected_.end(), index) == selected_.end())
     throw ValueError(concat("segment ", index, " is not one this job runs"));
-  const TciaSegment& segment = segments_[index];
+  const Segment& segment = segments_[index];
   SegmentResult result;
   if (config_.frames.resume && is_current(index)) {
     result.status = "skipped";

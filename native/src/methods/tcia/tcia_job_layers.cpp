@@ -89,7 +89,7 @@ std::string TciaJob::layer_path(std::size_t layer, int frame) const {
 }
 
 std::string TciaJob::layer_record_path(std::size_t index, std::size_t layer) const {
-  const TciaSegment& s = segments_.at(index);
+  const Segment& s = segments_.at(index);
   return (fs::path(config_.frames.out) / "tempera_tcia" /
           concat("segment_", s.first, "-", s.last, ".layer_", config_.layers.at(layer).name, ".txt"))
       .string();
@@ -97,7 +97,7 @@ std::string TciaJob::layer_record_path(std::size_t index, std::size_t layer) con
 
 // What one layer's frames depend on: the segment's inputs, its mask guide,
 // its painting and its own keys at the segment's bounds.
-std::string TciaJob::layer_key(const TciaSegment& segment, std::size_t layer) const {
+std::string TciaJob::layer_key(const Segment& segment, std::size_t layer) const {
   const LayerFile& l = config_.layers[layer];
   std::string text = concat(segment_key(segment), "\nlayer ", l.name, " ", l.mask, " ",
                             l.painting.empty() ? "shared" : file_stamp(l.painting));
@@ -108,7 +108,7 @@ std::string TciaJob::layer_key(const TciaSegment& segment, std::size_t layer) co
 }
 
 // The segment's shot with the layer's own keys in place of the shot's at their frames.
-Shot TciaJob::with_layer_keys(const Shot& shot, const TciaSegment& segment, std::size_t layer) const {
+Shot TciaJob::with_layer_keys(const Shot& shot, const Segment& segment, std::size_t layer) const {
   const LayerFile& l = config_.layers[layer];
   Shot out = shot;
   for (std::size_t k = 0; k < l.keys.size(); ++k) {
@@ -170,7 +170,7 @@ void TciaJob::check_layers() {
 }
 
 std::vector<Image> TciaJob::run_layers(std::size_t index, const Shot& shot, const SweepCallback& sweeps) {
-  const TciaSegment& segment = segments_[index];
+  const Segment& segment = segments_[index];
   const std::size_t n = config_.layers.size();
   std::vector<std::string> wanted;
   for (const LayerFile& l : config_.layers) wanted.push_back(l.mask);

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "tempera/app/segments.hpp"
 #include "tempera/methods/stylit/stylize_job.hpp"
 #include "tempera/methods/tcia/tcia.hpp"
 
@@ -109,14 +110,6 @@ struct TciaJobConfig {
 // The format line of a segment's and a layer's resume record (app/record.hpp).
 inline constexpr const char* kTciaRecordFormat = "tempera-tcia-segment 1";
 
-// Frames first..last (inclusive) are solved together; the segment writes
-// `writes` (first..last - 1, and last too for the shot's last segment), so a
-// key shared by two segments has one writer.
-struct TciaSegment {
-  int first = 0, last = 0;
-  std::vector<int> writes;
-};
-
 struct SegmentResult {
   std::string status;  // "stylized" | "skipped"
   double seconds = 0;
@@ -130,7 +123,7 @@ class TciaJob {
   // Validates everything up front (files, guides, keys, sizes).
   explicit TciaJob(TciaJobConfig config);
 
-  const std::vector<TciaSegment>& segments() const { return segments_; }
+  const std::vector<Segment>& segments() const { return segments_; }
   // The indices of the segments to run: all, or the one of config.segment.
   const std::vector<std::size_t>& selected() const { return selected_; }
   const StylizeJob& frames_job() const { return frames_; }
@@ -146,11 +139,11 @@ class TciaJob {
   SegmentResult run_segment(std::size_t index, const SegmentProgress& progress = {});
 
  private:
-  std::string segment_key(const TciaSegment& segment) const;
+  std::string segment_key(const Segment& segment) const;
   bool is_current(std::size_t index) const;
-  Shot load_shot(const TciaSegment& segment, std::deque<Image>& keep) const;
-  std::string composite_key(const TciaSegment& segment) const;  // segment_key and the layers
-  std::string layer_key(const TciaSegment& segment, std::size_t layer) const;
+  Shot load_shot(const Segment& segment, std::deque<Image>& keep) const;
+  std::string composite_key(const Segment& segment) const;  // segment_key and the layers
+  std::string layer_key(const Segment& segment, std::size_t layer) const;
 
   // Layers (tcia_job_layers.cpp): checked up front; each solved (or skipped
   // when its record is current) and written, then composited from the files.
@@ -165,14 +158,14 @@ class TciaJob {
   void read_keys(const std::vector<KeyFile>& keys, std::vector<Image>& paintings, std::vector<Image>& masks) const;
 
   TciaJobConfig config_;
-  std::vector<TciaSegment> segments_;
+  std::vector<Segment> segments_;
   std::vector<std::size_t> selected_;
   StylizeJob frames_;  // validates the per-frame inputs, names the outputs, writes the contact sheet
   std::vector<Image> paintings_, masks_;  // per key (masks_ empty for a whole key)
   std::vector<Image> layer_paintings_;    // per layer (empty: the shared painting)
   std::vector<Image> layer_style_masks_;  // per layer: its part of the exemplar (empty: all of it)
   std::vector<std::vector<Image>> layer_key_paintings_, layer_key_masks_;  // per layer, per own key
-  Shot with_layer_keys(const Shot& shot, const TciaSegment& segment, std::size_t layer) const;
+  Shot with_layer_keys(const Shot& shot, const Segment& segment, std::size_t layer) const;
   std::string settings_;
 };
 
