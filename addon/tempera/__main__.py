@@ -3,8 +3,8 @@
 
 `tempera farm ...` and `tempera stylize --scheduler ADDRESS ...` run a shot on
 a Dask cluster (tempera.app.farm); `tempera rigid ...` and `tempera stylize
---method rigid ...` run the rigid-body method on a guide cache's tracks
-(tempera.methods.rigid.rigid_cli); `tempera exemplar ...` writes one of the
+--method M ...` for a method the registry says is written in Python (rigid:
+tempera.methods.rigid.rigid_cli) run that method; `tempera exemplar ...` writes one of the
 project's own smoke/fire/ink exemplars (tempera.app.exemplar_cli); every other command is the
 native batch CLI
 (tempera_native/bin/tempera: synth, stylize, render-guides), run with this
@@ -57,10 +57,12 @@ def main(argv=None):
         from .methods.rigid.rigid_cli import main as rigid_main
 
         return rigid_main(argv[1:])
-    if argv[:1] == ["stylize"] and stylize_method(argv[1:]) == "rigid":
-        from .methods.rigid.rigid_cli import stylize_main
+    if argv[:1] == ["stylize"] and stylize_method(argv[1:]) is not None:
+        from .methods import registry
 
-        return stylize_main(argv[1:])
+        python_command = registry.python_command(stylize_method(argv[1:]))  # a method written in Python
+        if python_command is not None:
+            return python_command(argv[1:])
     if argv[:1] == ["exemplar"]:
         from .app.exemplar_cli import main as exemplar_main
 

@@ -122,7 +122,7 @@ function keyFrame(text) {
 // --layer-key NAME:F=PATH) and to the shot's ends; null for per-frame StyLit. The one copy
 // of the job core's rule (native/include/tempera/app/segments.hpp) that cannot call it:
 // the Flamenco manager runs no Tempera. tests/python/test_farm.py holds it to
-// tempera.app.farm.tcia_segments, which does.
+// tempera.app.farm.shot_segments, which does.
 function tciaSegments(frames, args) {
     const methods = optionValues(args, "--method");
     if (methods[methods.length - 1] !== "tcia") return null;

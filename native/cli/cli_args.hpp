@@ -54,11 +54,12 @@ int run_render_guides(const Args& args);
 int run_stylize(const Args& args);
 int run_noisy(const Args& args);
 // `tempera stylize --method lazyfluids` (lazyfluids_command.cpp).
-bool wants_lazyfluids(const Args& args);
 int run_lazyfluids(const Args& args);
 // `stylize --method fluidymation` (fluidymation_command.cpp).
-bool wants_fluidymation(const Args& args);
 int run_stylize_fluidymation(const Args& args);
+// The method of `stylize` arguments: the last --method's value, else stylit.
+// run_stylize sends the arguments to that method's command (methods/registry.hpp).
+std::string method_of(const Args& args);
 
 // Which Blender renders guides, and where it finds the tempera package.
 struct BlenderSetup {

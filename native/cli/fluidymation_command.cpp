@@ -86,12 +86,6 @@ FluidymationJobConfig parse(const Args& args) {
 
 }  // namespace
 
-bool wants_fluidymation(const Args& args) {
-  for (std::size_t i = 0; i + 1 < args.size(); ++i)
-    if (args[i] == "--method" && args[i + 1] == "fluidymation") return true;
-  return false;
-}
-
 int run_stylize_fluidymation(const Args& args) {
   if (ArgReader(args, "stylize").wants_help()) {
     std::string text = kHelp;

@@ -108,12 +108,6 @@ bool run_frames(LazyFluidsJob& job) {
 
 }  // namespace
 
-bool wants_lazyfluids(const Args& args) {
-  for (std::size_t i = 0; i + 1 < args.size(); ++i)
-    if (args[i] == "--method" && args[i + 1] == "lazyfluids") return true;
-  return false;
-}
-
 int run_lazyfluids(const Args& args) {
   if (ArgReader(args, "stylize").wants_help()) {
     std::cout << lazyfluids_help();

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <optional>
 
 #include "cli_args.hpp"
@@ -15,6 +16,7 @@
 #include "tempera/engine/error.hpp"
 #include "tempera/app/image_io.hpp"
 #include "tempera/methods/noisy/noisy_sequence.hpp"
+#include "tempera/methods/registry.hpp"
 #include "tempera/app/process.hpp"
 #include "tempera/methods/stylit/stylize_job.hpp"
 #include "tempera/methods/tcia/tcia_job.hpp"
@@ -192,17 +194,8 @@ bool set_engine_flag(Options& o, const std::string& flag, ArgReader& r) {
   return true;
 }
 
-// The rigid-body method is the Python package's (tempera.methods.rigid.rigid_cli): the
-// wheel's `tempera` command and `python -m tempera` run it before this CLI.
-constexpr const char* kRigidElsewhere =
-    "--method rigid runs in the Python package: use the pip-installed 'tempera stylize --method rigid ...' "
-    "or 'python -m tempera stylize --method rigid ...' (docs/rigid_bodies.md)";
-
+// run_stylize has sent every other method to its own command.
 void check_method(Options& o) {
-  if (o.method != "stylit" && o.method != "tcia")
-    throw ValueError(o.method == "rigid" ? std::string(kRigidElsewhere)
-                                         : concat("unknown --method '", o.method,
-                                                  "' (choose stylit, tcia, lazyfluids, fluidymation or rigid)"));
   if (o.method == "stylit") {
     if (!o.keys.empty() || o.segment || !o.tcia_flags.empty() || !o.layers.empty() || o.layer_order)
       throw ValueError(concat(!o.keys.empty()         ? "--key"
@@ -434,13 +427,47 @@ bool run_segments(TciaJob& job, const Options& o) {
   return true;
 }
 
+// A method written in Python (rigid): the wheel's `tempera` command and
+// `python -m tempera` run it before this CLI (tempera/__main__.py).
+std::string runs_in_python(const MethodEntry& method) {
+  return concat("--method ", method.name, " runs in the Python package: use the pip-installed 'tempera stylize --method ",
+                method.name, " ...' or 'python -m tempera stylize --method ", method.name, " ...' (", method.docs, ")");
+}
+
+// The command of each native method of the registry; StyLit and the coherent
+// method share this file's (run_stylit_or_tcia).
+int run_stylit_or_tcia(const Args& args);
+const std::map<std::string, int (*)(const Args&)>& method_commands() {
+  static const std::map<std::string, int (*)(const Args&)> commands = {
+      {"stylit", run_stylit_or_tcia},
+      {"tcia", run_stylit_or_tcia},
+      {"lazyfluids", run_lazyfluids},
+      {"fluidymation", run_stylize_fluidymation},
+  };
+  return commands;
+}
+
 }  // namespace
 
+std::string method_of(const Args& args) {
+  std::string method = "stylit";
+  for (std::size_t i = 0; i + 1 < args.size(); ++i)
+    if (args[i] == "--method") method = args[i + 1];
+  return method;
+}
+
 int run_stylize(const Args& args) {
-  if (wants_lazyfluids(args)) return run_lazyfluids(args);
-  if (wants_fluidymation(args)) return run_stylize_fluidymation(args);
-  for (std::size_t i = 0; i + 1 < args.size(); ++i)  // before its options are taken for stylit's
-    if (args[i] == "--method" && args[i + 1] == "rigid") throw ValueError(kRigidElsewhere);
+  const MethodEntry& method = find_method(method_of(args));  // before its options are taken for stylit's
+  if (!method.python_command.empty()) throw ValueError(runs_in_python(method));
+  const auto command = method_commands().find(method.name);
+  if (command == method_commands().end())
+    throw std::logic_error(concat("the registry's method '", method.name, "' has no native command"));
+  return command->second(args);
+}
+
+namespace {
+
+int run_stylit_or_tcia(const Args& args) {
   if (ArgReader(args, "stylize").wants_help() || args.empty()) {
     std::cout << stylize_help();
     return args.empty() ? 2 : 0;
@@ -491,4 +518,5 @@ int run_stylize(const Args& args) {
   return 0;
 }
 
+}  // namespace
 }  // namespace tempera::cli

@@ -8,12 +8,20 @@
 #include "tempera/app/job_inputs.hpp"
 #include "tempera/app/record.hpp"
 #include "tempera/app/segments.hpp"
+#include "tempera/methods/registry.hpp"
 
 namespace py = pybind11;
 using namespace tempera;
 using py_bridge::FloatArray;
 
 namespace {
+
+py::dict method_dict(const MethodEntry& e) {
+  py::dict d;
+  d["name"] = e.name, d["title"] = e.title, d["summary"] = e.summary, d["paper"] = e.paper;
+  d["unit"] = e.unit, d["docs"] = e.docs, d["python_command"] = e.python_command;
+  return d;
+}
 
 void register_exceptions(py::module_& m) {
   static py::exception<CancelledError> cancelled(m, "Cancelled", PyExc_RuntimeError);
@@ -104,6 +112,18 @@ void bind_io(py::module_& m) {
       },
       py::arg("record"), py::arg("format"), py::arg("key"), py::arg("files"),
       "True when the record has this format and key and every file is unchanged.");
+  m.def(
+      "methods",
+      [] {
+        py::list out;
+        for (const MethodEntry& e : method_registry()) out.append(method_dict(e));
+        return out;
+      },
+      "The method registry (methods/registry.hpp): a dict per method (name, title, summary, paper, unit, docs, "
+      "python_command), in the panel's order.");
+  m.def(
+      "find_method", [](const std::string& name) { return method_dict(find_method(name)); }, py::arg("name"),
+      "The registry's entry of `name`; ValueError naming every method.");
   m.def(
       "key_segments",
       [](const std::vector<int>& frames, const std::vector<int>& key_frames) {

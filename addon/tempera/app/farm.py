@@ -101,14 +101,26 @@ def _option_values(args, name):
     return values
 
 
-def tcia_segments(frames, stylize_args):
-    """The coherent method's segments [first, ..., last] of a shot: from key
-    to key (the shot's --key and every layer's --layer-key) and to the shot's
-    ends, by the rule `tempera stylize --method tcia` solves them with
-    (native/include/tempera/app/segments.hpp); None for per-frame StyLit."""
-    if _option_values(stylize_args, "--method")[-1:] != ["tcia"]:
+def method_unit(stylize_args):
+    """The unit of work of the shot's method (the method registry,
+    native/include/tempera/methods/registry.hpp): "frame", "segment" or
+    "chained frame"; FarmError for a method the registry does not know."""
+    from ..methods import registry  # here: a worker that only runs commands needs no native module
+    try:
+        return registry.find((_option_values(stylize_args, "--method") or ["stylit"])[-1])["unit"]
+    except ValueError as e:
+        raise FarmError(str(e)) from None
+
+
+def shot_segments(frames, stylize_args):
+    """The segments [first, ..., last] of a shot whose method's unit is the
+    segment (the coherent method): from key to key (the shot's --key and
+    every layer's --layer-key) and to the shot's ends, by the rule the job
+    solves them with (native/include/tempera/app/segments.hpp); None for
+    other units."""
+    if method_unit(stylize_args) != "segment":
         return None
-    from .. import _native  # here: planning per-frame shots needs no native module
+    from .. import _native
     from ..methods.tcia import tcia
     try:
         keys = _native.tcia_key_frames(_option_values(stylize_args, "--key"),
@@ -149,7 +161,7 @@ def plan(frames, out, exemplar, *, scene=None, guides=None, exemplar_guides=None
                               tempera + ["render-guides", str(scene), "--frames", format_frames(chunk),
                                          "--out", guides, *guide_args], frames=chunk))
             guide_tasks.append((set(chunk), name))
-    segments = tcia_segments(frames, list(stylize_args))
+    segments = shot_segments(frames, list(stylize_args))
     if temporal is None and segments is None:
         from .settings import DEFAULT_TEMPORAL_WEIGHT as temporal
     # Always stated: the chunks must agree with a single run whatever the CLI's default. The
@@ -159,8 +171,9 @@ def plan(frames, out, exemplar, *, scene=None, guides=None, exemplar_guides=None
     common += list(stylize_args)
     if segments is not None:  # each task solves one segment of the whole shot
         pieces = [(p, ["--frames", format_frames(frames), "--segment", f"{p[0]}-{p[-1]}"]) for p in segments]
-    else:  # a temporal chain is one task
-        pieces = [(p, ["--frames", format_frames(p)]) for p in ([frames] if temporal else
+    else:  # a temporal chain is one task, as is a method of chained frames
+        chained = bool(temporal) or method_unit(stylize_args) == "chained frame"
+        pieces = [(p, ["--frames", format_frames(p)]) for p in ([frames] if chained else
                                                                 chunk_frames(frames, chunk_size))]
     stylize_names = []
     for piece, which in pieces:

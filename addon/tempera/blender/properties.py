@@ -5,6 +5,7 @@ from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProp
 from bpy.types import PropertyGroup
 
 from ..app import guide_cache
+from ..methods import registry
 from ..methods.noisy import noisy
 from ..app import settings as limits
 from ..app.frames import MAX_FRAME
@@ -106,20 +107,7 @@ def _keep_guide_end_after_start(self, _context):
         self.guide_frame_start = self.guide_frame_end
 
 
-METHOD_ITEMS = (
-    ("STYLIT", "Per-Frame StyLit", "Each frame painted on its own from the light-path guides (with the temporal "
-     "guide's pull towards the previous frame); frames split anywhere over machines"),
-    ("TCIA", "Temporally Coherent (Bénard 2013)", "The whole shot at once, coarse to fine in forward and backward "
-     "sweeps along the motion, so the paint stays on the surfaces; painted Keyframes come out as painted and "
-     "steer the frames around them (Stylize Frame stays per-frame StyLit)"),
-    ("RIGID", "Rigid Bodies (hand-drawn)", "The squash, stretch and line of drawn examples carried onto the "
-     "scene's rigid-body simulation (Dvorožňák 2017; needs a baked rigid-body world)"),
-    ("LAZYFLUIDS", "Fluid (LazyFluids)", "Smoke, fire and liquids painted from an RGBA exemplar carried along the "
-     "fluid's flow, its texture kept fresh by uniform patch usage (Jamriška 2015); RGBA frames over the render"),
-    ("FLUIDYMATION", "Natural Media (Fluidymation)", "A moving object or collection rendered as a filmed medium "
-     "(ink, watercolour) spreading along its motion, from a video exemplar with masks (Platkevič 2021); RGBA "
-     "frames over the render"),
-)
+METHOD_ITEMS = registry.panel_items()  # the method registry (native/include/tempera/methods/registry.hpp)
 MEDIA_EXEMPLAR_KINDS = (
     ("STILL", "Still Image", "One RGBA image (LazyFluids only: Fluidymation needs the medium's motion)"),
     ("SEQUENCE", "Image Sequence", "A folder of frames, or the first file of a numbered sequence (ink_0001.png)"),

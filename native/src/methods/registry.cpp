@@ -1,0 +1,44 @@
+#include "tempera/methods/registry.hpp"
+
+#include "tempera/engine/error.hpp"
+
+namespace tempera {
+
+const std::vector<MethodEntry>& method_registry() {
+  static const std::vector<MethodEntry> registry = {
+      {"stylit", "Per-Frame StyLit",
+       "Each frame painted on its own from the light-path guides (with the temporal guide's pull towards the "
+       "previous frame); frames split anywhere over machines",
+       "Fišer et al. 2016", "frame", "docs/user_guide.md", ""},
+      {"tcia", "Temporally Coherent (Bénard 2013)",
+       "The whole shot at once, coarse to fine in forward and backward sweeps along the motion, so the paint stays "
+       "on the surfaces; painted Keyframes come out as painted and steer the frames around them (Stylize Frame "
+       "stays per-frame StyLit)",
+       "Bénard et al. 2013", "segment", "docs/coherent.md", ""},
+      {"rigid", "Rigid Bodies (hand-drawn)",
+       "The squash, stretch and line of drawn examples carried onto the scene's rigid-body simulation "
+       "(Dvorožňák 2017; needs a baked rigid-body world)",
+       "Dvorožňák et al. 2017", "frame", "docs/rigid_bodies.md", "tempera.methods.rigid.rigid_cli:stylize_main"},
+      {"lazyfluids", "Fluid (LazyFluids)",
+       "Smoke, fire and liquids painted from an RGBA exemplar carried along the fluid's flow, its texture kept fresh "
+       "by uniform patch usage (Jamriška 2015); RGBA frames over the render",
+       "Jamriška et al. 2015", "chained frame", "docs/lazyfluids.md", ""},
+      {"fluidymation", "Natural Media (Fluidymation)",
+       "A moving object or collection rendered as a filmed medium (ink, watercolour) spreading along its motion, "
+       "from a video exemplar with masks (Platkevič 2021); RGBA frames over the render",
+       "Platkevič et al. 2021", "chained frame", "docs/fluidymation.md", ""},
+  };
+  return registry;
+}
+
+const MethodEntry& find_method(const std::string& name) {
+  const auto& registry = method_registry();
+  std::string choices;
+  for (std::size_t i = 0; i < registry.size(); ++i) {
+    if (registry[i].name == name) return registry[i];
+    choices += concat(i == 0 ? "" : i + 1 == registry.size() ? " or " : ", ", registry[i].name);
+  }
+  throw ValueError(concat("unknown --method '", name, "' (choose ", choices, ")"));
+}
+
+}  // namespace tempera
