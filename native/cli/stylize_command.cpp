@@ -13,6 +13,7 @@
 
 #include "cli_args.hpp"
 #include "frame_loop.hpp"
+#include "scene_guides.hpp"
 #include "tempera/engine/error.hpp"
 #include "tempera/app/image_io.hpp"
 #include "tempera/methods/noisy/noisy_sequence.hpp"
@@ -284,14 +285,7 @@ Options parse(const Args& args) {
 }
 
 void render_guides(const Options& o, const std::string& scene, const std::string& frames, const std::string& out) {
-  Args options = {"--frames", frames, "--out", out};
-  if (!o.samples.empty()) options.insert(options.end(), {"--samples", o.samples, "--ld12e-samples", o.samples});
-  std::cerr << "tempera stylize: rendering the guides of " << scene << " (frames " << frames << ") into " << out
-            << "\n";
-  const int status = render_guides_in_blender(o.blender, scene, options, interrupt_flag());
-  if (interrupted()) throw CancelledError("interrupted while rendering guides");
-  if (status == 2) throw ValueError(concat("rendering the guides of '", scene, "' failed: bad values (see above)"));
-  if (status != 0) throw IoError(concat("rendering the guides of '", scene, "' failed (see above)"));
+  render_scene_guides(GuideRender{o.blender, o.samples}, scene, frames, out);
 }
 
 bool consecutive(const std::vector<int>& frames) {
@@ -434,15 +428,21 @@ std::string runs_in_python(const MethodEntry& method) {
                 method.name, " ...' or 'python -m tempera stylize --method ", method.name, " ...' (", method.docs, ")");
 }
 
-// The command of each native method of the registry; StyLit and the coherent
-// method share this file's (run_stylit_or_tcia).
+// The command of each native method of the registry. StyLit and the coherent
+// method share this file's (run_stylit_or_tcia), which renders a scene's
+// guides itself (and an exemplar scene's); the others read a guide cache, and
+// run_stylize renders a scene's for them first.
 int run_stylit_or_tcia(const Args& args);
-const std::map<std::string, int (*)(const Args&)>& method_commands() {
-  static const std::map<std::string, int (*)(const Args&)> commands = {
-      {"stylit", run_stylit_or_tcia},
-      {"tcia", run_stylit_or_tcia},
-      {"lazyfluids", run_lazyfluids},
-      {"fluidymation", run_stylize_fluidymation},
+struct MethodCommand {
+  int (*run)(const Args&);
+  bool renders_scenes;
+};
+const std::map<std::string, MethodCommand>& method_commands() {
+  static const std::map<std::string, MethodCommand> commands = {
+      {"stylit", {run_stylit_or_tcia, true}},
+      {"tcia", {run_stylit_or_tcia, true}},
+      {"lazyfluids", {run_lazyfluids, false}},
+      {"fluidymation", {run_stylize_fluidymation, false}},
   };
   return commands;
 }
@@ -462,7 +462,14 @@ int run_stylize(const Args& args) {
   const auto command = method_commands().find(method.name);
   if (command == method_commands().end())
     throw std::logic_error(concat("the registry's method '", method.name, "' has no native command"));
-  return command->second(args);
+  if (command->second.renders_scenes) return command->second.run(args);
+  Args with_guides;
+  try {
+    with_guides = with_scene_guides(args);  // SCENE.blend: its guides first
+  } catch (const CancelledError&) {
+    return report_interrupted("stylize");
+  }
+  return command->second.run(with_guides);
 }
 
 namespace {

@@ -3,6 +3,7 @@ import os
 import shutil
 import signal
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -134,3 +135,60 @@ def test_scene_form_renders_guides_with_blender(cli_path, tmp_path):
                     "--out", out, "--samples", "2", "--temporal", "0.5", "--threads", "2", "--no-video", timeout=600)
     assert again.returncode == 0, again.stderr[-2000:]
     assert "0 frame(s) stylized, 2 skipped" in again.stdout
+
+
+def _tiny_scene(blend):
+    code = (f"import sys, bpy; sys.path.insert(0, {str(ROOT / 'scenes')!r}); import demo_scene; "
+            "scene = bpy.context.scene; demo_scene.build_scene(scene); "
+            "scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = 64, 48, 50; "
+            f"bpy.ops.wm.save_as_mainfile(filepath={str(blend)!r})")
+    made = subprocess.run([BLENDER, "-b", "--factory-startup", "--python-exit-code", "1", "--python-expr", code],
+                          capture_output=True, text=True, timeout=120,
+                          env=dict(os.environ, PYTHONPATH=str(ROOT / "addon")))
+    assert made.returncode == 0, made.stderr[-2000:]
+
+
+def _exemplar(kind, out, size, frames):
+    made = subprocess.run([sys.executable, "-m", "tempera", "exemplar", kind, "--out", str(out), "--size", size,
+                           "--frames", str(frames)], capture_output=True, text=True, timeout=120,
+                          env=dict(os.environ, PYTHONPATH=str(ROOT / "addon")))
+    assert made.returncode == 0, made.stderr
+
+
+@pytest.mark.skipif(shutil.which(BLENDER) is None, reason="Blender not installed")
+def test_fluid_methods_render_a_scenes_guides_first(cli_path, tmp_path):
+    """Step 5 of issue 41: `stylize SCENE.blend` for the methods that read a guide cache
+    (LazyFluids, Fluidymation) renders the guides into OUT/guides, then runs the method."""
+    blend = tmp_path / "shot.blend"
+    _tiny_scene(blend)
+    _exemplar("smoke", tmp_path / "smoke", "64x64", 1)
+    _exemplar("ink", tmp_path / "ink", "64x64", 6)
+    runs = {"lazyfluids": ("--exemplar", tmp_path / "smoke" / "frame_0001.png"),
+            "fluidymation": ("--exemplar", tmp_path / "ink", "--exemplar-masks", tmp_path / "ink" / "masks")}
+    for method, exemplar in runs.items():
+        out = tmp_path / method
+        args = (blend, "--method", method, *exemplar, "--frames", "1-2", "--out", out, "--samples", "2",
+                "--threads", "2")
+        result = stylize(cli_path, *args, timeout=600)
+        assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
+        assert "rendering the guides of" in result.stderr and (out / "guides" / "frame_0002.exr").is_file()
+        frames = sorted(out.rglob("frame_000[12].png"))
+        assert len(frames) == 2 and all(tempera.read_image(str(f)).shape == (24, 32, 4) for f in frames), frames
+        again = stylize(cli_path, *args, timeout=600)
+        assert again.returncode == 0, again.stderr[-2000:]
+        assert "rendered 0 frame(s), 2 already current" in again.stdout + again.stderr  # Blender's output
+        assert again.stdout.count("skipped, already current") == 2, again.stdout[-2000:]
+
+
+def test_a_scene_for_a_fluid_method_is_checked_before_blender_runs(cli_path, tmp_path):
+    blend = tmp_path / "shot.blend"
+    blend.write_bytes(b"BLENDER")  # never opened: the checks come first
+    base = (blend, "--method", "lazyfluids", "--exemplar", tmp_path / "x.png")
+    no_frames = stylize(cli_path, *base, "--out", tmp_path / "o")
+    assert no_frames.returncode == 2 and "--frames is required" in no_frames.stderr
+    no_blender = stylize(cli_path, *base, "--frames", "1-2", "--out", tmp_path / "o", "--blender",
+                         tmp_path / "no_blender")
+    assert no_blender.returncode == 1 and "cannot run" in no_blender.stderr, no_blender.stderr
+    missing = stylize(cli_path, tmp_path / "none.blend", "--method", "fluidymation", "--exemplar", tmp_path,
+                      "--frames", "1-2", "--out", tmp_path / "o")
+    assert missing.returncode == 1 and "scene file not found" in missing.stderr
