@@ -2,6 +2,10 @@
 written atomically, resumed runs keep finished frames, bad input is named
 with a non-zero exit code."""
 import json
+import os
+import shutil
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -9,6 +13,7 @@ import pytest
 from tempera import _native
 from tempera.methods.rigid import rigid, rigid_tracks
 from tempera.__main__ import main
+from conftest import ROOT
 
 W, H = 240, 160
 
@@ -221,3 +226,61 @@ def test_frames_are_on_disk_as_they_are_drawn_and_kill_9_resumes(inputs):
     for f in range(1, 25):
         name = f"frame_{f:04d}.png"
         assert (inputs / "killed" / name).read_bytes() == (inputs / "whole" / name).read_bytes(), name
+
+
+BLENDER = os.environ.get("TEMPERA_BLENDER", "blender")
+RIGID_SCENE = """
+import math, bpy
+scene = bpy.context.scene
+for o in list(scene.objects):
+    bpy.data.objects.remove(o)
+bpy.ops.mesh.primitive_plane_add(size=40, location=(0, 0, 0))
+floor = bpy.context.object
+if scene.rigidbody_world is None:
+    bpy.ops.rigidbody.world_add()
+bpy.ops.rigidbody.object_add()
+floor.rigid_body.type = "PASSIVE"
+bpy.ops.mesh.primitive_uv_sphere_add(radius=0.5, location=(-2, 0, 3))
+ball = bpy.context.object
+ball.name = "Target"
+bpy.ops.rigidbody.object_add()
+ball.rigid_body.collision_shape = "SPHERE"
+ball.rigid_body.restitution = 0.9
+cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
+cam.data.type = "ORTHO"
+cam.data.ortho_scale = 10
+scene.collection.objects.link(cam)
+cam.location, cam.rotation_euler = (0, -10, 2.5), (math.pi / 2, 0, 0)
+scene.camera = cam
+r = scene.render
+r.resolution_x, r.resolution_y, r.resolution_percentage = 96, 64, 100
+scene.frame_start, scene.frame_end = 1, 12
+scene.rigidbody_world.point_cache.frame_end = 12
+bpy.ops.wm.save_as_mainfile(filepath=PATH)
+"""
+
+
+@pytest.mark.skipif(shutil.which(BLENDER) is None, reason="Blender not installed")
+def test_stylize_a_scene_renders_its_guides_and_tracks_first(tmp_path, cli_path):
+    """Step 5 of issue 41: `tempera stylize SCENE.blend --method rigid` as for the other methods."""
+    blend = tmp_path / "shot.blend"
+    made = subprocess.run([BLENDER, "-b", "--factory-startup", "--python-exit-code", "1", "--python-expr",
+                           f"PATH = {str(blend)!r}\n" + RIGID_SCENE], capture_output=True, text=True, timeout=120)
+    assert made.returncode == 0, made.stderr[-2000:]
+    (tmp_path / "ex").mkdir()
+    _exemplar(tmp_path / "ex")
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "addon"), TEMPERA_CLI=str(cli_path), TEMPERA_BLENDER=BLENDER)
+    command = [sys.executable, "-m", "tempera", "stylize", str(blend), "--method", "rigid", "--exemplar",
+               str(tmp_path / "ex"), "--frames", "1-12", "--out", str(tmp_path / "out"), "--samples", "1"]
+    result = subprocess.run(command, capture_output=True, text=True, timeout=600, env=env)
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
+    assert "rendering the guides of" in result.stderr
+    assert (tmp_path / "out" / "guides" / rigid_tracks.TRACKS_NAME).is_file()
+    frames = sorted((tmp_path / "out").glob("frame_*.png"))
+    assert len(frames) == 12 and _native.read_image(str(frames[0]), None).shape == (64, 96, 4)
+    assert max(_native.read_image(str(f), None)[:, :, 3].max() for f in frames) > 0.5  # the ball is drawn
+    again = subprocess.run(command, capture_output=True, text=True, timeout=600, env=env)
+    assert again.returncode == 0 and "0 frames written, 12 kept" in again.stdout, again.stderr[-2000:]
+    no_frames = subprocess.run(command[:-6] + ["--out", str(tmp_path / "o2")], capture_output=True, text=True,
+                               timeout=120, env=env)
+    assert no_frames.returncode == 2 and "--frames is required with a scene" in no_frames.stderr

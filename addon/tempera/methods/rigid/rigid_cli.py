@@ -6,6 +6,9 @@ tracks, with no Blender.
                   [--strokes IMAGE|generated] [method options]
     tempera stylize --method rigid --guides CACHE --exemplar EXEMPLAR ... (the same,
                   in the form of the other methods: --guides names the cache)
+    tempera stylize SCENE.blend --method rigid --exemplar EXEMPLAR --frames A-B --out OUT
+                  [--samples N] ... (the scene's guides and tracks rendered first, into
+                  --guides, default OUT/guides, by the native tempera render-guides)
 
 CACHE holds tracks.json (tempera.methods.rigid.rigid_tracks) of the target simulation and
 its manifest (the frame size). Each EXEMPLAR folder holds the source
@@ -31,7 +34,7 @@ import numpy as np
 
 from ... import _native
 from . import rigid, rigid_strokes, rigid_tracks
-from ...app import record
+from ...app import record, scene_guides
 from ...app.command import run_command
 from ...app.frames import parse_frames
 
@@ -209,8 +212,10 @@ STYLIZE_PROG = "tempera stylize --method rigid"
 
 
 def stylize_main(argv):
-    """`tempera stylize --method rigid ...`: `tempera rigid` in the form of
-    the other methods (stylize's argv without "stylize"); the same run."""
+    """`tempera stylize [SCENE.blend] --method rigid ...`: `tempera rigid` in
+    the form of the other methods (stylize's argv without "stylize"); the same
+    run. With a scene first, its guides (and tracks) are rendered into --guides
+    (default OUT/guides) first (tempera.app.scene_guides)."""
     rest, skip = [], False
     for a, b in zip(argv, argv[1:] + [""]):
         if skip:
@@ -219,4 +224,11 @@ def stylize_main(argv):
             skip = True
         elif a != "--method=rigid":
             rest.append(a)
-    return main(rest, STYLIZE_PROG)
+    ready = {}
+
+    def render_guides():
+        ready["argv"] = scene_guides.with_scene_guides(rest, STYLIZE_PROG)
+        return 0
+
+    status = run_command(STYLIZE_PROG, render_guides, "cancelled while rendering the guides; rerun the same command")
+    return status or main(ready["argv"], STYLIZE_PROG)

@@ -134,15 +134,23 @@ def make_track(centres, theta, radius, gravity, others=None, threshold=None):
 
 def write_tracks(cache_dir, tracks, frame_start, gravity):
     """Writes <cache>/tracks.json atomically (temporary file, then rename):
-    {"format", "frame_start", "gravity", "objects": {name: track}}."""
+    {"format", "frame_start", "gravity", "objects": {name: track}}. The same
+    tracks again leave the file as it is, so a rerun of the guide render keeps
+    the frames made from them current (their records stamp the file)."""
     cache_dir = Path(cache_dir)
     cache_dir.mkdir(parents=True, exist_ok=True)
     data = {"format": TRACKS_VERSION, "frame_start": int(frame_start),
             "gravity": [float(x) for x in gravity], "objects": tracks}
+    text = json.dumps(data, indent=1, sort_keys=True)
+    try:
+        if (cache_dir / TRACKS_NAME).read_text(encoding="utf-8") == text:
+            return
+    except (OSError, UnicodeDecodeError):
+        pass
     fd, tmp = tempfile.mkstemp(prefix=".tracks.", suffix=".partial", dir=cache_dir)
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as f:
-            json.dump(data, f, indent=1, sort_keys=True)
+            f.write(text)
         os.replace(tmp, cache_dir / TRACKS_NAME)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
