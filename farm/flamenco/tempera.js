@@ -111,6 +111,20 @@ function optionValues(args, name) {
     return values;
 }
 
+// The methods this job type plans: those guided by light paths (the method registry's
+// light_path_guides, native/include/tempera/methods/registry.hpp), whose settings are the
+// ones above (the exemplar's guides, the temporal weight, the video). tempera.app.farm
+// (Dask) plans every method.
+const LIGHT_PATH_METHODS = ["stylit", "tcia"];
+
+function checkMethod(args) {
+    const methods = optionValues(args, "--method");
+    const name = methods.length ? methods[methods.length - 1] : "stylit";
+    if (!LIGHT_PATH_METHODS.includes(name))
+        throw `the Flamenco job type plans stylit and tcia shots; run --method ${name} with ` +
+            "'tempera farm' (Dask) or 'tempera stylize'";
+}
+
 // The frame of a --key text "F=PATH[,MASK]".
 function keyFrame(text) {
     const number = text.split("=")[0];
@@ -182,6 +196,7 @@ function compileJob(job) {
     }
 
     const stylizeArgs = splitArgs(s.stylize_args);
+    checkMethod(stylizeArgs);
     const segments = tciaSegments(frames, stylizeArgs);
     // Always stated: the chunks must agree with a single run whatever the CLI's default. The
     // coherent method keeps its own (3; give --temporal W in stylize_args to change it).

@@ -19,7 +19,8 @@ namespace {
 py::dict method_dict(const MethodEntry& e) {
   py::dict d;
   d["name"] = e.name, d["title"] = e.title, d["summary"] = e.summary, d["paper"] = e.paper;
-  d["unit"] = e.unit, d["docs"] = e.docs, d["python_command"] = e.python_command;
+  d["unit"] = e.unit, d["light_path_guides"] = e.light_path_guides, d["docs"] = e.docs;
+  d["python_command"] = e.python_command;
   return d;
 }
 
@@ -119,8 +120,8 @@ void bind_io(py::module_& m) {
         for (const MethodEntry& e : method_registry()) out.append(method_dict(e));
         return out;
       },
-      "The method registry (methods/registry.hpp): a dict per method (name, title, summary, paper, unit, docs, "
-      "python_command), in the panel's order.");
+      "The method registry (methods/registry.hpp): a dict per method (name, title, summary, paper, unit, "
+      "light_path_guides, docs, python_command), in the panel's order.");
   m.def(
       "find_method", [](const std::string& name) { return method_dict(find_method(name)); }, py::arg("name"),
       "The registry's entry of `name`; ValueError naming every method.");

@@ -9,6 +9,7 @@ import sys
 import pytest
 
 from tempera.app import farm
+from tempera.methods import registry
 from tempera.methods.tcia import tcia
 from conftest import ROOT
 
@@ -161,3 +162,56 @@ def test_flamenco_default_temporal_weight_is_temperas():
 
     js = (Path(__file__).resolve().parents[2] / "farm" / "flamenco" / "tempera.js").read_text()
     assert f'key: "temporal", type: "float", default: {DEFAULT_TEMPORAL_WEIGHT:.1f}' in js
+
+
+SHOT_CACHE = dict(frames="1-24", out="/o", exemplar="/ex", guides="/g", chunk_size=8)
+
+
+def test_the_farm_plans_every_method_with_its_own_inputs():
+    """Methods not guided by light paths (the registry's light_path_guides) get no exemplar
+    guides, no --temporal and no --no-video, which their commands would refuse."""
+    for m in registry.METHODS:
+        if m["light_path_guides"]:
+            continue
+        tasks = farm.plan(**SHOT_CACHE, stylize_args=["--method", m["name"]])
+        for t in tasks:
+            assert not {"--exemplar-guides", "--temporal", "--no-video"} & set(t.command), t.command
+        stylize = [t for t in tasks if t.kind == "stylize"]
+        assert len(stylize) == (1 if m["unit"] == "chained frame" else 3), [t.name for t in stylize]
+        with pytest.raises(farm.FarmError, match="takes its exemplar as it is"):
+            farm.plan(**SHOT_CACHE, exemplar_guides="/eg", stylize_args=["--method", m["name"]])
+
+
+def test_a_planned_lazyfluids_shot_equals_one_run(cli_path, tmp_path):
+    """The farm's commands for a chained-frame method, run in their order, make the frames of one
+    `tempera stylize` run, byte for byte."""
+    from test_lazyfluids import disc, flow, smoke
+    import tempera
+    from tempera.app import guide_cache
+
+    for f in range(1, 5):
+        guide_cache.write_frame(tmp_path / "cache", f, {"alpha": disc(14 + 2 * f), "fluid_velocity": flow()})
+    tempera.write_image(str(tmp_path / "smoke.png"), smoke())
+    args = ["--method", "lazyfluids", "--em-iters", "2", "--threads", "2"]
+    tasks = farm.plan("1-4", tmp_path / "farm", tmp_path / "smoke.png", guides=tmp_path / "cache", chunk_size=2,
+                      tempera=[str(cli_path)], stylize_args=args)
+    for t in tasks:
+        assert subprocess.run(t.command, capture_output=True, text=True, timeout=300).returncode == 0, t.command
+    one = subprocess.run([str(cli_path), "stylize", "--guides", str(tmp_path / "cache"), "--exemplar",
+                          str(tmp_path / "smoke.png"), "--frames", "1-4", "--out", str(tmp_path / "one"), *args],
+                         capture_output=True, text=True, timeout=300)
+    assert one.returncode == 0, one.stderr
+    for f in range(1, 5):
+        name = f"frames/frame_{f:04d}.png"
+        assert (tmp_path / "farm" / name).read_bytes() == (tmp_path / "one" / name).read_bytes(), name
+
+
+@pytest.mark.skipif(shutil.which("node") is None, reason="node not installed")
+def test_flamenco_refuses_methods_it_cannot_plan():
+    settings = dict(FLAMENCO_SETTINGS, stylize_args="--method lazyfluids")
+    script = ("const {compile} = require(process.argv[1]);"
+              "try { compile(JSON.parse(process.argv[2])); console.log('planned'); } "
+              "catch (e) { console.log(String(e)); }")
+    result = subprocess.run(["node", "-e", script, str(ROOT / "farm" / "flamenco" / "standin.js"),
+                             json.dumps(settings)], capture_output=True, text=True, check=True)
+    assert "plans stylit and tcia shots; run --method lazyfluids" in result.stdout

@@ -2,7 +2,15 @@
 
     tempera farm [SCENE.blend] --exemplar STYLE.png (--exemplar-guides DIR | --exemplar-scene EX.blend)
                  --frames 1-48 --out DIR [--chunk-size 8] [--scheduler tcp://HOST:8786] [stylize options]
+    tempera farm [SCENE.blend] --method lazyfluids|fluidymation|rigid --exemplar EXEMPLAR
+                 --frames 1-48 --out DIR [method options]
     tempera stylize ... --scheduler ADDRESS            (the same)
+
+Every method of the registry (native/include/tempera/methods/registry.hpp) is
+planned by its unit of work and its guide needs: StyLit and tcia (guided by
+light paths) take the exemplar's guides, --temporal and write a video; the
+others take their exemplar as it is. Frames split anywhere, one task per
+segment, one task for chained frames (LazyFluids, Fluidymation).
 
 `plan()` cuts the shot into tasks, each one run of the batch CLI:
 
@@ -101,15 +109,19 @@ def _option_values(args, name):
     return values
 
 
-def method_unit(stylize_args):
-    """The unit of work of the shot's method (the method registry,
-    native/include/tempera/methods/registry.hpp): "frame", "segment" or
-    "chained frame"; FarmError for a method the registry does not know."""
+def shot_method(stylize_args):
+    """The registry's entry of the shot's method (native/include/tempera/methods/registry.hpp):
+    its unit of work ("frame", "segment", "chained frame") and guide needs; FarmError for a
+    method the registry does not know."""
     from ..methods import registry  # here: a worker that only runs commands needs no native module
     try:
-        return registry.find((_option_values(stylize_args, "--method") or ["stylit"])[-1])["unit"]
+        return registry.find((_option_values(stylize_args, "--method") or ["stylit"])[-1])
     except ValueError as e:
         raise FarmError(str(e)) from None
+
+
+def method_unit(stylize_args):
+    return shot_method(stylize_args)["unit"]
 
 
 def shot_segments(frames, stylize_args):
@@ -137,9 +149,14 @@ def plan(frames, out, exemplar, *, scene=None, guides=None, exemplar_guides=None
     frames = parse_frames(frames) if isinstance(frames, str) else sorted(set(frames))
     if not frames:
         raise FarmError("no frames to stylize")
-    if (exemplar_guides is None) == (exemplar_scene is None):
+    method = shot_method(list(stylize_args))
+    light_paths = method["light_path_guides"]  # StyLit's: the exemplar's guides, --temporal, a video
+    if light_paths and (exemplar_guides is None) == (exemplar_scene is None):
         raise FarmError("give the exemplar's guides as exactly one of exemplar_guides (a cache folder) "
                         "and exemplar_scene (a .blend to render)")
+    if not light_paths and (exemplar_guides is not None or exemplar_scene is not None or temporal is not None):
+        raise FarmError(f"--method {method['name']} takes its exemplar as it is: no exemplar guides or scene "
+                        "and no --temporal (those are StyLit's)")
     if scene is None and guides is None:
         raise FarmError("give the shot as a scene (.blend, guides rendered) or as a guide cache folder")
     tempera = list(tempera)
@@ -162,13 +179,15 @@ def plan(frames, out, exemplar, *, scene=None, guides=None, exemplar_guides=None
                                          "--out", guides, *guide_args], frames=chunk))
             guide_tasks.append((set(chunk), name))
     segments = shot_segments(frames, list(stylize_args))
-    if temporal is None and segments is None:
+    if temporal is None and segments is None and light_paths:
         from .settings import DEFAULT_TEMPORAL_WEIGHT as temporal
     # Always stated: the chunks must agree with a single run whatever the CLI's default. The
     # coherent method keeps its own (3) unless one is given.
-    common = ["--guides", guides, "--exemplar", str(exemplar), "--exemplar-guides", str(exemplar_guides),
-              "--out", out] + ([] if temporal is None else ["--temporal", repr(float(temporal))])
+    common = (["--guides", guides, "--exemplar", str(exemplar)]
+              + (["--exemplar-guides", str(exemplar_guides)] if light_paths else [])
+              + ["--out", out] + ([] if temporal is None else ["--temporal", repr(float(temporal))]))
     common += list(stylize_args)
+    no_video = ["--no-video"] if light_paths else []  # the others write no video
     if segments is not None:  # each task solves one segment of the whole shot
         pieces = [(p, ["--frames", format_frames(frames), "--segment", f"{p[0]}-{p[-1]}"]) for p in segments]
     else:  # a temporal chain is one task, as is a method of chained frames
@@ -179,11 +198,11 @@ def plan(frames, out, exemplar, *, scene=None, guides=None, exemplar_guides=None
     for piece, which in pieces:
         name = f"stylize {format_frames(piece)}"
         needs = exemplar_task + [n for covered, n in guide_tasks if covered & set(piece)]
-        tasks.append(Task(name, "stylize", tempera + ["stylize", *which, *common, "--no-video"], needs, piece))
+        tasks.append(Task(name, "stylize", tempera + ["stylize", *which, *common, *no_video], needs, piece))
         stylize_names.append(name)
     tasks.append(Task("finish", "finish",
                       tempera + ["stylize", "--frames", format_frames(frames), *common,
-                                 *([] if video else ["--no-video"])], stylize_names, frames))
+                                 *([] if video else no_video)], stylize_names, frames))
     return tasks
 
 

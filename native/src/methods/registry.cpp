@@ -9,24 +9,24 @@ const std::vector<MethodEntry>& method_registry() {
       {"stylit", "Per-Frame StyLit",
        "Each frame painted on its own from the light-path guides (with the temporal guide's pull towards the "
        "previous frame); frames split anywhere over machines",
-       "Fišer et al. 2016", "frame", "docs/user_guide.md", ""},
+       "Fišer et al. 2016", "frame", true, "docs/user_guide.md", ""},
       {"tcia", "Temporally Coherent (Bénard 2013)",
        "The whole shot at once, coarse to fine in forward and backward sweeps along the motion, so the paint stays "
        "on the surfaces; painted Keyframes come out as painted and steer the frames around them (Stylize Frame "
        "stays per-frame StyLit)",
-       "Bénard et al. 2013", "segment", "docs/coherent.md", ""},
+       "Bénard et al. 2013", "segment", true, "docs/coherent.md", ""},
       {"rigid", "Rigid Bodies (hand-drawn)",
        "The squash, stretch and line of drawn examples carried onto the scene's rigid-body simulation "
        "(Dvorožňák 2017; needs a baked rigid-body world)",
-       "Dvorožňák et al. 2017", "frame", "docs/rigid_bodies.md", "tempera.methods.rigid.rigid_cli:stylize_main"},
+       "Dvorožňák et al. 2017", "frame", false, "docs/rigid_bodies.md", "tempera.methods.rigid.rigid_cli:stylize_main"},
       {"lazyfluids", "Fluid (LazyFluids)",
        "Smoke, fire and liquids painted from an RGBA exemplar carried along the fluid's flow, its texture kept fresh "
        "by uniform patch usage (Jamriška 2015); RGBA frames over the render",
-       "Jamriška et al. 2015", "chained frame", "docs/lazyfluids.md", ""},
+       "Jamriška et al. 2015", "chained frame", false, "docs/lazyfluids.md", ""},
       {"fluidymation", "Natural Media (Fluidymation)",
        "A moving object or collection rendered as a filmed medium (ink, watercolour) spreading along its motion, "
        "from a video exemplar with masks (Platkevič 2021); RGBA frames over the render",
-       "Platkevič et al. 2021", "chained frame", "docs/fluidymation.md", ""},
+       "Platkevič et al. 2021", "chained frame", false, "docs/fluidymation.md", ""},
   };
   return registry;
 }

@@ -20,6 +20,11 @@ struct MethodEntry {
   // frames, split anywhere), "segment" (key to key, one task each) or
   // "chained frame" (each frame made from the previous: one task).
   std::string unit;
+  // StyLit's guide needs: the method matches a painting of an exemplar render
+  // to the shot by light-path guides, so it takes the exemplar's guide cache
+  // (--exemplar-guides or --exemplar-scene), --temporal, and writes a video.
+  // The others take their exemplar as it is (an image, a video, drawings).
+  bool light_path_guides = false;
   std::string docs;  // its page under docs/
   // Where it runs: "" for the native command; else the Python function that
   // runs `tempera stylize --method NAME ...` ("module:function").
