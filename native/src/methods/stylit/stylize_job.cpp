@@ -1,20 +1,10 @@
 #include "tempera/methods/stylit/stylize_job.hpp"
 
-#include <fcntl.h>
-#include <sys/file.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <charconv>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <iomanip>
 #include <limits>
-#include <map>
 #include <sstream>
 
 #include "tempera/app/contact_sheet.hpp"
@@ -52,148 +42,6 @@ std::string settings_text(const StylizeJobConfig& c) {
   s << ";temporal=" << c.stylit.temporal_weight << ";quality=" << quality_name(c.stylit.quality) << ";"
     << settings_text(o, synthesis_option_table()) << "format=" << c.format;
   return s.str();
-}
-
-std::string json_string(const std::string& text) {
-  std::ostringstream out;
-  out << '"';
-  for (unsigned char c : text) {
-    if (c == '"' || c == '\\') out << '\\' << c;
-    else if (c < 0x20) out << "\\u" << std::hex << std::setw(4) << std::setfill('0') << int(c) << std::dec;
-    else out << c;
-  }
-  out << '"';
-  return out.str();
-}
-
-std::string json_number(double value) {
-  if (!std::isfinite(value)) return "null";
-  std::ostringstream out;
-  out << std::setprecision(9) << value;
-  return out.str();
-}
-
-// Reads one report line as write_report() writes it, left to right:
-//   "12": {"key": "...", "file": "...", "flicker": 0.01, "source_coverage": 0.9},
-class LineReader {
- public:
-  explicit LineReader(const std::string& line) : line_(line) {}
-  void expect(const std::string& text) {
-    skip_spaces();
-    if (line_.compare(pos_, text.size(), text) != 0) throw ValueError("unexpected report text");
-    pos_ += text.size();
-  }
-  std::string string() {
-    expect("\"");
-    std::string out;
-    while (pos_ < line_.size() && line_[pos_] != '"') {
-      char c = line_[pos_++];
-      if (c == '\\' && pos_ < line_.size()) {
-        c = line_[pos_++];
-        if (c == 'u') {  // only control characters are written this way
-          c = char(std::stoi(line_.substr(pos_, 4), nullptr, 16));
-          pos_ += 4;
-        }
-      }
-      out += c;
-    }
-    expect("\"");
-    return out;
-  }
-  double number() {
-    skip_spaces();
-    if (line_.compare(pos_, 4, "null") == 0) {
-      pos_ += 4;
-      return std::numeric_limits<double>::quiet_NaN();
-    }
-    std::size_t used = 0;
-    const double value = std::stod(line_.substr(pos_), &used);
-    pos_ += used;
-    return value;
-  }
-
- private:
-  void skip_spaces() {
-    while (pos_ < line_.size() && line_[pos_] == ' ') ++pos_;
-  }
-  const std::string& line_;
-  std::size_t pos_ = 0;
-};
-
-struct ReportEntry {
-  std::string key, file;
-  double flicker = 0, source_coverage = 0;
-  FileDigest digest;  // of the output file as written: a changed or damaged file is redone
-};
-
-// Reads exactly the format write_report() writes: one frame per line. A file
-// that is not such a report (damaged, or from another Tempera version) is
-// renamed aside with a warning and counts as "no frames done": its frames
-// are redone, never wrongly skipped, and nothing of it is lost.
-std::map<int, ReportEntry> read_report(const std::string& path, std::vector<std::string>& warnings) {
-  std::map<int, ReportEntry> entries;
-  std::error_code ec;
-  if (!fs::exists(path, ec)) return entries;
-  std::ifstream in(path);
-  std::string line;
-  bool ok = in && std::getline(in, line) && line == "{" && std::getline(in, line) &&
-            line == concat("  \"format\": ", json_string(kReportFormat), ",");
-  bool closed = false;  // the final "}": a truncated record is damaged, not short
-  try {
-    while (ok && std::getline(in, line)) {
-      if (closed) ok = false;  // text after the end
-      if (line == "}") closed = true;
-      if (line.find("{\"key\": ") == std::string::npos) {
-        if (line.find("\"key\"") != std::string::npos) ok = false;
-        continue;
-      }
-      LineReader r(line);
-      const std::string number = r.string();
-      int frame = -1;
-      const auto [end, error] = std::from_chars(number.data(), number.data() + number.size(), frame);
-      if (error != std::errc() || end != number.data() + number.size() || frame < 0 || frame > kMaxFrame)
-        throw ValueError("bad frame number");
-      ReportEntry e;
-      r.expect(": {\"key\":");
-      e.key = r.string();
-      r.expect(", \"file\":");
-      e.file = r.string();
-      r.expect(", \"flicker\":");
-      e.flicker = r.number();
-      r.expect(", \"source_coverage\":");
-      e.source_coverage = r.number();
-      r.expect(", \"size\":");
-      e.digest.size = std::int64_t(r.number());
-      r.expect(", \"checksum\":");
-      e.digest.checksum = r.string();
-      r.expect("}");
-      entries[frame] = e;
-    }
-  } catch (const std::exception&) {
-    ok = false;
-  }
-  if (ok && closed) return entries;
-  const std::string aside = concat(path, ".corrupt-", temporary_name("", "").substr(5));
-  fs::rename(path, aside, ec);
-  warnings.push_back(concat("the resume record '", path, "' is damaged or from another Tempera version; ",
-                            ec ? "it is ignored" : concat("set aside as '", aside, "'"),
-                            " and its frames are stylized again"));
-  return {};
-}
-
-
-void write_report(const std::string& path, const std::string& settings, const std::map<int, ReportEntry>& entries) {
-  std::ostringstream out;
-  out << "{\n  \"format\": " << json_string(kReportFormat) << ",\n  \"settings\": " << json_string(settings)
-      << ",\n  \"frames\": {";
-  std::size_t i = 0;
-  for (const auto& [frame, e] : entries)
-    out << (i++ ? ",\n" : "\n") << "    \"" << frame << "\": {\"key\": " << json_string(e.key)
-        << ", \"file\": " << json_string(e.file) << ", \"flicker\": " << json_number(e.flicker)
-        << ", \"source_coverage\": " << json_number(e.source_coverage) << ", \"size\": " << e.digest.size
-        << ", \"checksum\": " << json_string(e.digest.checksum) << "}";
-  out << "\n  }\n}\n";
-  write_text_atomically(path, out.str(), "the job report");
 }
 
 // Temporary files (".<name>.tmp<pid>-<random>...") of writers killed with -9.
@@ -239,7 +87,8 @@ Image fit_painting(Image painting, const std::string& path, int width, int heigh
 
 }  // namespace
 
-StylizeJob::StylizeJob(StylizeJobConfig config) : config_(std::move(config)) {
+StylizeJob::StylizeJob(StylizeJobConfig config)
+    : config_(std::move(config)), report_(config_.out, kReportName, kReportFormat) {
   validate_config(config_);
   const auto guides = active_guides(config_.stylit);
   std::vector<std::string> names;
@@ -314,9 +163,7 @@ std::string StylizeJob::output_path(int frame) const {
   return (fs::path(config_.out) / frame_file(config_.prefix, frame, config_.format)).string();
 }
 
-std::string StylizeJob::report_path() const { return (fs::path(config_.out) / kReportName).string(); }
-
-std::string StylizeJob::lock_path() const { return config_.out; }  // the folder itself: no lock file
+std::string StylizeJob::report_path() const { return report_.path(); }
 
 std::string StylizeJob::target_path(int frame) const { return guide_cache_frame(config_.guides, frame); }
 
@@ -335,19 +182,12 @@ FrameResult StylizeJob::run_frame(std::size_t index, const ProgressCallback& pro
   result.path = output_path(result.frame);
   std::error_code ec;
   if (config_.resume) {
-    std::map<int, ReportEntry> done;
-    {
-      FileLock lock(lock_path());
-      done = read_report(report_path(), warnings_);
-    }
-    const auto it = done.find(result.frame);
     // Current: same key, and the file is the one written (size and checksum),
     // so a truncated or overwritten output is made again.
-    if (it != done.end() && it->second.key == keys_[index] && fs::is_regular_file(result.path, ec) &&
-        file_digest(result.path) == it->second.digest) {
+    if (const auto done = report_.current(result.frame, keys_[index], result.path, warnings_)) {
       result.status = "skipped";
-      result.flicker = it->second.flicker;
-      result.source_coverage = it->second.source_coverage;
+      result.flicker = done->flicker;
+      result.source_coverage = done->source_coverage;
       return result;
     }
   }
@@ -375,16 +215,11 @@ FrameResult StylizeJob::run_frame(std::size_t index, const ProgressCallback& pro
                        ? std::numeric_limits<double>::quiet_NaN()
                        : flicker(previous.view(), synth.image.view(), temporal.velocity_backward,
                                  temporal.occlusion_backward);
-  // Merge into what is on disk under the folder's lock: other processes and
-  // machines may share this folder, and each adds its own frames.
-  const FileDigest digest = file_digest(result.path);
-  {
-    FileLock lock(lock_path());
-    auto entries = read_report(report_path(), warnings_);
-    entries[result.frame] = {keys_[index], fs::path(result.path).filename().string(), result.flicker,
-                             result.source_coverage, digest};
-    write_report(report_path(), settings_, entries);
-  }
+  // Other processes and machines may share this folder, each adding its own frames.
+  report_.add(result.frame,
+              {keys_[index], fs::path(result.path).filename().string(), result.flicker, result.source_coverage,
+               file_digest(result.path)},
+              settings_, warnings_);
   result.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return result;
 }

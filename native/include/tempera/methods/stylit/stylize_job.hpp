@@ -3,13 +3,15 @@
 // cache frame and the target guide cache in, one stylized image per frame
 // out. Shared by `tempera stylize` and the Blender add-on, which calls
 // run_frame() once per modal step. Frames are resumable: each output is
-// written atomically and recorded with a key in OUT/tempera_stylize.json, and
-// a rerun skips frames whose key still matches.
+// written atomically and recorded with a key in the job core's shared frame
+// report OUT/tempera_stylize.json (app/frame_report.hpp: farm tasks share the
+// folder), and a rerun skips frames whose key still matches.
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "tempera/app/frame_job.hpp"
+#include "tempera/app/frame_report.hpp"
 #include "tempera/app/guide_cache.hpp"
 #include "tempera/app/job_config.hpp"
 #include "tempera/engine/image.hpp"
@@ -54,11 +56,11 @@ class StylizeJob : public FrameJob {
 
  private:
   std::string target_path(int frame) const;
-  std::string lock_path() const;  // guards the report's read-merge-write
   bool has_temporal_predecessor(std::size_t index) const;
   void check_target_guides(const std::vector<std::string>& names);
 
   StylizeJobConfig config_;
+  FrameReport report_;  // the resume record, shared with other processes writing this folder
   std::vector<std::string> warnings_;
   JobInputs inputs_;
   Image style_;  // the painting at the exemplar guides' size
