@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "tempera/engine/error.hpp"
+#include "tempera/methods/registry.hpp"
 
 namespace tempera::cli {
 
@@ -57,6 +58,8 @@ int run_noisy(const Args& args);
 int run_lazyfluids(const Args& args);
 // `stylize --method fluidymation` (fluidymation_command.cpp).
 int run_stylize_fluidymation(const Args& args);
+// `stylize --method NAME` for a method the registry runs by its job factory (method_command.cpp).
+int run_registered_method(const MethodEntry& method, const Args& args);
 // The method of `stylize` arguments: the last --method's value, else stylit.
 // run_stylize sends the arguments to that method's command (methods/registry.hpp).
 std::string method_of(const Args& args);

@@ -460,15 +460,16 @@ int run_stylize(const Args& args) {
   const MethodEntry& method = find_method(method_of(args));  // before its options are taken for stylit's
   if (!method.python_command.empty()) throw ValueError(runs_in_python(method));
   const auto command = method_commands().find(method.name);
-  if (command == method_commands().end())
+  if (command != method_commands().end() && command->second.renders_scenes) return command->second.run(args);
+  if (command == method_commands().end() && !method.make_job)
     throw std::logic_error(concat("the registry's method '", method.name, "' has no native command"));
-  if (command->second.renders_scenes) return command->second.run(args);
   Args with_guides;
   try {
     with_guides = with_scene_guides(args);  // SCENE.blend: its guides first
   } catch (const CancelledError&) {
     return report_interrupted("stylize");
   }
+  if (command == method_commands().end()) return run_registered_method(method, with_guides);
   return command->second.run(with_guides);
 }
 

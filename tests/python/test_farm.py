@@ -74,15 +74,19 @@ def test_coherent_shot_is_one_task_per_segment_between_keys():
         farm.plan(**dict(SHOT, stylize_args=["--method", "tcia", "--key", "x.png"]))
 
 
-@pytest.mark.skipif(shutil.which("node") is None, reason="node not installed")
-def test_flamenco_plans_the_same_segments():
-    settings = dict(FLAMENCO_SETTINGS, temporal=0.5, stylize_args=" ".join(TCIA))
+def _flamenco_argv(stylize_args):
+    """The commands the Flamenco job type compiles for a tcia shot with these stylize options."""
+    settings = dict(FLAMENCO_SETTINGS, temporal=0.5, stylize_args=" ".join(stylize_args))
     script = ("const {compile, summary} = require(process.argv[1]);"
               "console.log(JSON.stringify(summary(compile(JSON.parse(process.argv[2])).job)));")
     result = subprocess.run(["node", "-e", script, str(ROOT / "farm" / "flamenco" / "standin.js"),
                              json.dumps(settings)], capture_output=True, text=True, check=True)
-    ours = farm.plan(**dict(SHOT, stylize_args=TCIA))
-    assert [t["argv"] for t in json.loads(result.stdout)] == [t.command for t in ours]
+    return [t["argv"] for t in json.loads(result.stdout)]
+
+
+@pytest.mark.skipif(shutil.which("node") is None, reason="node not installed")
+def test_flamenco_plans_the_same_segments():
+    assert _flamenco_argv(TCIA) == [t.command for t in farm.plan(**dict(SHOT, stylize_args=TCIA))]
 
 
 LAYERED = ["--method", "tcia", "--key", "12=/shared/k12.png", "--layer", "suit=mask.CO_Suit",
@@ -102,13 +106,7 @@ def test_layer_keys_bound_segments_as_in_the_job():
 
 @pytest.mark.skipif(shutil.which("node") is None, reason="node not installed")
 def test_flamenco_plans_the_same_layered_segments():
-    settings = dict(FLAMENCO_SETTINGS, temporal=0.5, stylize_args=" ".join(LAYERED))
-    script = ("const {compile, summary} = require(process.argv[1]);"
-              "console.log(JSON.stringify(summary(compile(JSON.parse(process.argv[2])).job)));")
-    result = subprocess.run(["node", "-e", script, str(ROOT / "farm" / "flamenco" / "standin.js"),
-                             json.dumps(settings)], capture_output=True, text=True, check=True)
-    ours = farm.plan(**dict(SHOT, stylize_args=LAYERED))
-    assert [t["argv"] for t in json.loads(result.stdout)] == [t.command for t in ours]
+    assert _flamenco_argv(LAYERED) == [t.command for t in farm.plan(**dict(SHOT, stylize_args=LAYERED))]
 
 
 def test_plan_refuses_incomplete_shots():

@@ -1,11 +1,15 @@
 #include "tempera/methods/registry.hpp"
 
+#include <algorithm>
+
 #include "tempera/engine/error.hpp"
 
 namespace tempera {
 
-const std::vector<MethodEntry>& method_registry() {
-  static const std::vector<MethodEntry> registry = {
+namespace {
+
+std::deque<MethodEntry>& registry() {
+  static std::deque<MethodEntry> registry = {
       {"stylit", "Per-Frame StyLit",
        "Each frame painted on its own from the light-path guides (with the temporal guide's pull towards the "
        "previous frame); frames split anywhere over machines",
@@ -29,6 +33,22 @@ const std::vector<MethodEntry>& method_registry() {
        "Platkevič et al. 2021", "chained frame", false, "docs/fluidymation.md", ""},
   };
   return registry;
+}
+
+}  // namespace
+
+const std::deque<MethodEntry>& method_registry() { return registry(); }
+
+void register_method(MethodEntry entry) {
+  const bool plain = !entry.name.empty() && std::all_of(entry.name.begin(), entry.name.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+  });
+  if (!plain) throw ValueError(concat("a method's name is a plain lower-case word, got '", entry.name, "'"));
+  for (const MethodEntry& m : registry())
+    if (m.name == entry.name) throw ValueError(concat("the method '", entry.name, "' is registered already"));
+  if (!entry.make_job && entry.python_command.empty())
+    throw ValueError(concat("the method '", entry.name, "' has no job (make_job) to run"));
+  registry().push_back(std::move(entry));
 }
 
 const MethodEntry& find_method(const std::string& name) {

@@ -3,13 +3,30 @@
 // --method`, named once. The command line's dispatch and its "unknown
 // --method" message, the bindings' methods(), the panel's Method list
 // (tempera/methods/registry.py), the `tempera` console script and the farm
-// planner all read it; a new method adds one entry here (and its command).
-// Color Me Noisy is not a method of this list: it is a pass over any
-// method's frames (`--noise`, `tempera noisy`).
+// planner all read it; a new method adds one entry in registry.cpp, with
+// its job factory (make_job), and needs no command of its own
+// (docs/adding_a_method.md). Color Me Noisy is not a method of this list: it
+// is a pass over any method's frames (`--noise`, `tempera noisy`).
+#include <deque>
+#include <functional>
+#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "tempera/app/frame_job.hpp"
+#include "tempera/app/job_config.hpp"
+
 namespace tempera {
+
+// A method's own options as the command line gives them: the flag without
+// "--", and its text ("strength" -> "0.5"), in order.
+using MethodOptions = std::vector<std::pair<std::string, std::string>>;
+
+// The job of a method from the core's config (exemplar, guides, frames, out,
+// format, resume) and its own options: ValueError naming a bad or unknown
+// option, the errors of its inputs (files, sizes) as any job's.
+using MakeJob = std::function<std::unique_ptr<FrameJob>(const JobConfig&, const MethodOptions&)>;
 
 struct MethodEntry {
   std::string name;     // --method NAME; the panel's item is NAME in capitals
@@ -29,9 +46,22 @@ struct MethodEntry {
   // Where it runs: "" for the native command; else the Python function that
   // runs `tempera stylize --method NAME ...` ("module:function").
   std::string python_command;
+  // The job, for a method that the registry's one command runs
+  // (cli/method_command.cpp: flags, resume, progress, Ctrl-C, a .blend's
+  // guides); empty for the methods with a command of their own.
+  MakeJob make_job;
+  std::string options_help;  // its own options, for --help: "  --strength S   ...\n" lines
 };
 
-const std::vector<MethodEntry>& method_registry();
+// Every method, in the panel's order; a deque, so that entries keep their
+// address when a method is registered.
+const std::deque<MethodEntry>& method_registry();
+
+// Adds a method at run time (a plug-in, a test's example): registered before
+// a front end reads the registry, it is run like any other. ValueError when
+// the name is empty, taken or not a plain word, or when it has no job and
+// no command. Not thread-safe: register at start-up.
+void register_method(MethodEntry entry);
 
 // The entry of `name`; ValueError "unknown --method 'X' (choose ...)" naming every one.
 const MethodEntry& find_method(const std::string& name);
