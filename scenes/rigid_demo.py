@@ -107,8 +107,7 @@ def build(scene):
 
 def exemplars():
     """The generated exemplars: a thrown ball, and a box tumbling as it goes."""
-    ball = _native.bouncing_ball((60, 60), (5.0, 0), 20, 1.0, 330, 0.65, 0.05, 60)
-    box = _native.bouncing_ball((60, 60), (5.0, 0), 20, 1.0, 330, 0.65, 0.12, 60)
+    ball, box = rigid.generated_track("circle"), rigid.generated_track("box")
     return (rigid.fit_exemplar(ball, rigid.generated_exemplar(ball, W, H)),
             rigid.fit_exemplar(box, rigid.generated_exemplar(box, W, H, shape="box"), shape="box"))
 

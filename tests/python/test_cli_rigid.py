@@ -284,3 +284,17 @@ def test_stylize_a_scene_renders_its_guides_and_tracks_first(tmp_path, cli_path)
     no_frames = subprocess.run(command[:-6] + ["--out", str(tmp_path / "o2")], capture_output=True, text=True,
                                timeout=120, env=env)
     assert no_frames.returncode == 2 and "--frames is required with a scene" in no_frames.stderr
+
+
+def test_the_generated_exemplar_is_the_default(inputs, capsys):
+    """Step 5 of issue 41: the rigid-body method runs with no drawings of one's own."""
+    out = inputs / "out"
+    assert main(["rigid", "--cache", str(inputs / "cache"), "--out", str(out), "--frames", "1-4"]) == 0
+    folder = out / "exemplar_generated_circle"
+    assert (folder / rigid_tracks.TRACKS_NAME).is_file() and len(list((folder / "drawn").glob("*.png"))) == 60
+    frames = sorted(out.glob("frame_*.png"))
+    assert len(frames) == 4 and all(_native.read_image(str(f), None)[:, :, 3].max() > 0.5 for f in frames)
+    assert "4 frames written" in capsys.readouterr().out
+    assert main(["rigid", "--cache", str(inputs / "cache"), "--out", str(out), "--frames", "1-4",
+                 "--exemplar", "generated"]) == 0  # the same, said; the folder is not written again
+    assert "0 frames written, 4 kept" in capsys.readouterr().out

@@ -30,6 +30,16 @@ def _rgba(a, what):
     return a
 
 
+GENERATED = "generated"  # --exemplar generated: the project's own drawn exemplar
+GENERATED_SIZE = (640, 360)  # its drawings' canvas: the floor (y = 330) and the throw fit
+
+
+def generated_track(shape="circle"):
+    """The project's own source motion: a ball thrown from the left that
+    bounces on a floor (spinning more as a box, which tumbles as it goes)."""
+    return _native.bouncing_ball((60, 60), (5.0, 0), 20, 1.0, 330, 0.65, 0.12 if shape == "box" else 0.05, 60)
+
+
 def generated_exemplar(track, width, height, **style):
     """The generated drawings of every frame of `track` (RGBA, graphite on
     transparent paper), with the ExemplarStyle keywords (stretch, squash,

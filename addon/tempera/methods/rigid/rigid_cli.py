@@ -1,7 +1,7 @@
 """`tempera rigid`: the rigid-body method (tempera.methods.rigid.rigid) on a guide cache's
 tracks, with no Blender.
 
-    tempera rigid --cache CACHE --exemplar EXEMPLAR [--exemplar ...] --out OUT
+    tempera rigid --cache CACHE [--exemplar EXEMPLAR|generated ...] --out OUT
                   [--object NAME] [--frames A-B] [--shape circle|box] [--paper]
                   [--strokes IMAGE|generated] [method options]
     tempera stylize --method rigid --guides CACHE --exemplar EXEMPLAR ... (the same,
@@ -49,8 +49,10 @@ def _parser(prog="tempera rigid"):
     p = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0])
     p.add_argument("--cache", "--guides", dest="cache", required=True,
                    help="guide cache with the target's tracks.json")
-    p.add_argument("--exemplar", action="append", required=True,
-                   help="folder with a source tracks.json and drawn/NNNN.png (repeatable)")
+    p.add_argument("--exemplar", action="append",
+                   help="folder with a source tracks.json and drawn/NNNN.png (repeatable); default "
+                   f"'{rigid.GENERATED}': the project's own drawn bouncing ball (box with --shape box), "
+                   "written once into OUT/exemplar_generated_SHAPE")
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument("--object", help="the target object (needed when the cache tracks several)")
     p.add_argument("--frames", help="frames to draw, e.g. 1-24 (default: every tracked frame)")
@@ -114,6 +116,20 @@ def _read_exemplar(folder, shape, fit_values):
     return rigid.fit_exemplar(track, drawings, shape=shape, **fit_values), folder
 
 
+def generated_exemplar_folder(out, shape):
+    """The project's own exemplar for `shape` as an exemplar folder in OUT
+    (tracks.json and drawn/NNNN.png), written once: the tracks last, so a
+    folder with tracks is whole, and a rerun finds it unchanged (resume)."""
+    folder = Path(out) / f"exemplar_generated_{shape}"
+    if not (folder / rigid_tracks.TRACKS_NAME).is_file():
+        track = rigid.generated_track(shape)
+        (folder / "drawn").mkdir(parents=True, exist_ok=True)
+        for i, drawing in enumerate(rigid.generated_exemplar(track, *rigid.GENERATED_SIZE, shape=shape)):
+            _native.write_image(str(folder / "drawn" / f"{1 + i:04d}.png"), drawing, [])
+        rigid_tracks.write_tracks(folder, {"Generated": track}, 1, (0, 1.0))
+    return folder
+
+
 def _stamp(path):
     st = Path(path).stat()
     return f"{path}:{st.st_size}:{st.st_mtime_ns}"
@@ -169,7 +185,9 @@ def run(args):
     rigid_values = {"symmetry": rigid.SYMMETRY[args.shape], **rigid_values}  # --symmetry overrides the shape's
     rigid.RigidOptions(**rigid_values), rigid.QuadraticFitOptions(**fit_values)  # named errors before any work
     strokes = rigid_strokes.load_stroke_exemplar(args.strokes) if args.strokes else None
-    exemplars = [_read_exemplar(d, args.shape, fit_values) for d in args.exemplar]
+    folders = [generated_exemplar_folder(args.out, args.shape) if d == rigid.GENERATED else d
+               for d in (args.exemplar or [rigid.GENERATED])]
+    exemplars = [_read_exemplar(d, args.shape, fit_values) for d in folders]
     out = Path(args.out)
     settings = _settings_key(args, [d for _, d in exemplars], {**rigid_values, **fit_values})
     wanted = _frame_indices(args.frames, tracks["frame_start"], len(target["centre"]))
