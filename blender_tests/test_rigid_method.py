@@ -173,3 +173,18 @@ def test_panel_options_reach_the_job(rigid_scene):
     settings.rigid_strokes, settings.rigid_stroke_image = "IMAGE", "/nowhere/strokes.png"
     with pytest.raises(FileNotFoundError, match="strokes.png' does not exist"):
         StylizeRun.from_settings(rigid_scene, "ANIMATION")
+
+
+def test_empty_examples_use_the_projects_drawn_ball(rigid_scene, tmp_path):
+    """Issue 41, step 5: with no Examples folder the method uses the project's own drawn
+    exemplar (the CLI's default too), written once beside the results."""
+    import tempera
+
+    rigid_scene.tempera.rigid_examples = ""
+    rigid_scene.tempera.guide_frame_start, rigid_scene.tempera.guide_frame_end = 9, 10
+    assert bpy.ops.tempera.stylize(mode="ANIMATION") == {"FINISHED"}
+    generated = tmp_path / "out" / "rigid" / "generated_examples" / "exemplar_generated_circle"
+    assert (generated / "tracks.json").is_file() and len(list((generated / "drawn").glob("*.png"))) == 60
+    out = tmp_path / "out" / "rigid" / "frames"
+    assert _frames(out) == ["frame_0009.png", "frame_0010.png"]
+    assert all(tempera.read_image(str(out / name))[:, :, 3].max() > 0.5 for name in _frames(out))

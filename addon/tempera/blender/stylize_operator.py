@@ -353,8 +353,10 @@ class RigidRun(StylizeRun):
         self.out = output_dir(settings)
         from ..methods.rigid.rigid_job import exemplar_folders
 
-        self.examples = resolve_path(settings.rigid_examples, "rigid-body Examples folder")
-        exemplar_folders(self.examples)  # a named error now, not after the guides
+        self.examples = None  # empty: the project's own drawn exemplar, written with the results
+        if settings.rigid_examples.strip():
+            self.examples = resolve_path(settings.rigid_examples, "rigid-body Examples folder")
+            exemplar_folders(self.examples)  # a named error now, not after the guides
         bodies = {o.name for o in rigid_body_objects(scene)}
         if not bodies:
             raise ValueError("Rigid Bodies needs a rigid-body world with active bodies in the scene.")
@@ -389,7 +391,13 @@ class RigidRun(StylizeRun):
         from ..methods.rigid.rigid_job import RigidJob
 
         if self.job is None:
-            self.job = RigidJob(self.guides.folder, self.examples, os.path.join(self.out, RIGID_DIR), self.frames,
+            examples = self.examples
+            if examples is None:
+                from ..methods.rigid.rigid_cli import generated_exemplar_folder
+
+                examples = os.path.join(self.out, RIGID_DIR, "generated_examples")
+                generated_exemplar_folder(examples, self.shape)
+            self.job = RigidJob(self.guides.folder, examples, os.path.join(self.out, RIGID_DIR), self.frames,
                                 objects=self.objects, shape=self.shape, paper=self.paper, strokes=self.strokes,
                                 **self.options)
         return self.job
