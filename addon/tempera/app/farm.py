@@ -120,17 +120,13 @@ def shot_method(stylize_args):
         raise FarmError(str(e)) from None
 
 
-def method_unit(stylize_args):
-    return shot_method(stylize_args)["unit"]
-
-
-def shot_segments(frames, stylize_args):
+def shot_segments(frames, stylize_args, method):
     """The segments [first, ..., last] of a shot whose method's unit is the
-    segment (the coherent method): from key to key (the shot's --key and
+    segment (the coherent method; `method` is its registry entry): from key to key (the shot's --key and
     every layer's --layer-key) and to the shot's ends, by the rule the job
     solves them with (native/include/tempera/app/segments.hpp); None for
     other units."""
-    if method_unit(stylize_args) != "segment":
+    if method["unit"] != "segment":
         return None
     from .. import _native
     from ..methods.tcia import tcia
@@ -178,7 +174,7 @@ def plan(frames, out, exemplar, *, scene=None, guides=None, exemplar_guides=None
                               tempera + ["render-guides", str(scene), "--frames", format_frames(chunk),
                                          "--out", guides, *guide_args], frames=chunk))
             guide_tasks.append((set(chunk), name))
-    segments = shot_segments(frames, list(stylize_args))
+    segments = shot_segments(frames, list(stylize_args), method)
     if temporal is None and segments is None and light_paths:
         from .settings import DEFAULT_TEMPORAL_WEIGHT as temporal
     # Always stated: the chunks must agree with a single run whatever the CLI's default. The
@@ -191,7 +187,7 @@ def plan(frames, out, exemplar, *, scene=None, guides=None, exemplar_guides=None
     if segments is not None:  # each task solves one segment of the whole shot
         pieces = [(p, ["--frames", format_frames(frames), "--segment", f"{p[0]}-{p[-1]}"]) for p in segments]
     else:  # a temporal chain is one task, as is a method of chained frames
-        chained = bool(temporal) or method_unit(stylize_args) == "chained frame"
+        chained = bool(temporal) or method["unit"] == "chained frame"
         pieces = [(p, ["--frames", format_frames(p)]) for p in ([frames] if chained else
                                                                 chunk_frames(frames, chunk_size))]
     stylize_names = []
