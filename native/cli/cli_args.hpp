@@ -54,10 +54,6 @@ int run_synth(const Args& args);
 int run_render_guides(const Args& args);
 int run_stylize(const Args& args);
 int run_noisy(const Args& args);
-// `tempera stylize --method lazyfluids` (lazyfluids_command.cpp).
-int run_lazyfluids(const Args& args);
-// `stylize --method fluidymation` (fluidymation_command.cpp).
-int run_stylize_fluidymation(const Args& args);
 // `stylize --method NAME` for a method the registry runs by its job factory (method_command.cpp).
 int run_registered_method(const MethodEntry& method, const Args& args);
 // The method of `stylize` arguments: the last --method's value, else stylit.

@@ -428,21 +428,16 @@ std::string runs_in_python(const MethodEntry& method) {
                 method.name, " ...' or 'python -m tempera stylize --method ", method.name, " ...' (", method.docs, ")");
 }
 
-// The command of each native method of the registry. StyLit and the coherent
-// method share this file's (run_stylit_or_tcia), which renders a scene's
-// guides itself (and an exemplar scene's); the others read a guide cache, and
-// run_stylize renders a scene's for them first.
+// The methods with a command of their own: StyLit and the coherent method
+// share this file's (run_stylit_or_tcia), which renders a scene's guides
+// itself (and an exemplar scene's). Every other native method runs through
+// the registry's one command (method_command.cpp), after run_stylize has
+// rendered a scene's guides for it.
 int run_stylit_or_tcia(const Args& args);
-struct MethodCommand {
-  int (*run)(const Args&);
-  bool renders_scenes;
-};
-const std::map<std::string, MethodCommand>& method_commands() {
-  static const std::map<std::string, MethodCommand> commands = {
-      {"stylit", {run_stylit_or_tcia, true}},
-      {"tcia", {run_stylit_or_tcia, true}},
-      {"lazyfluids", {run_lazyfluids, false}},
-      {"fluidymation", {run_stylize_fluidymation, false}},
+const std::map<std::string, int (*)(const Args&)>& method_commands() {
+  static const std::map<std::string, int (*)(const Args&)> commands = {
+      {"stylit", run_stylit_or_tcia},
+      {"tcia", run_stylit_or_tcia},
   };
   return commands;
 }
@@ -460,17 +455,15 @@ int run_stylize(const Args& args) {
   const MethodEntry& method = find_method(method_of(args));  // before its options are taken for stylit's
   if (!method.python_command.empty()) throw ValueError(runs_in_python(method));
   const auto command = method_commands().find(method.name);
-  if (command != method_commands().end() && command->second.renders_scenes) return command->second.run(args);
-  if (command == method_commands().end() && !method.make_job)
-    throw std::logic_error(concat("the registry's method '", method.name, "' has no native command"));
+  if (command != method_commands().end()) return command->second(args);
+  if (!method.make_job) throw std::logic_error(concat("the registry's method '", method.name, "' has no job to run"));
   Args with_guides;
   try {
     with_guides = with_scene_guides(args);  // SCENE.blend: its guides first
   } catch (const CancelledError&) {
     return report_interrupted("stylize");
   }
-  if (command == method_commands().end()) return run_registered_method(method, with_guides);
-  return command->second.run(with_guides);
+  return run_registered_method(method, with_guides);
 }
 
 namespace {

@@ -197,6 +197,25 @@ def test_cli_runs_and_exits_2_on_bad_input(tmp_path, cli_path):
     assert "--exemplar-masks" in helptext and "--boundary-weight" in helptext
 
 
+def test_cli_runs_through_the_registrys_one_command(tmp_path, cli_path):
+    """Issue 41: Fluidymation has no command of its own; the registry's one
+    command gives it a lone switch, the engine's image cap, its contact sheet
+    and the flow it used on the last line."""
+    exemplar, cache = make_inputs(tmp_path, frames=2)
+    out = tmp_path / "out"
+    run = subprocess.run([str(cli_path), "stylize", "--method", "fluidymation", "--guides", str(cache),
+                          "--exemplar", str(exemplar), "--bidirectional", "--frames", "1-2", "--out", str(out),
+                          "--shape-blur", "6", "--levels", "2", "--max-image-pixels", "100000"],
+                         capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert "2 frame(s) stylized" in run.stdout and "flow from " in run.stdout, run.stdout
+    assert (out / "contact_sheet.png").is_file() and (out / "frame_0002.png").is_file()
+    tiny = subprocess.run([str(cli_path), "stylize", "--method", "fluidymation", "--guides", str(cache),
+                           "--exemplar", str(exemplar), "--frames", "1-2", "--out", str(tmp_path / "tiny"),
+                           "--max-image-pixels", "100"], capture_output=True, text=True)
+    assert tiny.returncode != 0 and "100" in tiny.stderr, tiny.stderr
+
+
 @pytest.mark.parametrize("bidirectional", [False, True])
 def test_an_empty_target_mask_gives_a_transparent_frame(tmp_path, bidirectional):
     """Issue 31, item 12: an object off screen for a frame stopped the shot

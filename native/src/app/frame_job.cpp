@@ -2,11 +2,17 @@
 
 #include "tempera/engine/error.hpp"
 
+#include <stdexcept>
+
 namespace tempera {
 
 const std::vector<std::string>& FrameJob::warnings() const {
   static const std::vector<std::string> none;
   return none;
+}
+
+void FrameJob::write_contact_sheet(const std::string&, int) const {
+  throw std::logic_error("this method has no contact sheet (has_contact_sheet() is false)");
 }
 
 FrameResult ChainedFrameJob::run_frame(std::size_t index, const ProgressCallback& progress) {

@@ -3,6 +3,8 @@
 #include <algorithm>
 
 #include "tempera/engine/error.hpp"
+#include "tempera/methods/fluidymation/fluidymation_method.hpp"
+#include "tempera/methods/lazyfluids/lazyfluids_method.hpp"
 
 namespace tempera {
 
@@ -23,14 +25,8 @@ std::deque<MethodEntry>& registry() {
        "The squash, stretch and line of drawn examples carried onto the scene's rigid-body simulation "
        "(Dvorožňák 2017; needs a baked rigid-body world)",
        "Dvorožňák et al. 2017", "frame", false, "docs/rigid_bodies.md", "tempera.methods.rigid.rigid_cli:stylize_main"},
-      {"lazyfluids", "Fluid (LazyFluids)",
-       "Smoke, fire and liquids painted from an RGBA exemplar carried along the fluid's flow, its texture kept fresh "
-       "by uniform patch usage (Jamriška 2015); RGBA frames over the render",
-       "Jamriška et al. 2015", "chained frame", false, "docs/lazyfluids.md", ""},
-      {"fluidymation", "Natural Media (Fluidymation)",
-       "A moving object or collection rendered as a filmed medium (ink, watercolour) spreading along its motion, "
-       "from a video exemplar with masks (Platkevič 2021); RGBA frames over the render",
-       "Platkevič et al. 2021", "chained frame", false, "docs/fluidymation.md", ""},
+      lazyfluids_method(),
+      fluidymation_method(),
   };
   return registry;
 }

@@ -27,6 +27,14 @@ class FrameJob {
   virtual const JobInputs& inputs() const = 0;
   // What was fixed on the way (a resampled painting, a damaged record set aside); none by default.
   virtual const std::vector<std::string>& warnings() const;
+  // The picture a front end writes beside the frames when a run ends: the
+  // exemplar followed by the frames written so far. A method without one
+  // says false, and its write_contact_sheet throws std::logic_error.
+  virtual bool has_contact_sheet() const { return false; }
+  virtual void write_contact_sheet(const std::string& path, int columns = 0) const;
+  // How the run went, in a phrase for the command's last line ("flow from
+  // velocity_forward"); empty by default.
+  virtual std::string summary() const { return ""; }
 };
 
 // The unit "chained frame": a frame that continues the one before

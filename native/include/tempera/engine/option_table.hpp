@@ -187,15 +187,36 @@ bool set_from_flag(S& options, const Tuple& table, std::string_view flag, Value&
   return found;
 }
 
-// "  --flag VALUE   help (default D)" lines for --help.
+// set_from_flag for an option given as text, as a registered method's
+// options arrive (methods/registry.hpp, MethodOptions): an empty text is a
+// bare switch, true for a yes/no field and "--flag needs a value" for any
+// other. False if the table has no such flag.
 template <class S, class Tuple>
-std::string flags_help(const Tuple& table) {
+bool set_from_text(S& options, const Tuple& table, std::string_view flag, const std::string& text) {
+  return set_from_flag(options, table, flag, [&] {
+    bool yes_no = false;
+    for_each_field(table, [&](const auto& f) {
+      if (*f.flag != 0 && flag == f.flag) yes_no = std::is_same_v<std::decay_t<decltype(options.*f.member)>, bool>;
+    });
+    if (!text.empty() || !yes_no) {
+      if (text.empty()) throw ValueError(concat("--", flag, " needs a value"));
+      return text;
+    }
+    return std::string("true");
+  });
+}
+
+// "  --flag VALUE   help (default D)" lines for --help. With `bare_switches`
+// a yes/no field reads "--flag [V]": given alone, it means true (set_from_text).
+template <class S, class Tuple>
+std::string flags_help(const Tuple& table, bool bare_switches = false) {
   const S defaults{};
   std::string out;
   for_each_field(table, [&](const auto& f) {
     if (*f.flag == 0) return;
     using T = std::decay_t<decltype(defaults.*f.member)>;
-    std::string left = std::string("  --") + f.flag + " " + (std::is_enum_v<T> ? "MODE" : "V");
+    const char* value = std::is_enum_v<T> ? "MODE" : bare_switches && std::is_same_v<T, bool> ? "[V]" : "V";
+    std::string left = std::string("  --") + f.flag + " " + value;
     left.resize(std::max<std::size_t>(left.size() + 1, 26), ' ');
     std::string choices;
     if constexpr (std::is_enum_v<T>) choices = " [" + enum_choices<T>() + "]";

@@ -50,7 +50,12 @@ struct MethodEntry {
   // (cli/method_command.cpp: flags, resume, progress, Ctrl-C, a .blend's
   // guides); empty for the methods with a command of their own.
   MakeJob make_job;
-  std::string options_help;  // its own options, for --help: "  --strength S   ...\n" lines
+  // Its own options, for --help: "  --strength S   ...\n" lines. Given alone
+  // (no value), an option arrives with the text "" (set_from_text: a switch).
+  std::string options_help;
+  // More of --help, after the summary: what the exemplar and the guides must
+  // hold, where the outputs go, how resume decides; paragraphs ending in "\n".
+  std::string help_details;
 };
 
 // Every method, in the panel's order; a deque, so that entries keep their

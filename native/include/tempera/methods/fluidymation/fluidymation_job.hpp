@@ -59,9 +59,11 @@ class FluidymationJob : public ChainedFrameJob {
   // The guide the target's flow is read from (fluid_velocity or
   // velocity_forward); empty when it is made from the masks.
   const std::string& flow_guide() const { return flow_guide_; }
+  std::string summary() const override { return "flow from " + (flow_guide_.empty() ? "masks" : flow_guide_); }
 
   // The first exemplar frame followed by the frames written so far.
-  void write_contact_sheet(const std::string& path, int columns = 0) const;
+  bool has_contact_sheet() const override { return true; }
+  void write_contact_sheet(const std::string& path, int columns = 0) const override;
 
  private:
   std::string state_path(int frame) const;

@@ -41,7 +41,8 @@ class LazyFluidsJob : public ChainedFrameJob {
   std::string field_path(int frame) const;  // warm start: the frame's final matches
 
   // The exemplar followed by the frames written so far.
-  void write_contact_sheet(const std::string& path, int columns = 0) const;
+  bool has_contact_sheet() const override { return true; }
+  void write_contact_sheet(const std::string& path, int columns = 0) const override;
 
  private:
   std::string guide_path(int frame) const;

@@ -52,7 +52,8 @@ class StylizeJob : public FrameJob {
 
   // The painting followed by the stylized frames written so far, downscaled
   // so that the sheet stays within about 2000 pixels wide. columns 0 = auto.
-  void write_contact_sheet(const std::string& path, int columns = 0) const;
+  bool has_contact_sheet() const override { return true; }
+  void write_contact_sheet(const std::string& path, int columns = 0) const override;
 
  private:
   std::string target_path(int frame) const;
