@@ -3,7 +3,6 @@
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
-#include "bind_frame_job.hpp"
 #include "bind_job_config.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
@@ -110,7 +109,7 @@ void bind_fluidymation(py::module_& m) {
       },
       py::arg("exemplar"), py::arg("exemplar_masks"), py::arg("target_masks"), py::arg("target_flows"),
       py::arg("options"), py::arg("progress") = nullptr, "Use tempera.methods.fluidymation.fluidymation.stylize_sequence.");
-  auto job_class = py::class_<FluidymationJob>(m, "FluidymationJob", "Fluidymation over a guide cache; use tempera.methods.fluidymation.fluidymation.MediaJob.")
+  py::class_<FluidymationJob, FrameJob>(m, "FluidymationJob", "Fluidymation over a guide cache; use tempera.methods.fluidymation.fluidymation.MediaJob.")
       .def(py::init([](const py::dict& config, const FluidymationOptions& options) {
              FluidymationJobConfig c = job_config(config, options);
              py::gil_scoped_release release;  // reads the exemplar and the target's masks
@@ -118,6 +117,4 @@ void bind_fluidymation(py::module_& m) {
            }),
            py::arg("config"), py::arg("options"))
       .def_property_readonly("flow_guide", &FluidymationJob::flow_guide);
-  py_bridge::def_frame_job<FluidymationJob>(job_class);
-  py_bridge::def_contact_sheet<FluidymationJob>(job_class);
 }

@@ -1,8 +1,8 @@
 #pragma once
-// What every per-frame job (app/frame_job.hpp) shows Python: its frames,
-// warnings and output paths, and run_frame, one frame with the GIL
-// released, returning the job core's one FrameResult as one dict; and, for
-// the jobs that have one, the contact sheet.
+// What the bindings of jobs share: Python's progress callable for code
+// running without the GIL, and the job core's one FrameResult as one dict.
+// The per-frame job itself is bound once, as _native.FrameJob
+// (bind_registry.cpp), the base of every per-frame job's class.
 #include <string>
 
 #include <pybind11/pybind11.h>
@@ -31,39 +31,6 @@ inline pybind11::dict frame_result(const FrameResult& r) {
   d["flicker"] = r.flicker;
   d["source_coverage"] = r.source_coverage;
   return d;
-}
-
-template <class Job, class Class>
-Class& def_frame_job(Class& cls) {
-  namespace py = pybind11;
-  return cls.def_property_readonly("frames", &Job::frames)
-      .def_property_readonly("warnings", &Job::warnings)
-      .def("output_path", &Job::output_path, py::arg("frame"))
-      .def(
-          "run_frame",
-          [](Job& job, std::size_t index, const py::object& progress) {
-            const ProgressCallback callback = python_progress(progress);
-            FrameResult r;
-            {
-              py::gil_scoped_release release;
-              r = job.run_frame(index, callback);
-            }
-            return frame_result(r);
-          },
-          py::arg("index"), py::arg("progress") = py::none(),
-          "Makes frames[index] or skips it when current; progress(fraction) returning False cancels.");
-}
-
-template <class Job, class Class>
-Class& def_contact_sheet(Class& cls) {
-  namespace py = pybind11;
-  return cls.def(
-      "write_contact_sheet",
-      [](const Job& job, const std::string& path, int columns) {
-        py::gil_scoped_release release;
-        job.write_contact_sheet(path, columns);
-      },
-      py::arg("path"), py::arg("columns") = 0);
 }
 
 }  // namespace tempera::py_bridge

@@ -3,7 +3,6 @@
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
-#include "bind_frame_job.hpp"
 #include "bind_job_config.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
@@ -58,7 +57,7 @@ void bind_lazyfluids(py::module_& m) {
                                                     py_bridge::view_of(advected, "advected"), lambda));
       },
       py::arg("target_alpha"), py::arg("advected"), py::arg("lam"), "λ_q of eq. 5.6.");
-  auto job_class = py::class_<LazyFluidsJob>(m, "LazyFluidsJob", "LazyFluids over a guide cache; use tempera.methods.lazyfluids.lazyfluids.FluidJob.")
+  py::class_<LazyFluidsJob, FrameJob>(m, "LazyFluidsJob", "LazyFluids over a guide cache; use tempera.methods.lazyfluids.lazyfluids.FluidJob.")
       .def(py::init([](const py::dict& config, const LazyFluidsOptions& options) {
              LazyFluidsJobConfig c;
              py_bridge::read_job_config(config, c, "FluidJob config");
@@ -67,6 +66,4 @@ void bind_lazyfluids(py::module_& m) {
              return std::make_unique<LazyFluidsJob>(std::move(c));
            }),
            py::arg("config"), py::arg("options"));
-  py_bridge::def_frame_job<LazyFluidsJob>(job_class);
-  py_bridge::def_contact_sheet<LazyFluidsJob>(job_class);
 }

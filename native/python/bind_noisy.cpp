@@ -4,7 +4,6 @@
 
 #include <tuple>
 
-#include "bind_frame_job.hpp"
 #include "bind_job_config.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
@@ -31,14 +30,13 @@ NoisySequenceConfig sequence_config(const py::dict& d, const NoisyOptions& optio
 }
 
 void bind_sequence(py::module_& m) {
-  auto sequence_class = py::class_<NoisySequence>(m, "NoisySequence", "Color Me Noisy over a folder of frames; use tempera.methods.noisy.noisy.NoisySequence.")
+  py::class_<NoisySequence, FrameJob>(m, "NoisySequence", "Color Me Noisy over a folder of frames; use tempera.methods.noisy.noisy.NoisySequence.")
       .def(py::init([](const py::dict& config, const NoisyOptions& options) {
              NoisySequenceConfig c = sequence_config(config, options);
              py::gil_scoped_release release;  // reads the medium, checks every frame
              return std::make_unique<NoisySequence>(std::move(c));
            }),
            py::arg("config"), py::arg("options"));
-  py_bridge::def_frame_job<NoisySequence>(sequence_class);
 }
 
 }  // namespace

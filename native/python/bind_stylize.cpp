@@ -137,7 +137,7 @@ py::tuple stylize_frame_py(const FloatArray& style, const py::dict& exemplar, co
 }
 
 void bind_job(py::module_& m) {
-  auto job_class = py::class_<StylizeJob>(m, "StylizeJob", "Stylization of a frame sequence; use tempera.methods.stylit.stylize.StylizeJob.")
+  py::class_<StylizeJob, FrameJob>(m, "StylizeJob", "Stylization of a frame sequence; use tempera.methods.stylit.stylize.StylizeJob.")
       .def(py::init([](const py::dict& config) {
              StylizeJobConfig c = parse_job_config(config);
              py::gil_scoped_release release;  // reads the painting and checks every cache frame
@@ -145,8 +145,6 @@ void bind_job(py::module_& m) {
            }),
            py::arg("config"))
       .def_property_readonly("report_path", &StylizeJob::report_path);
-  py_bridge::def_frame_job<StylizeJob>(job_class);
-  py_bridge::def_contact_sheet<StylizeJob>(job_class);
 }
 
 }  // namespace

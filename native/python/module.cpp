@@ -8,21 +8,12 @@
 #include "tempera/app/job_inputs.hpp"
 #include "tempera/app/record.hpp"
 #include "tempera/app/segments.hpp"
-#include "tempera/methods/registry.hpp"
 
 namespace py = pybind11;
 using namespace tempera;
 using py_bridge::FloatArray;
 
 namespace {
-
-py::dict method_dict(const MethodEntry& e) {
-  py::dict d;
-  d["name"] = e.name, d["title"] = e.title, d["summary"] = e.summary, d["paper"] = e.paper;
-  d["unit"] = e.unit, d["light_path_guides"] = e.light_path_guides, d["docs"] = e.docs;
-  d["python_command"] = e.python_command;
-  return d;
-}
 
 void register_exceptions(py::module_& m) {
   static py::exception<CancelledError> cancelled(m, "Cancelled", PyExc_RuntimeError);
@@ -114,18 +105,6 @@ void bind_io(py::module_& m) {
       py::arg("record"), py::arg("format"), py::arg("key"), py::arg("files"),
       "True when the record has this format and key and every file is unchanged.");
   m.def(
-      "methods",
-      [] {
-        py::list out;
-        for (const MethodEntry& e : method_registry()) out.append(method_dict(e));
-        return out;
-      },
-      "The method registry (methods/registry.hpp): a dict per method (name, title, summary, paper, unit, "
-      "light_path_guides, docs, python_command), in the panel's order.");
-  m.def(
-      "find_method", [](const std::string& name) { return method_dict(find_method(name)); }, py::arg("name"),
-      "The registry's entry of `name`; ValueError naming every method.");
-  m.def(
       "key_segments",
       [](const std::vector<int>& frames, const std::vector<int>& key_frames) {
         py::list out;
@@ -139,6 +118,7 @@ void bind_io(py::module_& m) {
 
 }  // namespace
 
+void bind_registry(py::module_& m);   // bind_registry.cpp
 void bind_synthesis(py::module_& m);  // bind_synthesis.cpp
 void bind_guides(py::module_& m);     // bind_guides.cpp
 void bind_stylize(py::module_& m);    // bind_stylize.cpp
@@ -154,6 +134,7 @@ PYBIND11_MODULE(_native, m) {
   m.attr("__version__") = TEMPERA_VERSION;
   register_exceptions(m);
   bind_io(m);
+  bind_registry(m);  // FrameJob, the base of the jobs bound after it
   bind_synthesis(m);
   bind_guides(m);
   bind_stylize(m);

@@ -1,7 +1,8 @@
 """The job core's per-frame job (native/include/tempera/app/frame_job.hpp) as
 Python sees it, whatever the method: StyLit's StylizeJob, LazyFluids'
-FluidJob, Fluidymation's MediaJob and the noise pass's NoisySequence wrap a
-native job ``_job`` and show it the same way."""
+FluidJob, Fluidymation's MediaJob, the noise pass's NoisySequence and the
+MethodJob of any method with a job factory (tempera.methods.registry.make_job)
+wrap a native job ``_job`` (a _native.FrameJob) and show it the same way."""
 from __future__ import annotations
 
 import os
@@ -22,6 +23,11 @@ class FrameJob:
     def warnings(self) -> list:
         return self._job.warnings
 
+    @property
+    def summary(self) -> str:
+        """How the run went, in a phrase for a report ("flow from velocity_forward"), or ""."""
+        return self._job.summary
+
     def output_path(self, frame: int) -> str:
         return self._job.output_path(int(frame))
 
@@ -41,3 +47,15 @@ class SheetFrameJob(FrameJob):
     def write_contact_sheet(self, path, columns: int = 0) -> None:
         """The exemplar followed by the frames written so far, on one image under ~2000 px wide."""
         self._job.write_contact_sheet(os.fspath(path), int(columns))
+
+
+class MethodJob(SheetFrameJob):
+    """The job of a method with a job factory, from tempera.methods.registry.make_job."""
+
+    def __init__(self, job):
+        self._job = job
+
+    @property
+    def has_contact_sheet(self) -> bool:
+        """False for a method without one: write_contact_sheet then raises ValueError."""
+        return self._job.has_contact_sheet

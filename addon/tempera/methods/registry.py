@@ -4,10 +4,14 @@ dispatch and the farm planner read it, so a method is named once."""
 from __future__ import annotations
 
 import importlib
+import os
 
 from .. import _native
+from ..app.frame_job import MethodJob
 
-METHODS = tuple(_native.methods())  # dicts: name, title, summary, paper, unit, docs, python_command
+# dicts: name, title, summary, paper, unit, light_path_guides, docs, python_command,
+# job (a job factory: make_job runs it), options_help
+METHODS = tuple(_native.methods())
 
 
 def names() -> list:
@@ -32,3 +36,31 @@ def python_command(name: str):
         return None
     module, function = entry["python_command"].split(":")
     return getattr(importlib.import_module(module), function)
+
+
+def _option_text(value) -> str:
+    """An option's value as the command line writes it."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (list, tuple)):
+        return ",".join(_option_text(v) for v in value)
+    return repr(value) if isinstance(value, float) else str(value)
+
+
+def make_job(name: str, exemplar, guides, frames, out, *, format: str = "png", resume: bool = True,
+             options: dict = None):
+    """The job of a method with a job factory (its entry's ``job``: LazyFluids,
+    Fluidymation, a registered plug-in), as ``tempera stylize --method NAME``
+    runs it: a tempera.app.frame_job.MethodJob; run ``run_frame(i)`` for each
+    frame index.
+
+    ``options`` are the method's, keyed by their command-line flags without
+    the dashes (``{"lambda": 0.3, "motion_blur": 4, "rotations": True}``;
+    ``_`` stands for ``-``), as ``tempera stylize --method NAME --help`` lists
+    them. ValueError for an unknown method, option or value, or a method
+    without a job factory (StyLit and the coherent method have their own
+    classes; rigid runs in tempera.methods.rigid)."""
+    config = dict(exemplar=os.fspath(exemplar), guides=os.fspath(guides), frames=[int(f) for f in frames],
+                  out=os.fspath(out), format=str(format), resume=bool(resume))
+    flags = [(str(flag).replace("_", "-"), _option_text(value)) for flag, value in (options or {}).items()]
+    return MethodJob(_native.method_job(str(name), config, flags))

@@ -1,0 +1,95 @@
+// Python binding of the method registry (methods/registry.hpp) and of the
+// job core's per-frame job (app/frame_job.hpp): the registry's entries as
+// dicts, FrameJob as the one base class of every per-frame job (StylizeJob,
+// NoisySequence, LazyFluidsJob, FluidymationJob derive from it in Python
+// too), and method_job, the job of any method with a job factory (make_job),
+// so that a registered method runs from Python with no binding of its own
+// (tempera.methods.registry.make_job).
+#include <pybind11/stl.h>
+
+#include "bind_frame_job.hpp"
+#include "bind_job_config.hpp"
+#include "tempera/app/frame_job.hpp"
+#include "tempera/methods/registry.hpp"
+
+namespace py = pybind11;
+using namespace tempera;
+
+namespace {
+
+py::dict method_dict(const MethodEntry& e) {
+  py::dict d;
+  d["name"] = e.name, d["title"] = e.title, d["summary"] = e.summary, d["paper"] = e.paper;
+  d["unit"] = e.unit, d["light_path_guides"] = e.light_path_guides, d["docs"] = e.docs;
+  d["python_command"] = e.python_command;
+  d["job"] = bool(e.make_job);
+  d["options_help"] = e.options_help;
+  return d;
+}
+
+void bind_frame_job_class(py::module_& m) {
+  py::class_<FrameJob>(m, "FrameJob", "The job core's per-frame job (app/frame_job.hpp); use tempera.app.frame_job.")
+      .def_property_readonly("frames", &FrameJob::frames)
+      .def_property_readonly("warnings", &FrameJob::warnings)
+      .def_property_readonly("has_contact_sheet", &FrameJob::has_contact_sheet)
+      .def_property_readonly("summary", &FrameJob::summary, "How the run went, in a phrase ('' if nothing to say).")
+      .def("output_path", &FrameJob::output_path, py::arg("frame"))
+      .def(
+          "run_frame",
+          [](FrameJob& job, std::size_t index, const py::object& progress) {
+            const ProgressCallback callback = py_bridge::python_progress(progress);
+            FrameResult r;
+            {
+              py::gil_scoped_release release;
+              r = job.run_frame(index, callback);
+            }
+            return py_bridge::frame_result(r);
+          },
+          py::arg("index"), py::arg("progress") = py::none(),
+          "Makes frames[index] or skips it when current; progress(fraction) returning False cancels.")
+      .def(
+          "write_contact_sheet",
+          [](const FrameJob& job, const std::string& path, int columns) {
+            if (!job.has_contact_sheet()) throw ValueError("this method writes no contact sheet");
+            py::gil_scoped_release release;
+            job.write_contact_sheet(path, columns);
+          },
+          py::arg("path"), py::arg("columns") = 0,
+          "The exemplar followed by the frames written so far, as one image (atomic).");
+}
+
+// The job of `name` from the core's config (a dict: exemplar, guides, frames,
+// out, format, resume) and the method's options as the command line takes
+// them ((flag without "--", text) pairs; "" for a switch alone).
+std::unique_ptr<FrameJob> method_job(const std::string& name, const py::dict& config, const MethodOptions& options) {
+  const MethodEntry& method = find_method(name);
+  if (!method.make_job)
+    throw ValueError(concat("--method ", name, " has no job factory: ",
+                            method.python_command.empty() ? "it has a command and a binding of its own (" + method.docs + ")"
+                                                          : "it runs in Python (" + method.python_command + ")"));
+  JobConfig c;
+  py_bridge::read_job_config(config, c, concat("the ", name, " job's config"));
+  py::gil_scoped_release release;  // the job reads its inputs' headers
+  return method.make_job(c, options);
+}
+
+}  // namespace
+
+void bind_registry(py::module_& m) {
+  bind_frame_job_class(m);
+  m.def(
+      "methods",
+      [] {
+        py::list out;
+        for (const MethodEntry& e : method_registry()) out.append(method_dict(e));
+        return out;
+      },
+      "The method registry (methods/registry.hpp): a dict per method (name, title, summary, paper, unit, "
+      "light_path_guides, docs, python_command, job: has a job factory, options_help), in the panel's order.");
+  m.def(
+      "find_method", [](const std::string& name) { return method_dict(find_method(name)); }, py::arg("name"),
+      "The registry's entry of `name`; ValueError naming every method.");
+  m.def("method_job", &method_job, py::arg("name"), py::arg("config"), py::arg("options") = MethodOptions{},
+        "The FrameJob of a method with a job factory, as tempera stylize --method NAME runs it; ValueError for "
+        "an unknown method, option or value, or a method without one.");
+}

@@ -1,0 +1,77 @@
+"""Any method with a job factory runs from Python with no binding of its own
+(issue 41): tempera.methods.registry.make_job gives the one _native.FrameJob
+that `tempera stylize --method NAME` runs, and every per-frame job's class
+derives from it."""
+import numpy as np
+import pytest
+
+import tempera
+from tempera import _native, read_image
+from tempera.app import guide_cache
+from tempera.methods import registry
+from tempera.methods.lazyfluids import lazyfluids
+
+H, W = 32, 40
+
+
+def smoke(n=20, seed=3):
+    rng = np.random.default_rng(seed)
+    yy, xx = np.mgrid[0:n, 0:n]
+    alpha = np.clip((0.42 * n - np.hypot(xx - (n - 1) / 2, yy - (n - 1) / 2)) / 1.5, 0, 1)
+    return np.dstack([rng.random((n, n, 3)), alpha]).astype(np.float32)
+
+
+@pytest.fixture()
+def shot(tmp_path):
+    yy, xx = np.mgrid[0:H, 0:W]
+    for f in range(1, 4):
+        alpha = np.clip(10 - np.hypot(xx - 14 - 2 * f, yy - H / 2) + 0.5, 0, 1).astype(np.float32)
+        flow = np.zeros((H, W, 2), np.float32)
+        flow[..., 0] = 2.0
+        guide_cache.write_frame(tmp_path / "guides", f, {"alpha": alpha, "fluid_velocity": flow})
+    tempera.write_image(str(tmp_path / "smoke.png"), smoke())
+    return tmp_path
+
+
+def test_the_registry_says_which_methods_have_a_job_factory():
+    jobs = {m["name"] for m in registry.METHODS if m["job"]}
+    assert {"lazyfluids", "fluidymation"} <= jobs and not {"stylit", "tcia", "rigid"} & jobs
+    assert "--lambda" in registry.find("lazyfluids")["options_help"]
+    for job_class in (_native.StylizeJob, _native.NoisySequence, _native.LazyFluidsJob, _native.FluidymationJob):
+        assert issubclass(job_class, _native.FrameJob)
+
+
+def test_lazyfluids_by_the_registry_equals_its_own_class(shot):
+    """The same options given as the command line's flags and as the class's
+    keywords give the same frames, byte for byte."""
+    own = lazyfluids.FluidJob(shot / "smoke.png", shot / "guides", [1, 2, 3], shot / "own", em_iterations=2,
+                              threads=2, temporal_weight=0.35, motion_blur=2.5, rotations=True)
+    job = registry.make_job("lazyfluids", shot / "smoke.png", shot / "guides", [1, 2, 3], shot / "by_registry",
+                            options={"em-iters": 2, "threads": 2, "lambda": 0.35, "motion_blur": 2.5,
+                                     "rotations": True})
+    assert job.frames == [1, 2, 3] and job.has_contact_sheet
+    for i, frame in enumerate(job.frames):
+        assert job.run_frame(i)["status"] == own.run_frame(i)["status"] == "stylized"
+        assert np.array_equal(read_image(job.output_path(frame)), read_image(own.output_path(frame)))
+    assert job.output_path(1).startswith(str(shot / "by_registry" / "frames"))  # as the command's OUT/frames
+    assert [job.run_frame(i)["status"] for i in range(3)] == ["skipped"] * 3  # resume
+    job.write_contact_sheet(shot / "sheet.png")
+    assert read_image(str(shot / "sheet.png")).shape[1] > W
+
+
+def test_a_registered_job_cancels_and_names_bad_options(shot):
+    job = registry.make_job("lazyfluids", shot / "smoke.png", shot / "guides", [1, 2], shot / "out",
+                            options={"em-iters": 1})
+    with pytest.raises(tempera.Cancelled):
+        job.run_frame(0, progress=lambda fraction: False)
+    assert not (shot / "out" / "frames" / "frame_0001.png").exists()
+    with pytest.raises(ValueError, match="unknown option '--bogus' for --method lazyfluids"):
+        registry.make_job("lazyfluids", shot / "smoke.png", shot / "guides", [1, 2], shot / "o", options={"bogus": 1})
+    with pytest.raises(ValueError, match="temporal weight"):  # --lambda is λ, the temporal weight
+        registry.make_job("lazyfluids", shot / "smoke.png", shot / "guides", [1, 2], shot / "o", options={"lambda": -1})
+    with pytest.raises(ValueError, match="no job factory"):
+        registry.make_job("stylit", shot / "smoke.png", shot / "guides", [1, 2], shot / "o")
+    with pytest.raises(ValueError, match="runs in Python"):
+        registry.make_job("rigid", shot / "smoke.png", shot / "guides", [1, 2], shot / "o")
+    with pytest.raises(ValueError, match="unknown --method 'ebsynth'"):
+        registry.make_job("ebsynth", shot / "smoke.png", shot / "guides", [1, 2], shot / "o")
