@@ -5,6 +5,7 @@
 
 #include "numpy_bridge.hpp"
 #include "tempera/app/guide_cache.hpp"
+#include "tempera/app/light_path_guides.hpp"
 #include "tempera/engine/distance_transform.hpp"
 #include "tempera/engine/motion.hpp"
 #include "tempera/methods/tcia/orientation.hpp"
@@ -29,6 +30,34 @@ py::array_t<float> without_gil(Fn&& fn) {
 }  // namespace
 
 void bind_guides(py::module_& m) {
+  m.def(
+      "light_path_guides",
+      [] {
+        py::list out;
+        for (const auto& g : light_path_guides()) {
+          py::dict d;
+          d["name"] = g.name;
+          d["expression"] = g.expression;
+          d["weight"] = g.weight;
+          d["label"] = g.label;
+          d["help"] = g.help;
+          out.append(d);
+        }
+        return out;
+      },
+      "The light-path guides: name, expression, default weight, label, help (the one table, app/light_path_guides.hpp).");
+  m.def(
+      "tonemap_guide",
+      [](const FloatArray& linear) {
+        const ImageView v = py_bridge::view_of(linear, "linear");
+        Image out;
+        {
+          py::gil_scoped_release release;
+          out = tonemap_guide(v);
+        }
+        return py_bridge::to_numpy(std::move(out));
+      },
+      py::arg("linear"), "Linear radiance -> guide values in [0, 1): x/(1+x), then sRGB (use tempera.methods.stylit.stylize.tonemap).");
   m.def(
       "cache_guides",
       [] {

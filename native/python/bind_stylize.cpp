@@ -175,22 +175,6 @@ void bind_stylize(py::module_& m) {
       },
       "StyLit's own defaults (the engine's are SynthesisOptions.table()).");
   m.def(
-      "light_path_guides",
-      [] {
-        py::list out;
-        for (const auto& g : light_path_guides()) {
-          py::dict d;
-          d["name"] = g.name;
-          d["expression"] = g.expression;
-          d["weight"] = g.weight;
-          d["label"] = g.label;
-          d["help"] = g.help;
-          out.append(d);
-        }
-        return out;
-      },
-      "StyLit's light-path guides: name, expression, default weight, label, help (the one table, stylit.hpp).");
-  m.def(
       "box_blur",
       [](const FloatArray& image, float width) {
         const ImageView v = py_bridge::view_of(image, "image");
@@ -202,18 +186,6 @@ void bind_stylize(py::module_& m) {
         return py_bridge::to_numpy(std::move(out));
       },
       py::arg("image"), py::arg("width"), "Box low-pass of `width` pixels (pyramid.hpp), clamped at the borders.");
-  m.def(
-      "tonemap_guide",
-      [](const FloatArray& linear) {
-        const ImageView v = py_bridge::view_of(linear, "linear");
-        Image out;
-        {
-          py::gil_scoped_release release;
-          out = tonemap_guide(v);
-        }
-        return py_bridge::to_numpy(std::move(out));
-      },
-      py::arg("linear"), "Linear radiance -> guide values in [0, 1): x/(1+x), then sRGB (use tempera.methods.stylit.stylize.tonemap).");
   m.def(
       "contact_sheet",
       [](const std::vector<FloatArray>& images, int columns, int gap, int margin, std::vector<float> background) {

@@ -25,8 +25,8 @@ struct GuideFrame {
   static GuideFrame read(const std::string& path, const std::vector<std::string>& names);
 };
 
-// A guide of the cache besides StyLit's light paths (RGB radiance, named by
-// methods/stylit's table): its name, its channel components in the order they
+// A guide of the cache besides the light paths (RGB radiance, named by
+// app/light_path_guides.hpp): its name, its channel components in the order they
 // are written ("<name>.<component>"), and what it holds.
 struct CacheGuide {
   std::string name;

@@ -8,7 +8,7 @@
 #include "tempera/app/guide_cache.hpp"
 #include "tempera/app/image_io.hpp"
 #include "tempera/app/record.hpp"
-#include "tempera/methods/stylit/stylit.hpp"
+#include "tempera/app/light_path_guides.hpp"
 
 namespace fs = std::filesystem;
 
@@ -88,9 +88,7 @@ void NoisySequence::read_exemplar_guides() {
     throw ValueError("guided noise (noise_guides > 0) needs the exemplar's guide cache (--exemplar-guides)");
   if (!fs::is_directory(c.exemplar_guides))
     throw FileNotFoundError(concat("the exemplar guide folder '", c.exemplar_guides, "' does not exist"));
-  StylitOptions weights;
-  weights.weights = c.guide_weights;
-  light_path_ = active_guides(weights);
+  light_path_ = active_guides(c.guide_weights);
   std::vector<std::string> names;
   for (const auto& [name, weight] : light_path_) names.push_back(name);
   const std::string path =

@@ -15,7 +15,7 @@
 #include "tempera/app/job_config.hpp"
 #include "tempera/engine/image.hpp"
 #include "tempera/methods/noisy/noisy.hpp"
-#include "tempera/methods/stylit/stylit.hpp"
+#include "tempera/app/light_path_guides.hpp"
 
 namespace tempera {
 
@@ -30,10 +30,11 @@ struct NoisySequenceConfig : JobConfig {
   // "mask.OB_Cube", an AOV), read per frame. 0 keeps R, 1 is the full amount.
   std::string noise_map;
   // Guided noise (options.noise_guides > 0): the exemplar render's guide
-  // cache (its frame as in StylizeJobConfig) and StyLit's guide weights.
+  // cache (its only frame, or exemplar_frame) and the light-path guides'
+  // weights (app/light_path_guides.hpp).
   std::string exemplar_guides;
   std::optional<int> exemplar_frame;
-  std::vector<std::pair<std::string, float>> guide_weights = default_guide_weights();
+  GuideWeights guide_weights = default_guide_weights();
   NoisyOptions options = default_noisy_options();
 };
 
