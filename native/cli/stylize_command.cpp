@@ -58,9 +58,7 @@ const char* kStylizeHelpText =
     "stylization:\n"
     "  --weights LIST          light-path guide weights (default @WEIGHTS@);\n"
     "                          guides not listed keep their default, 0 leaves a guide out\n"
-    "  --temporal W            weight of the temporal guide: the previous stylized frame\n"
-    "                          advected along the motion (default 0 = frames independent; 0.5 typical)\n"
-    "  --quality Q             final (default) | preview (about 5x faster, for trying settings)\n"
+    "@STYLIT@"
     "  --usage MODE            none | penalty | uniform | budget (default budget)\n"
     "  --patch-size N          odd patch width (default 5)\n"
     "  --seed N                random seed (default 1)\n"
@@ -132,6 +130,7 @@ std::string stylize_help() {
     defaults += (defaults.empty() ? "" : ",") + std::string(g.name) + "=" + format_value(g.weight);
   std::string text = kStylizeHelpText;
   text.replace(text.find("@WEIGHTS@"), 9, defaults);
+  text.replace(text.find("@STYLIT@"), 8, flags_help<StylitOptions>(stylit_option_table()));
   text.replace(text.find("@TCIA@"), 6, flags_help<TciaOptions>(tcia_option_table()));
   text.replace(text.find("@LINES@"), 7,
                flags_help<TciaLineOptions>(tcia_line_option_table()) +
@@ -228,8 +227,8 @@ Options parse(const Args& args) {
     else if (flag == "--frames") o.frames = parse_frames(o.frames_text = r.value(flag));
     else if (flag == "--out") o.out = r.value(flag);
     else if (flag == "--weights") parse_guide_weights(r.value(flag), o.stylit.weights);
-    else if (flag == "--temporal") o.stylit.temporal_weight = r.number<float>(flag), o.temporal_given = true;
-    else if (flag == "--quality") o.stylit.quality = parse_quality(r.value(flag));
+    else if (set_from_flag(o.stylit, stylit_option_table(), flag.substr(2), [&] { return r.value(flag); }))
+      o.temporal_given |= flag == "--temporal";  // --temporal, --quality
     else if (flag == "--format") o.format = r.value(flag);
     else if (flag == "--fps") o.fps = r.number<double>(flag);
     else if (flag == "--no-video") o.video = false;

@@ -25,13 +25,22 @@ using py_bridge::get;
 
 namespace {
 
-// StyLit's own keys; every other key is an engine option (SynthesisOptions).
-const std::set<std::string> kStylitKeys = {"weights", "temporal_weight", "quality"};
-
+// StyLit's keys: weights, its option table's and the engine's (SynthesisOptions).
 std::set<std::string> stylit_keys() {
-  std::set<std::string> keys = kStylitKeys;
+  std::set<std::string> keys = {"weights"};
+  for_each_field(stylit_option_table(), [&](const auto& f) { keys.insert(f.name); });
   for_each_field(synthesis_option_table(), [&](const auto& f) { keys.insert(f.name); });
   return keys;
+}
+
+// The entries of `d` whose keys are fields of `table`.
+template <class Tuple>
+py::dict table_keys(const py::dict& d, const Tuple& table) {
+  py::dict out;
+  for_each_field(table, [&](const auto& f) {
+    if (d.contains(f.name)) out[f.name] = d[f.name];
+  });
+  return out;
 }
 const std::set<std::string> kJobKeys = {"exemplar", "exemplar_guides", "exemplar_frame", "guides", "frames",
                                         "out", "format", "prefix", "resume"};
@@ -65,14 +74,9 @@ StylitOptions parse_stylit(const py::dict& d) {
   StylitOptions opt;
   const std::string what = "option";
   if (d.contains("weights")) set_weights(opt, get<py::dict>(d, "weights", what));
-  if (d.contains("temporal_weight")) opt.temporal_weight = get<float>(d, "temporal_weight", what);
-  if (d.contains("quality")) opt.quality = parse_quality(get<std::string>(d, "quality", what));
-  py::dict engine;
-  std::set<std::string> engine_keys;
-  for_each_field(synthesis_option_table(), [&](const auto& f) { engine_keys.insert(f.name); });
-  for (const auto& [key, value] : d)
-    if (engine_keys.count(py::str(key))) engine[key] = value;
-  py_bridge::set_from_dict(opt.synthesis, synthesis_option_table(), engine, "engine option");
+  py_bridge::set_from_dict(opt, stylit_option_table(), table_keys(d, stylit_option_table()), what.c_str());
+  py_bridge::set_from_dict(opt.synthesis, synthesis_option_table(), table_keys(d, synthesis_option_table()),
+                           "engine option");
   validate(opt.synthesis);
   active_guides(opt);  // errors now, not in the middle of a run
   return opt;
@@ -167,13 +171,15 @@ void bind_stylize(py::module_& m) {
   m.def(
       "stylit_defaults",
       [] {
-        const StylitOptions o;
         py::dict d;
-        d["temporal_weight"] = o.temporal_weight;
-        d["quality"] = quality_name(o.quality);
+        for (const py::handle& f : py_bridge::table_as_list<StylitOptions>(stylit_option_table()))
+          d[f["name"]] = f["default"];
         return d;
       },
       "StyLit's own defaults (the engine's are SynthesisOptions.table()).");
+  m.def(
+      "stylit_option_table", [] { return py_bridge::table_as_list<StylitOptions>(stylit_option_table()); },
+      "StyLit's option table (stylit.hpp): name, flag, help, default, min, max, choices; the panel's tooltips.");
   m.def(
       "box_blur",
       [](const FloatArray& image, float width) {

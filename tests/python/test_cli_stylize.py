@@ -86,6 +86,30 @@ def test_errors_and_exit_codes(cli_path, caches):
         assert option in help_text.stdout
 
 
+def test_stylits_options_come_from_its_one_table(cli_path, caches):
+    """Issue 41, step 6: --temporal and --quality, their help, the Python
+    defaults and keywords, and the panel's tooltips read StyLit's option table."""
+    from tempera.app import settings
+    from tempera.methods.stylit import stylize as stylit
+
+    table = {row["name"]: row for row in tempera._native.stylit_option_table()}
+    assert (table["temporal_weight"]["flag"], table["quality"]["choices"]) == ("temporal", ["final", "preview"])
+    assert tempera._native.stylit_defaults() == {"temporal_weight": 0.0, "quality": "final"}
+    assert settings.STYLIT_OPTIONS == table and settings.DEFAULT_QUALITY == "final"
+    help_text = stylize(cli_path, "--help").stdout
+    assert table["quality"]["help"] in help_text and table["temporal_weight"]["help"] in help_text
+    for bad, message in ((("--quality", "best"), "unknown quality 'best' (choose final, preview)"),
+                         (("--temporal", "x"), "--temporal expects a number, got 'x'"),
+                         (("--temporal", "-1"), "temporal weight must be finite and >= 0")):
+        result = stylize(cli_path, *farm_args(caches, *bad))
+        assert result.returncode == 2 and message in result.stderr, (bad, result.stderr)
+    config = dict(style=caches / "paint.png", exemplar_guides=caches / "exemplar", guides=caches / "cache",
+                  frames=[1], out=caches / "py")
+    with pytest.raises(ValueError, match="unknown quality 'best'"):
+        stylit.StylizeJob(**config, quality="best")
+    assert stylit.StylizeJob(**config, quality="preview", temporal_weight=1).frames == [1]
+
+
 def test_ctrl_c_keeps_finished_frames(cli_path, tmp_path):
     # Frames big enough to take a while, so the interrupt lands mid-run.
     from tempera.app import guide_cache

@@ -34,13 +34,14 @@ DEFAULT_GUIDE_WEIGHTS = {g["name"]: g["weight"] for g in LIGHT_PATH_GUIDES}
 # default to 0 (frames independent, so farms can split a shot anywhere); the
 # panel starts artists at 0.5, measured on the demo: flicker 0.030 -> 0.011
 # with the stroke detail kept (docs/user_guide.md).
-DEFAULT_TEMPORAL_WEIGHT = _native.stylit_defaults()["temporal_weight"]
+# StyLit's option table (stylit.hpp): name -> row (flag, help, default, min, max, choices).
+STYLIT_OPTIONS = {row["name"]: row for row in _native.stylit_option_table()}
+DEFAULT_TEMPORAL_WEIGHT = STYLIT_OPTIONS["temporal_weight"]["default"]
 PANEL_TEMPORAL_WEIGHT = 0.5
 # The panel's Guided Noise checkbox sets noise_guides to this (docs/noisy.md:
 # 0.5 and 1 keep the same share of thin strokes; 0.5 was the probe's best).
 PANEL_NOISE_GUIDES = 0.5
-DEFAULT_QUALITY = _native.stylit_defaults()["quality"]
-QUALITY_PRESETS = ("preview", "final")
+DEFAULT_QUALITY = STYLIT_OPTIONS["quality"]["default"]
 OUTPUT_FORMATS = ("png", "exr")
 
 # The fluid methods' option tables (name -> row, as ENGINE_OPTIONS):

@@ -73,13 +73,17 @@ def _weight(guide):
                          description=f"Weight of {guide['help']} ({guide['expression']})")
 
 
+def _tooltip(row):
+    """A native option table row's help as a tooltip: a sentence."""
+    return row["help"][0].upper() + row["help"][1:]
+
+
 def _option_property(prop):
     """The panel property `prop` of settings.PANEL_OPTIONS: default, limits
     and tooltip from its row of the method's native option table."""
     table, option, label, soft_max = limits.PANEL_OPTIONS[prop]
     row = table[option]
-    text = row["help"]
-    common = dict(name=label, default=row["default"], description=text[0].upper() + text[1:])
+    common = dict(name=label, default=row["default"], description=_tooltip(row))
     if isinstance(row["default"], bool):
         return BoolProperty(**common)
     return FloatProperty(min=row["min"], max=row["max"], soft_max=soft_max, **common)
@@ -312,13 +316,12 @@ class TemperaSettings(PropertyGroup):
     usage: EnumProperty(name="Patch Usage", items=USAGE_ITEMS, default=limits.ENGINE_OPTIONS["usage"]["default"],
                         description="How evenly the exemplar's patches are used")
     quality: EnumProperty(name="Quality", items=QUALITY_ITEMS, default=limits.DEFAULT_QUALITY,
-                          description="Solver effort per frame")
+                          description=_tooltip(limits.STYLIT_OPTIONS["quality"]))
     temporal_weight: FloatProperty(
         name="Temporal Coherence",
-        description="Pull of the previous stylized frame, moved along the rendered motion: higher values "
-        "flicker less but let the paint stick and smear; 0 stylizes each frame on its own",
+        description=_tooltip(limits.STYLIT_OPTIONS["temporal_weight"]),
         default=limits.PANEL_TEMPORAL_WEIGHT,
-        min=0.0,
+        min=limits.STYLIT_OPTIONS["temporal_weight"]["min"],
         soft_max=2.0,
     )
     output_format: EnumProperty(name="Format", items=FORMAT_ITEMS, default="png",

@@ -15,7 +15,7 @@ import numpy as np
 from ... import _native
 from ...app.frame_job import ProgressFn, SheetFrameJob
 from ...app.settings import DEFAULT_GUIDE_WEIGHTS as DEFAULT_WEIGHTS
-from ...app.settings import LIGHT_PATH_GUIDES, QUALITY_PRESETS as QUALITIES
+from ...app.settings import LIGHT_PATH_GUIDES
 
 GUIDES = tuple(g["name"] for g in LIGHT_PATH_GUIDES)
 

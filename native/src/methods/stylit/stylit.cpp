@@ -19,14 +19,6 @@ void require_channels(const ImageView& image, int channels, const char* what) {
 
 }  // namespace
 
-Quality parse_quality(const std::string& name) {
-  if (name == "final") return Quality::Final;
-  if (name == "preview") return Quality::Preview;
-  throw ValueError(concat("unknown quality '", name, "' (choose preview or final)"));
-}
-
-const char* quality_name(Quality quality) { return quality == Quality::Preview ? "preview" : "final"; }
-
 std::vector<std::pair<std::string, float>> active_guides(const StylitOptions& options) {
   auto out = active_guides(options.weights);
   if (!std::isfinite(options.temporal_weight) || options.temporal_weight < 0)

@@ -39,7 +39,7 @@ std::string settings_text(const StylizeJobConfig& c) {
   std::ostringstream s;
   s << "weights=";
   for (const auto& [name, weight] : active_guides(c.stylit)) s << name << ":" << weight << ",";
-  s << ";temporal=" << c.stylit.temporal_weight << ";quality=" << quality_name(c.stylit.quality) << ";"
+  s << ";temporal=" << c.stylit.temporal_weight << ";quality=" << enum_name(c.stylit.quality) << ";"
     << settings_text(o, synthesis_option_table()) << "format=" << c.format;
   return s.str();
 }

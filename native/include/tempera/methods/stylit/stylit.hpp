@@ -14,13 +14,17 @@
 #include "tempera/app/guide_cache.hpp"
 #include "tempera/app/light_path_guides.hpp"
 #include "tempera/engine/image.hpp"
+#include "tempera/engine/option_table.hpp"
 #include "tempera/engine/synthesis.hpp"
 
 namespace tempera {
 
 enum class Quality { Final, Preview };
-Quality parse_quality(const std::string& name);  // "final" | "preview", else ValueError
-const char* quality_name(Quality quality);
+template <>
+struct EnumNames<Quality> {
+  static constexpr const char* what = "quality";
+  static constexpr std::array<const char*, 2> names = {"final", "preview"};
+};
 
 struct StylitOptions {
   // Light-path guide weights in matching order; a weight <= 0 leaves the guide out.
@@ -34,6 +38,22 @@ struct StylitOptions {
   // taken as they are, except that the quality preset sets the iteration counts.
   SynthesisOptions synthesis;
 };
+
+// StyLit's own options besides the guide weights (--weights, a list) and the
+// engine's (synthesis_option_table): the flags, help and ranges of `tempera
+// stylize`, the Python defaults and the panel's tooltips come from here. The
+// panel starts artists at a temporal weight of 0.5 (settings.PANEL_TEMPORAL_WEIGHT).
+inline const auto& stylit_option_table() {
+  using S = StylitOptions;
+  static const auto table = std::make_tuple(
+      field(&S::temporal_weight, "temporal_weight", "temporal",
+            "pull of the previous stylized frame, moved along the rendered motion: higher values flicker less but "
+            "let the paint stick and smear; 0 stylizes each frame on its own (0.5 typical)",
+            0.0),
+      field(&S::quality, "quality", "quality",
+            "solver effort per frame: preview is about 5x faster, for trying settings"));
+  return table;
+}
 
 // active_guides of the options' weights, and ValueError for a temporal
 // weight that is negative or not finite.
