@@ -52,7 +52,7 @@ max_image_pixels, set_max_image_pixels = _native.max_image_pixels, _native.set_m
 
 # Python API on top of the native module; public entry points are listed in __all__.
 from .app.contact_sheet import contact_sheet
-from .tracer.lpe import check_lpe, trace_lpe
+from .tracer.lpe import TraceOptions, check_lpe, trace_lpe
 from .engine.synthesis import USAGE_MODES, SynthesisOptions, synthesize
 
 __all__ = [
@@ -67,6 +67,7 @@ __all__ = [
     "synthesize",
     "SynthesisOptions",
     "trace_lpe",
+    "TraceOptions",
     "USAGE_MODES",
     "write_image",
 ]

@@ -5,6 +5,7 @@
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
+#include "bind_options.hpp"
 #include "numpy_bridge.hpp"
 #include "tempera/tracer/embree_tracer.hpp"
 #include "tempera/tracer/lpe.hpp"
@@ -17,15 +18,15 @@ namespace {
 
 constexpr const char* kTraceDoc = R"(Render light-path-expression guides by path tracing (Embree).
 
-trace_lpe(scene: Scene, expressions, samples=64, seed=0, threads=0, max_bounces=8,
-          progress=None) -> (images, alpha)
+trace_lpe(scene: Scene, expressions, options: TraceOptions, progress=None) -> (images, alpha)
 
 images: one float32 (H, W, 3) linear radiance array per expression, in order;
 alpha: float32 (H, W), the fraction of camera rays that hit geometry.
 Expressions are written light-to-eye (LDE, LSE, L.*DDE, LD{1,2}E, ...).
-The result depends on seed only, not on threads. max_bounces counts indirect
-bounces like Cycles (0: direct light only). progress(fraction) returning False
-cancels with tempera.Cancelled. The GIL is released while tracing.
+The result depends on options.seed only, not on threads; TraceOptions.table()
+lists every option (Cycles' bounce limits, caustics, Filter Glossy, pixel
+filter). progress(fraction) returning False cancels with tempera.Cancelled.
+The GIL is released while tracing.
 
 scene: a tempera._native.Scene; tempera.trace_lpe also takes the scene dict
 (unknown or missing keys raise ValueError naming them):
@@ -66,29 +67,12 @@ void bind_scene_types(py::module_& m);  // bind_scene.cpp
 
 void bind_tracer(py::module_& m) {
   bind_scene_types(m);
+  py_bridge::bind_options_class<TraceOptions>(m, "TraceOptions", trace_option_table(),
+                                              "Options of the tracer (native/include/tempera/tracer/embree_tracer.hpp).");
   m.def(
       "trace_lpe",
-      [](const Scene& scene, const std::vector<std::string>& expressions, int samples, std::uint64_t seed,
-         int threads, int max_bounces, std::function<bool(double)> progress, int diffuse_bounces, int glossy_bounces,
-         int transmission_bounces, int transparent_bounces, bool caustics_reflective, bool caustics_refractive,
-         float filter_glossy, const std::string& pixel_filter, float filter_width) {
-        TraceOptions options;
-        options.samples = samples;
-        options.seed = seed;
-        options.threads = threads;
-        options.max_bounces = max_bounces;
-        options.diffuse_bounces = diffuse_bounces;
-        options.glossy_bounces = glossy_bounces;
-        options.transmission_bounces = transmission_bounces;
-        options.transparent_bounces = transparent_bounces;
-        options.caustics_reflective = caustics_reflective;
-        options.caustics_refractive = caustics_refractive;
-        options.filter_glossy = filter_glossy;
-        if (pixel_filter == "box") options.pixel_filter = TraceOptions::PixelFilter::box;
-        else if (pixel_filter == "gaussian") options.pixel_filter = TraceOptions::PixelFilter::gaussian;
-        else if (pixel_filter == "blackman_harris") options.pixel_filter = TraceOptions::PixelFilter::blackman_harris;
-        else throw ValueError(concat("pixel_filter must be 'box', 'gaussian' or 'blackman_harris', got '", pixel_filter, "'"));
-        options.filter_width = filter_width;
+      [](const Scene& scene, const std::vector<std::string>& expressions, const TraceOptions& options,
+         std::function<bool(double)> progress) {
         TraceProgress callback = py_bridge::with_gil([&](double fraction) {
           return progress ? progress(fraction) : true;
         });
@@ -103,11 +87,7 @@ void bind_tracer(py::module_& m) {
         py::object alpha = py_bridge::to_numpy(std::move(result.alpha)).attr("reshape")(h, w);
         return py::make_tuple(images, alpha);
       },
-      py::arg("scene"), py::arg("expressions"), py::arg("samples") = 64, py::arg("seed") = 0, py::arg("threads") = 0,
-      py::arg("max_bounces") = 8, py::arg("progress") = nullptr, py::arg("diffuse_bounces") = 1024,
-      py::arg("glossy_bounces") = 1024, py::arg("transmission_bounces") = 1024, py::arg("transparent_bounces") = 1024,
-      py::arg("caustics_reflective") = true, py::arg("caustics_refractive") = true, py::arg("filter_glossy") = 0.0f,
-      py::arg("pixel_filter") = "box", py::arg("filter_width") = 1.0f, kTraceDoc);
+      py::arg("scene"), py::arg("expressions"), py::arg("options"), py::arg("progress") = nullptr, kTraceDoc);
   m.def(
       "check_lpe", [](const std::string& expression) { compile_lpe(expression); }, py::arg("expression"),
       "Raise ValueError (with the 0-based position) if the light path expression is malformed.");

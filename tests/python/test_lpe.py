@@ -40,6 +40,26 @@ def test_sun_on_lambert_plane():
     np.testing.assert_allclose(images[2], images[0], rtol=1e-5)
 
 
+def test_the_tracers_options_are_one_table():
+    """Issue 41, step 6: tempera.TraceOptions' table gives trace_lpe's keywords,
+    their defaults, ranges and help; a typo is a ValueError, not a default."""
+    table = {row["name"]: row for row in tempera.TraceOptions.table()}
+    assert (table["samples"]["default"], table["max_bounces"]["default"], table["seed"]["default"]) == (64, 8, 0)
+    assert table["pixel_filter"]["choices"] == ["box", "gaussian", "blackman_harris"]
+    assert all(row["help"] for row in table.values())
+    for options, message in (({"bounces": 2}, "unknown option 'bounces'"),
+                             ({"samples": 0}, r"samples must be in \[1, 1048576\], got 0"),
+                             ({"max_bounces": -1}, "max bounces must be in"),
+                             ({"pixel_filter": "mitchell"}, "unknown pixel filter 'mitchell'"),
+                             ({"filter_width": 0}, "filter width must be above 0")):
+        with pytest.raises(ValueError, match=message):
+            tempera.trace_lpe(plane_scene(), ["LDE"], **options)
+    defaults = {name: row["default"] for name, row in table.items()}
+    (given,), _ = tempera.trace_lpe(plane_scene(), ["LDE"], **dict(defaults, samples=2))
+    (default,), _ = tempera.trace_lpe(plane_scene(), ["LDE"], samples=2)
+    np.testing.assert_array_equal(given, default)
+
+
 def test_same_result_for_any_thread_count():
     one, _ = tempera.trace_lpe(plane_scene(), ["L.*E"], samples=4, seed=3, threads=1)
     two, _ = tempera.trace_lpe(plane_scene(), ["L.*E"], samples=4, seed=3, threads=2)

@@ -277,38 +277,30 @@ def lpe_matches(expression: str, events: str) -> bool:
     return _native.lpe_matches(str(expression), str(events))
 
 
-def trace_lpe(
-    scene: dict,
-    expressions: Sequence[str],
-    *,
-    samples: int = 64,
-    seed: int = 0,
-    threads: int = 0,
-    max_bounces: int = 8,
-    progress: Optional[Callable[[float], Optional[bool]]] = None,
-    diffuse_bounces: int = 1024,
-    glossy_bounces: int = 1024,
-    transmission_bounces: int = 1024,
-    transparent_bounces: int = 1024,
-    caustics_reflective: bool = True,
-    caustics_refractive: bool = True,
-    filter_glossy: float = 0.0,
-    pixel_filter: str = "box",
-    filter_width: float = 1.0,
-):
+TraceOptions = _native.TraceOptions  # the tracer's options (samples, seed, Cycles' bounce limits, ...)
+
+
+def trace_lpe(scene: dict, expressions: Sequence[str], *,
+              progress: Optional[Callable[[float], Optional[bool]]] = None, **options):
     """Render one linear radiance image per light path expression.
 
     ``expressions`` are written light-to-eye: ``L`` emitter (lights, emissive
     surfaces, world), ``D`` diffuse, ``S`` (or ``G``) glossy/specular
     reflection, ``T`` transmission, ``E`` eye; operators ``. * + ? {m} {m,}
-    {m,n} [..] [^..] | ( )``. The result depends only on ``seed``, not on
-    ``threads``. ``max_bounces`` counts indirect bounces as Cycles does, and
-    so do the per-kind limits (``diffuse_bounces`` ...; transparent surfaces
-    count separately). ``caustics_reflective``/``caustics_refractive`` False
-    drop glossy/refractive lobes after a diffuse bounce, as Cycles' options do;
-    ``filter_glossy`` is Cycles' Filter Glossy (0: off); ``pixel_filter``
-    (``"box"``, ``"gaussian"``, ``"blackman_harris"``) and ``filter_width``
-    (pixels) are Cycles' Film > Pixel Filter (default: the pixel itself).
+    {m,n} [..] [^..] | ( )``.
+
+    ``options`` are the fields of tempera.TraceOptions, whose ``table()``
+    gives each one's default, range and help (the one table,
+    native/include/tempera/tracer/embree_tracer.hpp): ``samples`` (64),
+    ``seed`` (0; the result depends only on it, not on ``threads``),
+    ``max_bounces`` (8, indirect bounces as Cycles counts them) and Cycles'
+    per-kind limits (``diffuse_bounces`` ...; transparent surfaces count
+    separately), ``caustics_reflective``/``caustics_refractive`` (False drops
+    glossy/refractive lobes after a diffuse bounce), ``filter_glossy``
+    (Cycles' Filter Glossy, 0: off), ``pixel_filter`` (``"box"``,
+    ``"gaussian"``, ``"blackman_harris"``) and ``filter_width`` (pixels):
+    Cycles' Film > Pixel Filter (default: the pixel itself). An unknown
+    option or a value out of range is a ValueError naming it.
     ``progress(fraction)`` returning False cancels (raises ``tempera.Cancelled``).
 
     Returns ``(images, alpha)``: a list of float32 (H, W, 3) arrays in the
@@ -322,12 +314,4 @@ def trace_lpe(
     def report(fraction: float) -> bool:
         return True if progress is None else progress(fraction) is not False
 
-    return _native.trace_lpe(scene_from_dict(scene), expressions, samples=int(samples), seed=int(seed),
-                             threads=int(threads), max_bounces=int(max_bounces), progress=report,
-                             diffuse_bounces=int(diffuse_bounces), glossy_bounces=int(glossy_bounces),
-                             transmission_bounces=int(transmission_bounces),
-                             transparent_bounces=int(transparent_bounces),
-                             caustics_reflective=bool(caustics_reflective),
-                             caustics_refractive=bool(caustics_refractive),
-                             filter_glossy=float(filter_glossy), pixel_filter=str(pixel_filter),
-                             filter_width=float(filter_width))
+    return _native.trace_lpe(scene_from_dict(scene), expressions, TraceOptions(**options), report)

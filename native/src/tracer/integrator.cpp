@@ -34,7 +34,6 @@ namespace {
 using namespace tracer;
 
 constexpr int kRouletteFromBounce = 3;
-constexpr int kMaxSamples = 1 << 20;  // per pixel: path random streams are pixel * 2^20 + sample
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
 unsigned ray_kind(LpeEvent event) {
@@ -436,14 +435,8 @@ class Tracer {
 
 TraceResult trace_lpe(const Scene& scene, const std::vector<std::string>& expressions, const TraceOptions& options,
                       const TraceProgress& progress) {
-  if (options.samples < 1 || options.samples > kMaxSamples)
-    throw ValueError(concat("samples must be in [1, ", kMaxSamples, "], got ", options.samples));
-  if (!(options.filter_glossy >= 0)) throw ValueError(concat("filter_glossy must be >= 0, got ", options.filter_glossy));
-  if (!(options.filter_width > 0 && options.filter_width <= 64))
-    throw ValueError(concat("filter_width must be in (0, 64], got ", options.filter_width));
-  for (int limit : {options.max_bounces, options.diffuse_bounces, options.glossy_bounces,
-                    options.transmission_bounces, options.transparent_bounces})
-    if (limit < 0) throw ValueError(concat("bounce limits must be >= 0, got ", limit));
+  validate_fields(options, trace_option_table());
+  if (!(options.filter_width > 0)) throw ValueError(concat("filter width must be above 0, got ", options.filter_width));
   std::vector<LpeDfa> dfas;
   for (const auto& e : expressions) dfas.push_back(compile_lpe(e, LpeOrder::eye_to_light));
   validate_scene(scene);
@@ -466,7 +459,7 @@ TraceResult trace_lpe(const Scene& scene, const std::vector<std::string>& expres
       std::fill(sums.begin(), sums.end(), Float3{});
       float alpha = 0;
       for (int i = 0; i < options.samples; ++i) {
-        Rng rng(options.seed, pixel * kMaxSamples + std::uint64_t(i));
+        Rng rng(options.seed, pixel * kMaxTraceSamples + std::uint64_t(i));
         tracer.trace_sample(x, y, std::uint32_t(i), scramble_x, scramble_y, rng, states, sums, alpha);
       }
       const float inv = 1.0f / float(options.samples);

@@ -9,9 +9,13 @@
 #include <vector>
 
 #include "tempera/engine/image.hpp"
+#include "tempera/engine/option_table.hpp"
 #include "tempera/tracer/scene.hpp"
 
 namespace tempera {
+
+// Samples per pixel at most: a path's random stream is pixel * 2^20 + sample.
+inline constexpr int kMaxTraceSamples = 1 << 20;
 
 struct TraceOptions {
   int samples = 64;   // per pixel, stratified
@@ -40,6 +44,38 @@ struct TraceOptions {
   float filter_width = 1;
 };
 
+template <>
+struct EnumNames<TraceOptions::PixelFilter> {
+  static constexpr const char* what = "pixel filter";
+  static constexpr std::array<const char*, 3> names = {"box", "gaussian", "blackman_harris"};
+};
+
+// The one table of the tracer's options: their ranges (checked by
+// trace_lpe), Python's tempera.TraceOptions and trace_lpe keywords with their
+// defaults and help. Not on the command line: render-guides takes them from
+// the scene's Cycles settings.
+inline const auto& trace_option_table() {
+  using T = TraceOptions;
+  static const auto table = std::make_tuple(
+      field(&T::samples, "samples", "", "camera rays per pixel, stratified", 1, kMaxTraceSamples),
+      field(&T::seed, "seed", "", "random seed: the result depends on it, never on threads"),
+      not_in_settings(field(&T::threads, "threads", "", "worker threads; 0 = all cores", 0)),
+      field(&T::max_bounces, "max_bounces", "", "indirect bounces as Cycles counts them; 0 = direct light only", 0),
+      field(&T::diffuse_bounces, "diffuse_bounces", "", "Cycles' Max Bounces > Diffuse", 0),
+      field(&T::glossy_bounces, "glossy_bounces", "", "Cycles' Max Bounces > Glossy", 0),
+      field(&T::transmission_bounces, "transmission_bounces", "", "Cycles' Max Bounces > Transmission", 0),
+      field(&T::transparent_bounces, "transparent_bounces", "",
+            "Cycles' Max Bounces > Transparent: transparent surfaces passed without a bounce", 0),
+      field(&T::caustics_reflective, "caustics_reflective", "",
+            "Cycles' Reflective Caustics: off drops glossy lobes after a diffuse bounce"),
+      field(&T::caustics_refractive, "caustics_refractive", "",
+            "Cycles' Refractive Caustics: off drops refractive lobes after a diffuse bounce"),
+      field(&T::filter_glossy, "filter_glossy", "", "Cycles' Filter Glossy; 0 = off", 0),
+      field(&T::pixel_filter, "pixel_filter", "", "Cycles' Film > Pixel Filter"),
+      field(&T::filter_width, "filter_width", "", "Cycles' Film > Pixel Filter width in pixels, above 0", 0, 64));
+  return table;
+}
+
 struct TraceResult {
   std::vector<Image> images;  // (H, W, 3) linear radiance, one per expression
   Image alpha;                // (H, W, 1) fraction of camera rays that hit geometry
@@ -48,8 +84,9 @@ struct TraceResult {
 // Called with the fraction done; returning false cancels (CancelledError).
 using TraceProgress = std::function<bool(double)>;
 
-// Throws ValueError for a malformed expression or scene, and a tempera error
-// carrying Embree's message if Embree fails.
+// Throws ValueError for a malformed expression or scene, or options outside
+// their table's ranges, and a tempera error carrying Embree's message if
+// Embree fails.
 TraceResult trace_lpe(const Scene& scene, const std::vector<std::string>& expressions,
                       const TraceOptions& options, const TraceProgress& progress = {});
 
