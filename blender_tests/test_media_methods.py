@@ -205,6 +205,20 @@ def test_stylize_frame_runs_the_fluid_method_on_that_frame(media_scene, tmp_path
     assert bpy.path.abspath(image.filepath) == str(tmp_path / "out" / "lazyfluids" / "frames" / written[0])
 
 
+@pytest.mark.parametrize("method, kind", [("LAZYFLUIDS", "smoke"), ("FLUIDYMATION", "ink")])
+def test_an_empty_exemplar_field_uses_the_projects_own(media_scene, tmp_path, method, kind):
+    """Issue 41, step 5: with the File field empty, the method's default
+    exemplar (its registry entry's), written once beside its frames, as
+    `tempera stylize` does with no --exemplar."""
+    s = media_scene.tempera
+    s.method, s.media_exemplar = method, ""
+    assert bpy.ops.tempera.stylize(mode="ANIMATION") == {"FINISHED"}
+    folder = tmp_path / "out" / method.lower() / f"exemplar_generated_{kind}"
+    assert len(list(folder.glob("frame_*.png"))) == 24
+    written = sorted(p.name for p in (tmp_path / "out" / method.lower() / "frames").glob("frame_*.png"))
+    assert written == [f"frame_{f:04d}.png" for f in FRAMES]
+
+
 def _movie(tmp_path):
     movie = tmp_path / "ink.mov"
     frames = str(tmp_path / "ink" / "ink_%04d.png")

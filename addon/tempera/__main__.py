@@ -5,7 +5,8 @@
 a Dask cluster (tempera.app.farm); `tempera rigid ...` and `tempera stylize
 --method M ...` for a method the registry says is written in Python (rigid:
 tempera.methods.rigid.rigid_cli) run that method; `tempera exemplar ...` writes one of the
-project's own smoke/fire/ink exemplars (tempera.app.exemplar_cli); every other command is the
+project's own smoke/fire/ink exemplars (tempera.app.exemplar_cli), which `tempera stylize --method M`
+also uses when M has a default exemplar and --exemplar is left out; every other command is the
 native batch CLI
 (tempera_native/bin/tempera: synth, stylize, render-guides), run with this
 package as the add-on that `render-guides` hands to Blender.
@@ -58,11 +59,17 @@ def main(argv=None):
 
         return rigid_main(argv[1:])
     if argv[:1] == ["stylize"] and stylize_method(argv[1:]) is not None:
+        from .app.exemplar_cli import with_default_exemplar
         from .methods import registry
 
         python_command = registry.python_command(stylize_method(argv[1:]))  # a method written in Python
         if python_command is not None:
             return python_command(argv[1:])
+        try:
+            argv = ["stylize", *with_default_exemplar(argv[1:], registry.find(stylize_method(argv[1:])))]
+        except (ValueError, OSError) as exc:  # an unknown method, an output folder that cannot be written
+            print(f"tempera stylize: error: {exc}", file=sys.stderr)
+            return 2 if isinstance(exc, ValueError) else 1
     if argv[:1] == ["exemplar"]:
         from .app.exemplar_cli import main as exemplar_main
 

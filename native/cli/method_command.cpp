@@ -17,6 +17,14 @@ namespace fs = std::filesystem;
 namespace tempera::cli {
 namespace {
 
+// The help's note on the default exemplar, if the method has one.
+std::string method_default_exemplar(const MethodEntry& m) {
+  if (m.default_exemplar.empty()) return "";
+  return concat(" (left out: the Python package's tempera generates\n"
+                "                          the project's own ", m.default_exemplar, " into OUT/exemplar_generated_",
+                m.default_exemplar, ")");
+}
+
 std::string method_help(const MethodEntry& m) {
   return concat("usage: tempera stylize --method ", m.name,
                 " --guides DIR --exemplar PATH --frames A-B --out DIR [options]\n"
@@ -25,7 +33,8 @@ std::string method_help(const MethodEntry& m) {
                 m.paper, "): ", m.summary, ". See ", m.docs, ".\n\n", m.help_details,
                 m.help_details.empty() ? "" : "\n",
                 "inputs and outputs:\n"
-                "  --exemplar PATH         the exemplar\n"
+                "  --exemplar PATH         the exemplar",
+                method_default_exemplar(m), "\n"
                 "  --guides DIR            guide cache of the animation (with SCENE.blend: rendered there first\n"
                 "                          by background Blender, default OUT/guides, as tempera render-guides\n"
                 "                          does: --samples N, --blender PATH, --addon-path DIR)\n"
@@ -41,7 +50,7 @@ std::string method_help(const MethodEntry& m) {
 
 // The core's flags into `config`; every other flag is the method's, with its
 // text, or "" when it stands alone (a switch).
-MethodOptions parse(const Args& args, JobConfig& config) {
+MethodOptions parse(const MethodEntry& method, const Args& args, JobConfig& config) {
   MethodOptions options;
   ArgReader r(args, "stylize");
   while (r.more()) {
@@ -56,6 +65,10 @@ MethodOptions parse(const Args& args, JobConfig& config) {
     else if (flag == "--max-image-pixels") set_max_image_pixels(r.number<std::int64_t>(flag));
     else options.emplace_back(flag.substr(2), r.optional_value() ? r.value(flag) : "");  // the method names unknown ones
   }
+  if (config.exemplar.empty() && !method.default_exemplar.empty())
+    throw ValueError(concat("--exemplar is required here; the Python package's 'tempera stylize' uses the project's "
+                            "own ", method.default_exemplar, " exemplar when it is left out (or write it with "
+                            "'tempera exemplar ", method.default_exemplar, " --out DIR')"));
   for (const auto& [value, what] : {std::pair{&config.exemplar, "--exemplar is required (the exemplar)"},
                                     {&config.guides, "--guides is required (the shot's guide cache)"},
                                     {&config.out, "--out is required (the output folder)"}})
@@ -72,7 +85,7 @@ int run_registered_method(const MethodEntry& method, const Args& args) {
     return 0;
   }
   JobConfig config;
-  const MethodOptions options = parse(args, config);  // usage errors: exit status 2
+  const MethodOptions options = parse(method, args, config);  // usage errors: exit status 2
   catch_interrupts();
   const std::unique_ptr<FrameJob> job = method.make_job(config, options);
   job->inputs().refuse_folder(config.out);  // the contact sheet goes there too

@@ -24,6 +24,7 @@ py::dict method_dict(const MethodEntry& e) {
   d["python_command"] = e.python_command;
   d["job"] = bool(e.make_job);
   d["options_help"] = e.options_help;
+  d["default_exemplar"] = e.default_exemplar;
   return d;
 }
 
@@ -85,7 +86,7 @@ void bind_registry(py::module_& m) {
         return out;
       },
       "The method registry (methods/registry.hpp): a dict per method (name, title, summary, paper, unit, "
-      "light_path_guides, docs, python_command, job: has a job factory, options_help), in the panel's order.");
+      "light_path_guides, docs, python_command, job: has a job factory, options_help, default_exemplar), in the panel's order.");
   m.def(
       "find_method", [](const std::string& name) { return method_dict(find_method(name)); }, py::arg("name"),
       "The registry's entry of `name`; ValueError naming every method.");

@@ -179,6 +179,43 @@ def _exemplar(kind, out, size, frames):
     assert made.returncode == 0, made.stderr
 
 
+def test_fluid_methods_default_to_the_projects_own_exemplar(cli_path, tmp_path):
+    """Step 5 of issue 41: with no --exemplar, the Python package's `tempera
+    stylize` writes the method's default exemplar (its registry entry's
+    default_exemplar) into OUT once and runs the method with it; the native
+    CLI alone names the way to one."""
+    from tempera.app import guide_cache
+
+    yy, xx = np.mgrid[0:40, 0:48].astype(np.float32)
+    for f in (1, 2):
+        alpha = np.clip(12 - np.hypot(xx - 20 - 2 * f, yy - 20) + 0.5, 0, 1).astype(np.float32)
+        flow = np.zeros((40, 48, 2), np.float32)
+        flow[..., 0] = 2.0
+        guide_cache.write_frame(tmp_path / "guides", f, {"alpha": alpha, "fluid_velocity": flow,
+                                                         "velocity_forward": flow * alpha[..., None]})
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "addon"), TEMPERA_CLI=str(cli_path))
+    for method, kind, frames in (("lazyfluids", "smoke", "frames"), ("fluidymation", "ink", ".")):
+        assert tempera._native.find_method(method)["default_exemplar"] == kind
+        out = tmp_path / method
+        args = ["stylize", "--method", method, "--guides", str(tmp_path / "guides"), "--frames", "1-2",
+                "--out", str(out), "--levels", "2", "--threads", "2"]
+        native = subprocess.run([str(cli_path), *args], capture_output=True, text=True, timeout=300)
+        assert native.returncode == 2 and f"tempera exemplar {kind} --out DIR" in native.stderr, native.stderr
+        run = subprocess.run([sys.executable, "-m", "tempera", *args], capture_output=True, text=True, timeout=300,
+                             env=env)
+        assert run.returncode == 0, run.stderr[-2000:]
+        assert f"the project's own {kind} exemplar" in run.stderr
+        exemplar = out / f"exemplar_generated_{kind}"
+        assert len(list(exemplar.glob("frame_*.png"))) == 24
+        assert tempera.read_image(str(exemplar / "frame_0001.png")).shape == (256, 256, 4)
+        assert tempera.read_image(str(out / frames / "frame_0002.png")).shape == (40, 48, 4)
+        written = (exemplar / "frame_0001.png").stat().st_mtime_ns
+        again = subprocess.run([sys.executable, "-m", "tempera", *args], capture_output=True, text=True,
+                               timeout=300, env=env)
+        assert again.returncode == 0 and again.stdout.count("skipped, already current") == 2, again.stdout
+        assert (exemplar / "frame_0001.png").stat().st_mtime_ns == written  # made once
+
+
 @pytest.mark.skipif(shutil.which(BLENDER) is None, reason="Blender not installed")
 def test_fluid_methods_render_a_scenes_guides_first(cli_path, tmp_path):
     """Step 5 of issue 41: `stylize SCENE.blend` for the methods that read a guide cache

@@ -13,6 +13,12 @@ naming it.
 from __future__ import annotations
 
 import argparse
+import os
+import shutil
+import sys
+from pathlib import Path
+
+import numpy as np
 
 from . import media_exemplars
 from .command import run_command
@@ -59,6 +65,50 @@ def run(args):
     media_exemplars.write_frames(args.out, frames, masks)
     print(f"tempera exemplar: {len(frames)} {args.kind} frames of {width}x{height} in {args.out}")
     return 0
+
+
+def generated_folder(out, kind):
+    """The project's own `kind` exemplar (smoke, fire, ink) as a folder of
+    RGBA frames in OUT, OUT/exemplar_generated_KIND/frame_0001.png ..., at
+    this command's defaults (256x256, 24 frames, seed 1); ink's pigment masks
+    are its alpha. Written once, under a temporary name renamed at the end,
+    so a folder that exists is whole and a rerun reuses it (resume)."""
+    folder = Path(out) / f"exemplar_generated_{kind}"
+    if folder.is_dir():
+        return folder
+    width, height = DEFAULT_SIZE
+    if kind == "ink":
+        rgb, masks = media_exemplars.ink_video(width, height, DEFAULT_FRAMES, DEFAULT_SPEED, 1)
+        frames = [np.dstack([colour, mask]).astype(np.float32) for colour, mask in zip(rgb, masks)]
+    else:
+        frames = media_exemplars.smoke_loop(width, height, DEFAULT_FRAMES, 1, kind)
+    partial = folder.with_name(f".{folder.name}.partial{os.getpid()}")
+    shutil.rmtree(partial, ignore_errors=True)
+    media_exemplars.write_frames(partial, frames)
+    try:
+        os.rename(partial, folder)
+    except OSError:  # another run wrote it meanwhile: keep theirs
+        shutil.rmtree(partial, ignore_errors=True)
+        if not folder.is_dir():
+            raise
+    return folder
+
+
+def with_default_exemplar(args, entry):
+    """`tempera stylize` arguments with `--exemplar OUT/exemplar_generated_KIND`
+    added when the method has a default exemplar (its registry entry's
+    ``default_exemplar``) and none is given; else the arguments as they are
+    (the command then names what is missing)."""
+    kind = entry["default_exemplar"]
+    if not kind or "--exemplar" in args or "--help" in args or "-h" in args:
+        return list(args)
+    at = args.index("--out") if "--out" in args else len(args)
+    if at + 1 >= len(args):
+        return list(args)
+    folder = generated_folder(args[at + 1], kind)
+    print(f"tempera stylize: no --exemplar given: using the project's own {kind} exemplar, {folder}",
+          file=sys.stderr, flush=True)
+    return [*args, "--exemplar", str(folder)]
 
 
 def main(argv=None):

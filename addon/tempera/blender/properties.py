@@ -420,7 +420,7 @@ class TemperaSettings(PropertyGroup):
     media_exemplar: StringProperty(
         name="File", subtype="FILE_PATH", default="",
         description="The still, the sequence's folder or first file, or the movie; '//' is relative to the "
-        ".blend file")
+        ".blend file. Empty: the project's own (a smoke loop for Fluid, an ink drop for Natural Media)")
     media_masks: StringProperty(
         name="Masks", subtype="DIR_PATH", default="",
         description="Optional: a folder of the exemplar's mask frames (white = medium); empty: its alpha")

@@ -486,16 +486,23 @@ class RgbaRun(StylizeRun):
         self.mode = mode
         self.frames = list(frames)
         self.out = output_dir(settings)
-        label = next(n for k, n, _ in MEDIA_EXEMPLAR_KINDS if k == settings.media_exemplar_kind)
-        if settings.media_exemplar_kind not in self.kinds:
-            raise ValueError(f"The {self.method_label} method needs a video exemplar: set Exemplar to Image Sequence "
-                             f"or Movie (not {label}).")
-        cache = os.path.join(self.out, EXEMPLAR_FRAMES_DIR)
-        self.exemplar = exemplar_source(settings.media_exemplar_kind,
-                                        resolve_path(settings.media_exemplar, f"exemplar {label}"), cache)
+        self.method_out = self.result_dir = os.path.join(self.out, self.folder)
+        if settings.media_exemplar.strip():
+            label = next(n for k, n, _ in MEDIA_EXEMPLAR_KINDS if k == settings.media_exemplar_kind)
+            if settings.media_exemplar_kind not in self.kinds:
+                raise ValueError(f"The {self.method_label} method needs a video exemplar: set Exemplar to Image "
+                                 f"Sequence or Movie (not {label}).")
+            cache = os.path.join(self.out, EXEMPLAR_FRAMES_DIR)
+            self.exemplar = exemplar_source(settings.media_exemplar_kind,
+                                            resolve_path(settings.media_exemplar, f"exemplar {label}"), cache)
+        else:  # the project's own (its registry entry's default_exemplar), written once beside the frames
+            from ..app.exemplar_cli import generated_folder
+            from ..methods import registry
+
+            kind = registry.find(settings.method.lower())["default_exemplar"]
+            self.exemplar = str(generated_folder(self.method_out, kind))
         require_consecutive(self.frames, f"The {self.method_label} method")
         self.guides = GuideJob.from_settings(scene, self.frames)
-        self.method_out = self.result_dir = os.path.join(self.out, self.folder)
         self.config = {"out": os.path.join(self.method_out, FRAMES_DIR), "format": settings.output_format,
                        "quality": "final"}
         self.options = self.job_options(settings)

@@ -53,6 +53,12 @@ struct MethodEntry {
   // Its own options, for --help: "  --strength S   ...\n" lines. Given alone
   // (no value), an option arrives with the text "" (set_from_text: a switch).
   std::string options_help;
+  // The project's own exemplar that stands in when --exemplar is left out:
+  // the kind `tempera exemplar KIND` writes ("smoke", "ink"), which the
+  // Python package's `tempera stylize` generates into OUT once and passes
+  // on (tempera/app/exemplar_cli.py); "" when the method needs the artist's
+  // (StyLit's painting). The rigid-body method makes its own in Python.
+  std::string default_exemplar;
   // More of --help, after the summary: what the exemplar and the guides must
   // hold, where the outputs go, how resume decides; paragraphs ending in "\n".
   std::string help_details;

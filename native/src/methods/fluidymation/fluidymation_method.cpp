@@ -66,6 +66,7 @@ MethodEntry fluidymation_method() {
   m.options_help = kInputsHelp + flags_help<FluidymationOptions>(fluidymation_option_table(), true) +
                    "  (any engine option of 'tempera synth --help'; defaults: 5x5 patches, directed\n"
                    "  orientations, 3 EM iterations, exact guides)\n";
+  m.default_exemplar = "ink";
   m.help_details = kDetails;
   return m;
 }

@@ -57,6 +57,7 @@ MethodEntry lazyfluids_method() {
   m.options_help = flags_help<LazyFluidsOptions>(lazyfluids_option_table(), true) +
                    "  (any engine option of 'tempera synth --help'; LazyFluids' defaults: --patch-size 5\n"
                    "  --usage uniform)\n";
+  m.default_exemplar = "smoke";
   m.help_details = kDetails;
   return m;
 }
