@@ -5,26 +5,21 @@
 #include "tempera/engine/error.hpp"
 #include "tempera/methods/fluidymation/fluidymation_method.hpp"
 #include "tempera/methods/lazyfluids/lazyfluids_method.hpp"
+#include "tempera/methods/rigid/rigid_method.hpp"
+#include "tempera/methods/stylit/stylit_method.hpp"
+#include "tempera/methods/tcia/tcia_method.hpp"
 
 namespace tempera {
 
 namespace {
 
+// Every built-in method, one line each, in the panel's order; each entry is
+// written in its method's folder.
 std::deque<MethodEntry>& registry() {
   static std::deque<MethodEntry> registry = {
-      {"stylit", "Per-Frame StyLit",
-       "Each frame painted on its own from the light-path guides (with the temporal guide's pull towards the "
-       "previous frame); frames split anywhere over machines",
-       "Fišer et al. 2016", "frame", true, "docs/user_guide.md", ""},
-      {"tcia", "Temporally Coherent (Bénard 2013)",
-       "The whole shot at once, coarse to fine in forward and backward sweeps along the motion, so the paint stays "
-       "on the surfaces; painted Keyframes come out as painted and steer the frames around them (Stylize Frame "
-       "stays per-frame StyLit)",
-       "Bénard et al. 2013", "segment", true, "docs/coherent.md", ""},
-      {"rigid", "Rigid Bodies (hand-drawn)",
-       "The squash, stretch and line of drawn examples carried onto the scene's rigid-body simulation "
-       "(Dvorožňák 2017; needs a baked rigid-body world)",
-       "Dvorožňák et al. 2017", "frame", false, "docs/rigid_bodies.md", "tempera.methods.rigid.rigid_cli:stylize_main"},
+      stylit_method(),
+      tcia_method(),
+      rigid_method(),
       lazyfluids_method(),
       fluidymation_method(),
   };
