@@ -315,9 +315,9 @@ void print_summary(const std::vector<FrameResult>& results, const std::string& o
   std::cout << std::defaultfloat << "; results in " << out << "\n";
 }
 
-void write_extras(const StylizeJob& job, const Options& o) {
+void write_extras(const LightPathShot& shot, const Options& o) {
   const fs::path sheet = fs::path(o.out) / "contact_sheet.png";
-  if (write_beside_frames("stylize", "the contact sheet", [&] { job.write_contact_sheet(sheet.string()); }))
+  if (write_beside_frames("stylize", "the contact sheet", [&] { shot.write_contact_sheet(sheet.string()); }))
     std::cout << "contact sheet: " << sheet.string() << "\n";
   if (!o.video) return;
   if (o.format != "png" || !consecutive(o.frames)) {
@@ -325,7 +325,7 @@ void write_extras(const StylizeJob& job, const Options& o) {
     return;
   }
   const fs::path video = fs::path(o.out) / "stylized.mp4";
-  job.inputs().refuse_file(video.string());
+  shot.inputs().refuse_file(video.string());
   // ffmpeg reads '%' in the folder as a pattern of its own: doubled, it is a plain '%'.
   const std::string pattern = printf_escaped((fs::path(o.out) / "frames").string()) + "/frame_%04d.png";
   bool encoded = false;
@@ -502,14 +502,14 @@ int run_stylit_or_tcia(const Args& args) {
                    o.orientation});
       for (const auto& w : job.warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
       if (!run_segments(job, o)) return report_interrupted("stylize", "segment");
-      if (!o.segment) write_extras(job.frames_job(), o);  // a segment is a farm task: the finish writes them
+      if (!o.segment) write_extras(job.shot(), o);  // a segment is a farm task: the finish writes them
       if (o.noisy.noise > 0 && !run_noise_pass(o)) return report_interrupted("stylize", "segment");
       return 0;
     }
     StylizeJob job(config);
     for (const auto& w : job.warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
     if (!run_frames(job, results)) return interrupted_frames(results);
-    write_extras(job, o);
+    write_extras(job.shot(), o);
     print_summary(results, o.out);
     if (o.noisy.noise > 0 && !run_noise_pass(o)) return interrupted_frames(results);
   } catch (const CancelledError&) {

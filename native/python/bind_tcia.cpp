@@ -115,7 +115,7 @@ void bind_tcia(py::module_& m) {
                              })
       .def_property_readonly("selected", &TciaJob::selected)
       .def_property_readonly("warnings", &TciaJob::warnings)
-      .def("output_path", [](const TciaJob& job, int frame) { return job.frames_job().output_path(frame); })
+      .def("output_path", &TciaJob::output_path, py::arg("frame"))
       .def("record_path", &TciaJob::record_path)
       .def("layer_path", &TciaJob::layer_path, py::arg("layer"), py::arg("frame"))
       .def(
@@ -143,7 +143,7 @@ void bind_tcia(py::module_& m) {
           "write_contact_sheet",
           [](const TciaJob& job, const std::string& path, int columns) {
             py::gil_scoped_release release;
-            job.frames_job().write_contact_sheet(path, columns);
+            job.shot().write_contact_sheet(path, columns);
           },
           py::arg("path"), py::arg("columns") = 0);
   py_bridge::bind_options_class<TciaOptions>(m, "TciaOptions", tcia_option_table(),

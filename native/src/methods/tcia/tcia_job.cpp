@@ -98,15 +98,18 @@ Image ink_distance(const ImageView& style, const TciaLineOptions& o) {
 
 }  // namespace
 
-// The per-frame job checks the files and sizes of the frames to solve; its
-// temporal guide is StyLit's, not this method's, so it is off there.
-StylizeJobConfig per_frame(const TciaJobConfig& c) {
-  StylizeJobConfig out = c.frames;
-  out.stylit.temporal_weight = 0;
+// The painting, the exemplar's guides and the frames to solve (a farm task's
+// segment only), read and checked; the output folder made.
+LightPathShot checked_shot(const TciaJobConfig& c, std::vector<std::string>& warnings) {
+  LightPathShotConfig shot = c.frames;
   if (c.segment) {
-    out.frames.clear();
-    for (int f = c.segment->first; f <= c.segment->second; ++f) out.frames.push_back(f);
+    shot.frames.clear();
+    for (int f = c.segment->first; f <= c.segment->second; ++f) shot.frames.push_back(f);
   }
+  std::vector<std::string> names;
+  for (const auto& [name, weight] : active_guides(c.frames.stylit.weights)) names.push_back(name);
+  LightPathShot out(shot, names, warnings);
+  out.prepare_output();
   return out;
 }
 
@@ -125,18 +128,18 @@ KeyFile parse_key(const std::string& text) {
   return k;
 }
 
-// Options, keys and segments are checked before the per-frame job reads any file.
+// Options, keys and segments are checked before the shot's files are read.
 TciaJob::TciaJob(TciaJobConfig config)
     : config_(checked(std::move(config))),
       segments_(key_segments(config_.frames.frames, key_frames(config_))),
       selected_(select_segments(segments_, config_.segment)),
-      frames_(per_frame(config_)) {
+      shot_(checked_shot(config_, warnings_)) {
   // Motion: a segment's frames link to their neighbours inside it; its first
   // frame needs no V-, its last no V+.
   for (std::size_t i : selected_) {
     const Segment& s = segments_[i];
     for (int f = s.first; f <= s.last; ++f) {
-      const std::string path = frames_.target_guides_path(f);
+      const std::string path = shot_.target_path(f);
       const ImageFileInfo info = inspect_image(path);
       if (config_.lines.weight > 0 && !has_guide(info, "line_distance"))
         throw ValueError(concat("the line term (--lines) needs 'line_distance' in '", path, "'"));
@@ -148,9 +151,9 @@ TciaJob::TciaJob(TciaJobConfig config)
                                   "' (render the guides with motion)"));
     }
   }
-  if (config_.orientation.from_cache && !has_guide(inspect_image(frames_.exemplar_path()), "tensor"))
+  if (config_.orientation.from_cache && !has_guide(inspect_image(shot_.exemplar_path()), "tensor"))
     throw ValueError(concat("--orientation needs the structure tensor 'tensor' in the exemplar's guides '",
-                            frames_.exemplar_path(), "'"));
+                            shot_.exemplar_path(), "'"));
   refuse_writing_on_keys();
   read_keys(config_.keys, paintings_, masks_);
   for (const LayerFile& l : config_.layers)
@@ -162,7 +165,7 @@ TciaJob::TciaJob(TciaJobConfig config)
     << settings_text(config_.tcia.synthesis, synthesis_option_table())
     << settings_text(config_.lines, tcia_line_option_table())
     << settings_text(config_.orientation, tcia_orientation_option_table()) << "format=" << config_.frames.format << ";"
-    << file_stamp(config_.frames.exemplar) << ";" << file_stamp(frames_.exemplar_path());
+    << file_stamp(config_.frames.exemplar) << ";" << file_stamp(shot_.exemplar_path());
   settings_ = s.str();
   check_layers();
   std::error_code ec;
@@ -183,7 +186,7 @@ TciaJobConfig TciaJob::checked(TciaJobConfig c) {
   return c;
 }
 
-// The per-frame job refuses writing onto the guides and the painting; the
+// The shot refuses writing onto the guides and the painting; the
 // key paintings, their masks and the layers' paintings may sit in the output
 // folder too (a painted frame_0004.png): refuse before anything is written.
 void TciaJob::refuse_writing_on_keys() const {
@@ -201,7 +204,7 @@ void TciaJob::refuse_writing_on_keys() const {
   }
   for (const Segment& s : segments_)
     for (int f : s.writes) {
-      inputs.refuse_file(frames_.output_path(f));
+      inputs.refuse_file(shot_.output_path(f));
       for (std::size_t l = 0; l < config_.layers.size(); ++l) inputs.refuse_file(layer_path(l, f));
     }
 }
@@ -211,8 +214,8 @@ void TciaJob::read_keys(const std::vector<KeyFile>& keys, std::vector<Image>& pa
   for (const KeyFile& k : keys) {
     paintings.emplace_back(), masks.emplace_back();
     if (!is_read(k.frame)) continue;  // outside the one segment run
-    const ImageFileInfo info = inspect_image(frames_.target_guides_path(k.frame));
-    paintings.back() = read_key_painting(k, frames_.style().channels(), info.width, info.height);
+    const ImageFileInfo info = inspect_image(shot_.target_path(k.frame));
+    paintings.back() = read_key_painting(k, shot_.style().channels(), info.width, info.height);
     masks.back() = read_key_mask(k, info.width, info.height);
   }
 }
@@ -231,7 +234,7 @@ std::string TciaJob::record_path(std::size_t index) const {
 // other segments.
 std::string TciaJob::segment_key(const Segment& segment) const {
   std::string text = concat(settings_, "\nsegment ", segment.first, "-", segment.last);
-  for (int f = segment.first; f <= segment.last; ++f) text += "\n" + file_stamp(frames_.target_guides_path(f));
+  for (int f = segment.first; f <= segment.last; ++f) text += "\n" + file_stamp(shot_.target_path(f));
   for (const KeyFile& k : config_.keys)
     if (k.frame == segment.first || k.frame == segment.last)
       text += concat("\nkey ", k.frame, " ", file_stamp(k.painting), " ", k.mask.empty() ? "" : file_stamp(k.mask));
@@ -247,7 +250,7 @@ std::string TciaJob::composite_key(const Segment& segment) const {
 
 bool TciaJob::is_current(std::size_t index) const {
   std::vector<std::string> files;
-  for (int f : segments_[index].writes) files.push_back(frames_.output_path(f));
+  for (int f : segments_[index].writes) files.push_back(shot_.output_path(f));
   return record_current(record_path(index), kTciaRecordFormat, composite_key(segments_[index]), files);
 }
 
@@ -255,28 +258,28 @@ Shot TciaJob::load_shot(const Segment& segment, std::deque<Image>& keep) const {
   std::vector<std::string> names;
   for (const auto& [name, weight] : active_guides(config_.frames.stylit)) names.push_back(name);
   Shot shot;
-  shot.style = frames_.style().view();
+  shot.style = shot_.style().view();
   for (const auto& [name, weight] : active_guides(config_.frames.stylit)) {
     shot.guide_names.push_back(name);
-    shot.style_guides.push_back(keep.emplace_back(tonemap_guide(frames_.exemplar().get(name).view())).view());
+    shot.style_guides.push_back(keep.emplace_back(tonemap_guide(shot_.exemplar().get(name).view())).view());
     shot.guide_weights.push_back(weight);
   }
   const bool lines = config_.lines.weight > 0;
   if (lines) {
     shot.guide_names.push_back("line_distance");
-    shot.style_guides.push_back(keep.emplace_back(ink_distance(frames_.style().view(), config_.lines)).view());
+    shot.style_guides.push_back(keep.emplace_back(ink_distance(shot_.style().view(), config_.lines)).view());
     shot.guide_weights.push_back(config_.lines.weight);
   }
   const bool oriented = config_.orientation.from_cache;
   if (oriented)
-    shot.style_orientation = keep.emplace_back(tensor_angle(GuideFrame::read(frames_.exemplar_path(), {"tensor"}))).view();
+    shot.style_orientation = keep.emplace_back(tensor_angle(GuideFrame::read(shot_.exemplar_path(), {"tensor"}))).view();
   for (int f = segment.first; f <= segment.last; ++f) {
     std::vector<std::string> wanted = names;
     if (lines) wanted.push_back("line_distance");
     if (oriented) wanted.push_back("tensor");
     const int from = f == segment.first ? 2 : 0, to = f == segment.last ? 2 : 4;
     for (int m = from; m < to; ++m) wanted.push_back(kMotion[m]);
-    const GuideFrame g = GuideFrame::read(frames_.target_guides_path(f), wanted);
+    const GuideFrame g = GuideFrame::read(shot_.target_path(f), wanted);
     ShotFrame frame;
     for (const auto& name : names) frame.guides.push_back(keep.emplace_back(tonemap_guide(g.get(name).view())).view());
     if (lines) frame.guides.push_back(keep.emplace_back(Image::copy_of(g.get("line_distance").view())).view());
@@ -323,7 +326,7 @@ SegmentResult TciaJob::run_segment(std::size_t index, const SegmentProgress& pro
       config_.layers.empty() ? stylize_shot_sweeps(shot, config_.tcia, sweeps) : run_layers(index, shot, sweeps);
   std::vector<std::string> files;
   for (int f : segment.writes) {
-    files.push_back(frames_.output_path(f));
+    files.push_back(shot_.output_path(f));
     write_image(files.back(), images[std::size_t(f - segment.first)].view());  // atomic
   }
   write_record(record_path(index), kTciaRecordFormat, composite_key(segment), files);

@@ -84,7 +84,7 @@ void add_layer_keys(std::vector<LayerFile>& layers, const std::vector<std::pair<
 
 std::string TciaJob::layer_path(std::size_t layer, int frame) const {
   return (fs::path(config_.frames.out) / "layers" / config_.layers.at(layer).name /
-          fs::path(frames_.output_path(frame)).filename())
+          fs::path(shot_.output_path(frame)).filename())
       .string();
 }
 
@@ -126,9 +126,9 @@ Shot TciaJob::with_layer_keys(const Shot& shot, const Segment& segment, std::siz
 // The layer's part of the exemplar render: its mask guide in the exemplar's
 // cache, if there and covering at least a patch's area; else empty (the whole exemplar).
 Image TciaJob::exemplar_mask(const LayerFile& l) const {
-  const std::string path = frames_.exemplar_path();
+  const std::string path = shot_.exemplar_path();
   if (!has_guide(inspect_image(path), l.mask)) return {};
-  const Image& style = frames_.style();
+  const Image& style = shot_.style();
   Image m = pick_resize(coverage(GuideFrame::read(path, {l.mask}).get(l.mask)).view(), style.width(), style.height());
   const int patch = config_.tcia.synthesis.patch_size;
   const auto inside = std::count_if(m.data(), m.data() + m.pixel_count(), [](float v) { return v > 0.5f; });
@@ -148,7 +148,7 @@ void TciaJob::check_layers() {
       throw FileNotFoundError(concat("painting of layer '", l.name, "' not found: '", l.painting, "'"));
     Image p = read_image(l.painting);
     require_finite(p.view(), concat("the painting of layer '", l.name, "'"));
-    const Image& style = frames_.style();
+    const Image& style = shot_.style();
     if (p.width() != style.width() || p.height() != style.height() || p.channels() < style.channels())
       throw ValueError(concat("the painting of layer '", l.name, "' '", l.painting, "' is ", p.width(), "x",
                               p.height(), "x", p.channels(), " but the shared painting is ", style.width(), "x",
@@ -158,7 +158,7 @@ void TciaJob::check_layers() {
   if (config_.layers.empty()) return;
   for (std::size_t i : selected_)
     for (int f = segments_[i].first; f <= segments_[i].last; ++f) {
-      const std::string path = frames_.target_guides_path(f);
+      const std::string path = shot_.target_path(f);
       const ImageFileInfo info = inspect_image(path);
       for (const LayerFile& l : config_.layers)
         if (!has_guide(info, l.mask))
@@ -178,7 +178,7 @@ std::vector<Image> TciaJob::run_layers(std::size_t index, const Shot& shot, cons
   std::vector<std::vector<Image>> masks(n);  // per layer, per frame of the segment
   std::vector<Image> depths;
   for (int f = segment.first; f <= segment.last; ++f) {
-    const GuideFrame g = GuideFrame::read(frames_.target_guides_path(f), wanted);
+    const GuideFrame g = GuideFrame::read(shot_.target_path(f), wanted);
     for (std::size_t l = 0; l < n; ++l) masks[l].push_back(coverage(g.get(config_.layers[l].mask)));
     if (config_.layer_order == "depth") depths.push_back(extract_channels(g.get("depth").view(), 0, 1));
   }

@@ -13,18 +13,16 @@
 #include "tempera/app/frame_job.hpp"
 #include "tempera/app/frame_report.hpp"
 #include "tempera/app/guide_cache.hpp"
+#include "tempera/app/light_path_shot.hpp"
 #include "tempera/app/job_config.hpp"
 #include "tempera/engine/image.hpp"
 #include "tempera/methods/stylit/stylit.hpp"
 
 namespace tempera {
 
-// exemplar: the painting (PNG, EXR, ...); guides: the animation's guide
-// cache; out: the output folder (created).
-struct StylizeJobConfig : JobConfig {
-  std::string exemplar_guides;        // guide cache folder of the exemplar render
-  std::optional<int> exemplar_frame;  // default: the folder's only frame_*.exr
-  std::string prefix = "frame_";      // OUT/<prefix>0001.<format>
+// The painting, the exemplar's and the animation's guide caches, frames and
+// output folder (app/light_path_shot.hpp), and StyLit's options.
+struct StylizeJobConfig : LightPathShotConfig {
   StylitOptions stylit;
 };
 
@@ -36,40 +34,31 @@ class StylizeJob : public FrameJob {
   const std::vector<int>& frames() const override { return config_.frames; }
   // What was fixed on the way: a resampled painting, a damaged resume record set aside.
   const std::vector<std::string>& warnings() const override { return warnings_; }
-  const JobInputs& inputs() const override { return inputs_; }
-  std::string output_path(int frame) const override;
+  const JobInputs& inputs() const override { return shot_.inputs(); }
+  std::string output_path(int frame) const override { return shot_.output_path(frame); }
   std::string report_path() const;
-  // The painting at the exemplar guides' size, the exemplar's guides and their
-  // file: what the coherent job (tcia_job.hpp) takes from this one.
-  const Image& style() const { return style_; }
-  const GuideFrame& exemplar() const { return exemplar_; }
-  const std::string& exemplar_path() const { return exemplar_path_; }
-  std::string target_guides_path(int frame) const { return target_path(frame); }
+  // The painting, the exemplar's guides and the shot's frames, as read and checked.
+  const LightPathShot& shot() const { return shot_; }
 
   // Stylizes frames()[index] (or skips it when its output is current).
   // `progress` returning false cancels: CancelledError, nothing written.
   FrameResult run_frame(std::size_t index, const ProgressCallback& progress = {}) override;
 
-  // The painting followed by the stylized frames written so far, downscaled
-  // so that the sheet stays within about 2000 pixels wide. columns 0 = auto.
   bool has_contact_sheet() const override { return true; }
-  void write_contact_sheet(const std::string& path, int columns = 0) const override;
+  void write_contact_sheet(const std::string& path, int columns = 0) const override {
+    shot_.write_contact_sheet(path, columns);
+  }
 
  private:
-  std::string target_path(int frame) const;
   bool has_temporal_predecessor(std::size_t index) const;
-  void check_target_guides(const std::vector<std::string>& names);
+  void check_temporal_guides() const;
 
   StylizeJobConfig config_;
   FrameReport report_;  // the resume record, shared with other processes writing this folder
   std::vector<std::string> warnings_;
-  JobInputs inputs_;
-  Image style_;  // the painting at the exemplar guides' size
-  GuideFrame exemplar_;
-  std::string exemplar_path_;
+  LightPathShot shot_;
   std::string settings_;           // canonical text of the stylization settings
   std::vector<std::string> keys_;  // resume key per frame index
-  std::vector<bool> has_motion_;   // target frame has velocity_backward and occlusion_backward
 };
 
 }  // namespace tempera

@@ -126,8 +126,10 @@ class TciaJob {
   const std::vector<Segment>& segments() const { return segments_; }
   // The indices of the segments to run: all, or the one of config.segment.
   const std::vector<std::size_t>& selected() const { return selected_; }
-  const StylizeJob& frames_job() const { return frames_; }
-  const std::vector<std::string>& warnings() const { return frames_.warnings(); }
+  // The painting, the exemplar's guides, the shot's frames (those read) and the outputs' names.
+  const LightPathShot& shot() const { return shot_; }
+  std::string output_path(int frame) const { return shot_.output_path(frame); }
+  const std::vector<std::string>& warnings() const { return warnings_; }
   std::string record_path(std::size_t index) const;
   // Layer `layer`'s frame (OUT/layers/NAME/frame_0001.png) and its record for segment `index`.
   std::string layer_path(std::size_t layer, int frame) const;
@@ -160,7 +162,8 @@ class TciaJob {
   TciaJobConfig config_;
   std::vector<Segment> segments_;
   std::vector<std::size_t> selected_;
-  StylizeJob frames_;  // validates the per-frame inputs, names the outputs, writes the contact sheet
+  std::vector<std::string> warnings_;  // a resampled painting
+  LightPathShot shot_;  // the per-frame inputs of the frames read, the outputs' names, the contact sheet
   std::vector<Image> paintings_, masks_;  // per key (masks_ empty for a whole key)
   std::vector<Image> layer_paintings_;    // per layer (empty: the shared painting)
   std::vector<Image> layer_style_masks_;  // per layer: its part of the exemplar (empty: all of it)
