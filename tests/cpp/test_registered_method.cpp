@@ -35,7 +35,7 @@ TintOptions tint_options(const MethodOptions& given) {
   for (const auto& [flag, text] : given) {
     if (flag == "guide") o.guide = text;
     else if (flag == "strength") o.strength = parse_number<float>(text, "--strength");
-    else throw ValueError(concat("unknown option '--", flag, "' for --method tint"));
+    else throw unknown_method_option("tint", flag);
   }
   if (!(o.strength >= 0 && o.strength <= 1)) throw ValueError(concat("--strength must be in [0, 1], got ", o.strength));
   return o;

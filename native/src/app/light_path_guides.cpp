@@ -59,6 +59,12 @@ GuideWeights active_guides(const GuideWeights& weights) {
   return out;
 }
 
+std::vector<std::string> active_guide_names(const GuideWeights& weights) {
+  std::vector<std::string> names;
+  for (const auto& [name, weight] : active_guides(weights)) names.push_back(name);
+  return names;
+}
+
 Image tonemap_guide(const ImageView& linear) {
   require_nonempty(linear, "light-path guide");
   Image out(linear.width, linear.height, linear.channels);

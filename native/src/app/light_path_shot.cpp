@@ -65,7 +65,7 @@ bool has_guide(const ImageFileInfo& info, const std::string& guide) {
 
 LightPathShot::LightPathShot(const LightPathShotConfig& config, const std::vector<std::string>& guides,
                              std::vector<std::string>& warnings)
-    : config_(config) {
+    : config_(config), guides_(guides) {
   if (config_.prefix.find('/') != std::string::npos)
     throw ValueError(concat("prefix '", config_.prefix, "' must not contain '/'"));
   require_file(config_.exemplar, "painting");

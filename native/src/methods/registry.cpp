@@ -42,6 +42,11 @@ void register_method(MethodEntry entry) {
   registry().push_back(std::move(entry));
 }
 
+ValueError unknown_method_option(const std::string& name, const std::string& flag) {
+  return ValueError(concat("unknown option '--", flag, "' for --method ", name, " (see tempera stylize --method ",
+                           name, " --help)"));
+}
+
 const MethodEntry& find_method(const std::string& name) {
   const auto& registry = method_registry();
   std::string choices;

@@ -59,6 +59,8 @@ void parse_guide_weights(const std::string& text, GuideWeights& weights);
 // The guides with weight > 0, in order. ValueError for unknown names,
 // duplicates, non-finite weights or when no guide is left.
 GuideWeights active_guides(const GuideWeights& weights);
+// The names of active_guides(weights), in order.
+std::vector<std::string> active_guide_names(const GuideWeights& weights);
 
 // Linear radiance -> guide values in [0, 1): NaN and negatives to 0, +inf to
 // 1e6, Reinhard x / (1 + x), then the sRGB encoding. The same numbers as

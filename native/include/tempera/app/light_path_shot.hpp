@@ -41,6 +41,7 @@ class LightPathShot {
   const Image& style() const { return style_; }  // the painting at the exemplar guides' size
   const GuideFrame& exemplar() const { return exemplar_; }
   const std::string& exemplar_path() const { return exemplar_path_; }
+  const std::vector<std::string>& guides() const { return guides_; }  // the light-path guides read, in order
   std::string target_path(int frame) const;  // the shot's guide cache frame
   std::string output_path(int frame) const;
   // frames[index] has velocity_backward and occlusion_backward.
@@ -53,6 +54,7 @@ class LightPathShot {
 
  private:
   LightPathShotConfig config_;
+  std::vector<std::string> guides_;
   JobInputs inputs_;
   Image style_;
   GuideFrame exemplar_;

@@ -16,6 +16,7 @@
 
 #include "tempera/app/frame_job.hpp"
 #include "tempera/app/job_config.hpp"
+#include "tempera/engine/error.hpp"
 
 namespace tempera {
 
@@ -73,6 +74,10 @@ const std::deque<MethodEntry>& method_registry();
 // the name is empty, taken or not a plain word, or when it has no job and
 // no command. Not thread-safe: register at start-up.
 void register_method(MethodEntry entry);
+
+// The ValueError of an option that the method `name` does not take,
+// pointing to its --help: what every job factory throws for one.
+ValueError unknown_method_option(const std::string& name, const std::string& flag);
 
 // The entry of `name`; ValueError "unknown --method 'X' (choose ...)" naming every one.
 const MethodEntry& find_method(const std::string& name);

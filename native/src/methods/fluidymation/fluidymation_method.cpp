@@ -42,8 +42,7 @@ FluidymationJobConfig job_config(const JobConfig& given, const MethodOptions& op
     else if (flag == "flow") config.flow = parse_enum<FlowSource>(value_of(flag, text), "--flow");
     else if (!set_from_text(config.options, fluidymation_option_table(), flag, text) &&
              !set_from_text(config.options.synthesis, synthesis_option_table(), flag, text))
-      throw ValueError(concat("unknown option '--", flag,
-                              "' for --method fluidymation (see tempera stylize --method fluidymation --help)"));
+      throw unknown_method_option("fluidymation", flag);
   }
   return config;
 }

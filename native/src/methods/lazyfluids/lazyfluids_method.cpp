@@ -34,8 +34,7 @@ LazyFluidsJobConfig job_config(const JobConfig& given, const MethodOptions& opti
   for (const auto& [flag, text] : options)
     if (!set_from_text(config.options, lazyfluids_option_table(), flag, text) &&
         !set_from_text(config.options.synthesis, synthesis_option_table(), flag, text))
-      throw ValueError(concat("unknown option '--", flag,
-                              "' for --method lazyfluids (see tempera stylize --method lazyfluids --help)"));
+      throw unknown_method_option("lazyfluids", flag);
   return config;
 }
 

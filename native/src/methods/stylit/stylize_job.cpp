@@ -40,9 +40,8 @@ LightPathShot checked_shot(const StylizeJobConfig& c, std::vector<std::string>& 
   if (o.patch_size < 3 || o.patch_size % 2 == 0)
     throw ValueError(concat("patch size must be odd and >= 3, got ", o.patch_size));
   if (o.threads < 0) throw ValueError(concat("threads must be >= 0 (0 = all cores), got ", o.threads));
-  std::vector<std::string> names;
-  for (const auto& [name, weight] : active_guides(c.stylit)) names.push_back(name);
-  return LightPathShot(c, names, warnings);
+  active_guides(c.stylit);  // the temporal weight too
+  return LightPathShot(c, active_guide_names(c.stylit.weights), warnings);
 }
 
 }  // namespace
@@ -99,8 +98,7 @@ FrameResult StylizeJob::run_frame(std::size_t index, const ProgressCallback& pro
       return result;
     }
   }
-  std::vector<std::string> names;
-  for (const auto& [name, weight] : active_guides(config_.stylit)) names.push_back(name);
+  std::vector<std::string> names = shot_.guides();
   if (shot_.has_motion(index)) names.insert(names.end(), {"velocity_backward", "occlusion_backward"});
   const GuideFrame target = GuideFrame::read(shot_.target_path(result.frame), names);
 

@@ -106,9 +106,7 @@ LightPathShot checked_shot(const TciaJobConfig& c, std::vector<std::string>& war
     shot.frames.clear();
     for (int f = c.segment->first; f <= c.segment->second; ++f) shot.frames.push_back(f);
   }
-  std::vector<std::string> names;
-  for (const auto& [name, weight] : active_guides(c.frames.stylit.weights)) names.push_back(name);
-  LightPathShot out(shot, names, warnings);
+  LightPathShot out(shot, active_guide_names(c.frames.stylit.weights), warnings);
   out.prepare_output();
   return out;
 }
@@ -255,8 +253,7 @@ bool TciaJob::is_current(std::size_t index) const {
 }
 
 Shot TciaJob::load_shot(const Segment& segment, std::deque<Image>& keep) const {
-  std::vector<std::string> names;
-  for (const auto& [name, weight] : active_guides(config_.frames.stylit)) names.push_back(name);
+  const std::vector<std::string>& names = shot_.guides();
   Shot shot;
   shot.style = shot_.style().view();
   for (const auto& [name, weight] : active_guides(config_.frames.stylit)) {
