@@ -124,7 +124,7 @@ demo-fluids-stylize: build
 	$(BUILD)/bin/tempera stylize --method fluidymation --guides $(DEMO_FLUIDS_IN)/ink/guides \
 	    --exemplar $(DEMO_FLUIDS_IN)/exemplars/ink --exemplar-masks $(DEMO_FLUIDS_IN)/exemplars/ink/masks \
 	    --target-mask mask.OB_Ink --frames 1-24 --out $(DEMO_FLUIDS_OUT)/ink/fluidymation
-	$(PYTHON) tools/composite_over.py --over $(DEMO_FLUIDS_OUT)/ink/fluidymation \
+	$(PYTHON) tools/composite_over.py --over $(DEMO_FLUIDS_OUT)/ink/fluidymation/frames \
 	    --under $(DEMO_FLUIDS_IN)/ink/paper.png --frames 1-24 --out $(DEMO_FLUIDS_OUT)/ink/composite \
 	    --video $(DEMO_FLUIDS_OUT)/ink/growing_ink.mp4
 

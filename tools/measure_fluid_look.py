@@ -63,7 +63,7 @@ def _ink(rgb, mask):
 
 
 def ink(out):
-    frames = _frames(out / "ink/fluidymation")
+    frames = _frames(out / "ink/fluidymation/frames")
     got = [_ink(f, f[..., 3] > 0.5) for f in frames[len(frames) // 2:]]
     masks = _frames(out / "exemplars/ink/masks")
     ex = [_ink(e, m[..., 0] > 0.5) for e, m in list(zip(_frames(out / "exemplars/ink"), masks))[len(masks) // 2:]]

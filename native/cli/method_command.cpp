@@ -87,7 +87,7 @@ int run_registered_method(const MethodEntry& method, const Args& args) {
   JobConfig config;
   const MethodOptions options = parse(method, args, config);  // usage errors: exit status 2
   catch_interrupts();
-  const std::unique_ptr<FrameJob> job = method.make_job(config, options);
+  const std::unique_ptr<FrameJob> job = make_method_job(method, config, options);  // frames in OUT/frames
   job->inputs().refuse_folder(config.out);  // the contact sheet goes there too
   for (const auto& w : job->warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
   FrameLine line;

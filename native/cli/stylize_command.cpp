@@ -455,7 +455,6 @@ int run_stylize(const Args& args) {
   if (!method.python_command.empty()) throw ValueError(runs_in_python(method));
   const auto command = method_commands().find(method.name);
   if (command != method_commands().end()) return command->second(args);
-  if (!method.make_job) throw std::logic_error(concat("the registry's method '", method.name, "' has no job to run"));
   Args with_guides;
   try {
     with_guides = with_scene_guides(args);  // SCENE.blend: its guides first

@@ -60,18 +60,14 @@ void bind_frame_job_class(py::module_& m) {
 }
 
 // The job of `name` from the core's config (a dict: exemplar, guides, frames,
-// out, format, resume) and the method's options as the command line takes
+// out, format, resume; the frames go to OUT/frames) and the method's options as the command line takes
 // them ((flag without "--", text) pairs; "" for a switch alone).
 std::unique_ptr<FrameJob> method_job(const std::string& name, const py::dict& config, const MethodOptions& options) {
   const MethodEntry& method = find_method(name);
-  if (!method.make_job)
-    throw ValueError(concat("--method ", name, " has no job factory: ",
-                            method.python_command.empty() ? "it has a command and a binding of its own (" + method.docs + ")"
-                                                          : "it runs in Python (" + method.python_command + ")"));
   JobConfig c;
   py_bridge::read_job_config(config, c, concat("the ", name, " job's config"));
   py::gil_scoped_release release;  // the job reads its inputs' headers
-  return method.make_job(c, options);
+  return make_method_job(method, c, options);
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include "tempera/app/guide_cache.hpp"
 #include "tempera/app/image_io.hpp"
 #include "tempera/app/job_inputs.hpp"
+#include "tempera/app/paths.hpp"
 #include "tempera/app/record.hpp"
 #include "tempera/engine/error.hpp"
 #include "tempera/engine/option_table.hpp"
@@ -53,7 +54,6 @@ class TintJob : public FrameJob {
     inputs_.add_file(config_.exemplar, "exemplar");
     inputs_.add_folder(config_.guides, "guide cache", "the guides");
     inputs_.refuse_folder(config_.out);  // the core's rule: inputs are never written
-    fs::create_directories(config_.out);
   }
   const std::vector<int>& frames() const override { return config_.frames; }
   std::string output_path(int frame) const override {
@@ -83,8 +83,8 @@ class TintJob : public FrameJob {
           out.at(x, y, c) = (1 - options_.strength) * g.at(x, y, c) + options_.strength * colour_[c] * lum;
       }
     if (progress && !progress(1.0)) throw CancelledError("cancelled");
+    create_output_folder(fs::path(record).parent_path().string());  // at the first write: a refused job leaves nothing
     write_image(r.path, out.view());  // atomic, read back
-    fs::create_directories(fs::path(record).parent_path());
     write_record(record, "tempera-tint 1", key, {r.path});
     r.status = "stylized";
     return r;
@@ -147,7 +147,7 @@ TEST(RegisteredMethod, RunsThroughTheOneCommandWithResumeAndNamedErrors) {
 
   Shot shot;
   EXPECT_EQ(cli::run_stylize(shot.args("out", {"--strength", "1"})), 0);
-  const Image made = read_image((shot.root / "out" / "frame_0002.png").string());
+  const Image made = read_image((shot.root / "out" / "frames" / "frame_0002.png").string());
   EXPECT_NEAR(made.at(3, 3, 0), 0.5f, 0.01f);  // red times the guide's brightness
   EXPECT_NEAR(made.at(3, 3, 1), 0.0f, 0.01f);
   testing::internal::CaptureStdout();

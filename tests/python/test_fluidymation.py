@@ -183,7 +183,7 @@ def test_cli_runs_and_exits_2_on_bad_input(tmp_path, cli_path):
             str(exemplar), "--out", str(tmp_path / "out")]
     ok = subprocess.run(base + ["--frames", "1-2", "--shape-blur", "6", "--levels", "2"], capture_output=True, text=True)
     assert ok.returncode == 0, ok.stderr
-    assert (tmp_path / "out" / "frame_0002.png").is_file()
+    assert (tmp_path / "out" / "frames" / "frame_0002.png").is_file()  # the one layout: OUT/frames
     assert "skipped" in subprocess.run(base + ["--frames", "1-2", "--shape-blur", "6", "--levels", "2"],
                                        capture_output=True, text=True).stdout
     for extra, message in ((["--frames", "1-2", "--flow", "sideways"], "flow"),
@@ -209,7 +209,7 @@ def test_cli_runs_through_the_registrys_one_command(tmp_path, cli_path):
                          capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
     assert "2 frame(s) stylized" in run.stdout and "flow from " in run.stdout, run.stdout
-    assert (out / "contact_sheet.png").is_file() and (out / "frame_0002.png").is_file()
+    assert (out / "contact_sheet.png").is_file() and (out / "frames" / "frame_0002.png").is_file()
     tiny = subprocess.run([str(cli_path), "stylize", "--method", "fluidymation", "--guides", str(cache),
                            "--exemplar", str(exemplar), "--frames", "1-2", "--out", str(tmp_path / "tiny"),
                            "--max-image-pixels", "100"], capture_output=True, text=True)

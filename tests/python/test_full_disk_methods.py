@@ -53,7 +53,7 @@ def fluidymation(p, cli):
     exemplar, cache = make_inputs(p, frames=3)
     base = [str(cli), "stylize", "--method", "fluidymation", "--guides", str(cache), "--exemplar", str(exemplar),
             "--frames", "1-3", "--levels", "2", "--shape-blur", "6", "--threads", "1"]
-    return lambda out, b: base + ["--out", str(out), "--seed", "2" if b else "1"], "."
+    return lambda out, b: base + ["--out", str(out), "--seed", "2" if b else "1"], "frames"
 
 
 def noisy(p, cli):

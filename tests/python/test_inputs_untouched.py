@@ -84,7 +84,7 @@ def test_fluidymation_refuses_the_exemplar_folder_as_output(cli_path, tmp_path):
                      "1-2", "--out", exemplar, "--levels", "1")
     assert result.returncode == 2, result.stderr
     assert "is the exemplar folder" in result.stderr
-    assert snapshot(exemplar) == before and not (exemplar / "tempera_fluidymation").exists()
+    assert snapshot(exemplar) == before and not (exemplar / "frames").exists()  # not even its output folder
 
 
 def test_tcia_refuses_a_key_painting_kept_where_its_frame_goes(cli_path, tmp_path):

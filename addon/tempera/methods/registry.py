@@ -52,7 +52,7 @@ def make_job(name: str, exemplar, guides, frames, out, *, format: str = "png", r
     """The job of a method with a job factory (its entry's ``job``: LazyFluids,
     Fluidymation, a registered plug-in), as ``tempera stylize --method NAME``
     runs it: a tempera.app.frame_job.MethodJob; run ``run_frame(i)`` for each
-    frame index.
+    frame index. Its frames go to OUT/frames, as for every method.
 
     ``options`` are the method's, keyed by their command-line flags without
     the dashes (``{"lambda": 0.3, "motion_blur": 4, "rotations": True}``;

@@ -7,6 +7,7 @@
 
 #include "tempera/app/contact_sheet.hpp"
 #include "tempera/app/image_io.hpp"
+#include "tempera/app/paths.hpp"
 #include "tempera/app/file_keys.hpp"
 #include "tempera/engine/error.hpp"
 
@@ -107,10 +108,7 @@ LightPathShot::LightPathShot(const LightPathShotConfig& config, const std::vecto
 }
 
 void LightPathShot::prepare_output() const {
-  std::error_code ec;
-  fs::create_directories(config_.out, ec);
-  if (!fs::is_directory(config_.out, ec))
-    throw IoError(concat("cannot create the output folder '", config_.out, "'", ec ? ": " + ec.message() : ""));
+  create_output_folder(config_.out);
   remove_stale_temporaries(config_.out);
 }
 

@@ -27,6 +27,13 @@ bool same_path(const std::string& a, const std::string& b) {
   return ca.lexically_normal() == cb.lexically_normal();
 }
 
+void create_output_folder(const std::string& folder) {
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  if (!fs::is_directory(folder, ec))
+    throw IoError(concat("cannot create the output folder '", folder, "'", ec ? ": " + ec.message() : ""));
+}
+
 void refuse_output_on_inputs(const std::string& output, const std::vector<std::string>& inputs,
                              const std::string& what) {
   for (const auto& spec : inputs) {

@@ -1,6 +1,7 @@
 #include "tempera/methods/registry.hpp"
 
 #include <algorithm>
+#include <filesystem>
 
 #include "tempera/engine/error.hpp"
 #include "tempera/methods/fluidymation/fluidymation_method.hpp"
@@ -55,6 +56,15 @@ const MethodEntry& find_method(const std::string& name) {
     choices += concat(i == 0 ? "" : i + 1 == registry.size() ? " or " : ", ", registry[i].name);
   }
   throw ValueError(concat("unknown --method '", name, "' (choose ", choices, ")"));
+}
+
+std::unique_ptr<FrameJob> make_method_job(const MethodEntry& method, JobConfig config, const MethodOptions& options) {
+  if (!method.make_job)
+    throw ValueError(concat("--method ", method.name, " has no job factory: ",
+                            method.python_command.empty() ? "it has a command and a binding of its own (" + method.docs + ")"
+                                                          : "it runs in Python (" + method.python_command + ")"));
+  config.out = (std::filesystem::path(config.out) / "frames").string();
+  return method.make_job(config, options);
 }
 
 }  // namespace tempera

@@ -20,6 +20,11 @@ bool same_path(const std::string& a, const std::string& b);
 void refuse_output_on_inputs(const std::string& output, const std::vector<std::string>& inputs,
                              const std::string& what);
 
+// Creates `folder` and its parents, at a job's first write rather than when
+// it is set up, so that a refused job leaves nothing behind. IoError naming
+// `folder` if it cannot be made.
+void create_output_folder(const std::string& folder);
+
 // An exclusive advisory lock (flock) on `path`, held until destruction: a
 // folder is locked through itself, a file is created if missing. Blocks while another process holds it. IoError naming
 // the file if it cannot be opened.

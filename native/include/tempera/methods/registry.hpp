@@ -25,7 +25,7 @@ namespace tempera {
 using MethodOptions = std::vector<std::pair<std::string, std::string>>;
 
 // The job of a method from the core's config (exemplar, guides, frames, out,
-// format, resume) and its own options: ValueError naming a bad or unknown
+// format, resume; out is the frames' folder, OUT/frames: make_method_job) and its own options: ValueError naming a bad or unknown
 // option, the errors of its inputs (files, sizes) as any job's.
 using MakeJob = std::function<std::unique_ptr<FrameJob>(const JobConfig&, const MethodOptions&)>;
 
@@ -81,5 +81,12 @@ ValueError unknown_method_option(const std::string& name, const std::string& fla
 
 // The entry of `name`; ValueError "unknown --method 'X' (choose ...)" naming every one.
 const MethodEntry& find_method(const std::string& name);
+
+// The job of `method` in the one output layout of every front end (the
+// command, Python's make_job, the panel): its frames and records in
+// OUT/frames, so that OUT holds what goes beside them (the contact sheet, a
+// video, the generated exemplar, the guides). ValueError for a method
+// without a job factory.
+std::unique_ptr<FrameJob> make_method_job(const MethodEntry& method, JobConfig config, const MethodOptions& options);
 
 }  // namespace tempera

@@ -10,6 +10,7 @@
 #include "tempera/app/file_keys.hpp"
 #include "tempera/app/guide_cache.hpp"
 #include "tempera/app/image_io.hpp"
+#include "tempera/app/paths.hpp"
 #include "tempera/app/record.hpp"
 
 namespace fs = std::filesystem;
@@ -129,7 +130,6 @@ FluidymationJob::FluidymationJob(FluidymationJobConfig c) : config_(std::move(c)
   inputs_.refuse_folder((fs::path(config_.out) / "tempera_fluidymation").string());
   for (int f : config_.frames)
     for (const std::string& path : {output_path(f), state_path(f), record_path(f)}) inputs_.refuse_file(path);
-  fs::create_directories(fs::path(config_.out) / "tempera_fluidymation");
   std::ostringstream base;
   base << settings_text(config_.options, fluidymation_option_table())
        << settings_text(config_.options.synthesis, synthesis_option_table()) << "format=" << config_.format
@@ -171,6 +171,7 @@ const Fluidymation& FluidymationJob::method() {
 
 void FluidymationJob::write_frame(std::size_t index, const FluidFrame& r) {
   const int f = config_.frames[index];
+  create_output_folder((fs::path(config_.out) / "tempera_fluidymation").string());
   const Image& mask = target_masks_[index];
   Image rgba(r.image.width(), r.image.height(), 4);
   for (std::size_t q = 0; q < rgba.pixel_count(); ++q) {

@@ -14,9 +14,9 @@ const char* kDetails =
     "velocity_forward, or from its masks (--flow). Frames must be consecutive.\n"
     "\n"
     "outputs:\n"
-    "  OUT/frame_0001.png ...       RGBA frames (alpha = the target mask), each written atomically\n"
-    "  OUT/tempera_fluidymation/    per frame the matches and a resume record\n"
-    "  OUT/contact_sheet.png        the first exemplar frame followed by the frames\n"
+    "  OUT/frames/frame_0001.png ...     RGBA frames (alpha = the target mask), each written atomically\n"
+    "  OUT/frames/tempera_fluidymation/  per frame the matches and a resume record\n"
+    "  OUT/contact_sheet.png             the first exemplar frame followed by the frames\n"
     "\n"
     "Resume: a frame is skipped when its output, matches and record are current (same settings,\n"
     "files and every frame before it); rerun the same command after an interruption.\n";

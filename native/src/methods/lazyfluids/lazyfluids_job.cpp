@@ -228,11 +228,8 @@ FrameResult LazyFluidsJob::make_frame(std::size_t index, const ProgressCallback&
 void LazyFluidsJob::write_frame(std::size_t index, const FluidFrameResult& frame) const {
   const int f = config_.frames[index];
   const Image& state = frame.image;
-  // Made at the first write, not up front: a refused job leaves nothing behind.
+  create_output_folder((fs::path(config_.out) / kStateFolder).string());
   std::error_code ec;
-  fs::create_directories(fs::path(config_.out) / kStateFolder, ec);
-  if (!fs::is_directory(fs::path(config_.out) / kStateFolder, ec))
-    throw IoError(concat("cannot create the output folder '", config_.out, "'"));
   if (config_.options.warm_start && !frame.synthesis.field.x.empty())
     write_image(field_path(f), field_positions(frame.synthesis.field).view());
   else

@@ -1,11 +1,7 @@
 #include "tempera/methods/lazyfluids/lazyfluids_method.hpp"
 
-#include <filesystem>
-
 #include "tempera/engine/error.hpp"
 #include "tempera/methods/lazyfluids/lazyfluids_job.hpp"
-
-namespace fs = std::filesystem;
 
 namespace tempera {
 namespace {
@@ -30,7 +26,6 @@ const char* kDetails =
 LazyFluidsJobConfig job_config(const JobConfig& given, const MethodOptions& options) {
   LazyFluidsJobConfig config;
   static_cast<JobConfig&>(config) = given;
-  config.out = (fs::path(given.out) / "frames").string();  // the contact sheet goes beside them
   for (const auto& [flag, text] : options)
     if (!set_from_text(config.options, lazyfluids_option_table(), flag, text) &&
         !set_from_text(config.options.synthesis, synthesis_option_table(), flag, text))
