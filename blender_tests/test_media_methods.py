@@ -100,7 +100,8 @@ def test_methods_and_their_options_in_the_panel(media_scene):
 
 
 # The panel's table options: defaults and tooltips from the native tables,
-# and a changed value reaches the method's job under its option name.
+# and a changed value reaches the method's job (the registry's make_job)
+# under its command-line flag.
 PANEL_CHANGES = {"LAZYFLUIDS": {"lf_eta": ("alpha_guide_weight", 1.25), "lf_alpha_weight": ("alpha_weight", 2.5),
                                 "lf_warm_start": ("warm_start", True)},
                  "FLUIDYMATION": {"fm_boundary_weight": ("boundary_weight", 1.5),
@@ -112,9 +113,8 @@ PANEL_CHANGES = {"LAZYFLUIDS": {"lf_eta": ("alpha_guide_weight", 1.25), "lf_alph
 
 @pytest.mark.parametrize("method", sorted(PANEL_CHANGES))
 def test_panel_options_reach_the_job(media_scene, tmp_path, monkeypatch, method):
-    import tempera.methods.fluidymation.fluidymation
-    import tempera.methods.lazyfluids.lazyfluids
     from tempera.app import settings as limits
+    from tempera.methods import registry
     from tempera.blender.stylize_operator import StylizeRun
 
     s = media_scene.tempera
@@ -129,18 +129,18 @@ def test_panel_options_reach_the_job(media_scene, tmp_path, monkeypatch, method)
         setattr(s, prop, value)
     made = {}
 
-    class Job:  # the method's job, recording what it was made with
-        def __init__(self, *args, **values):
-            made.update(values)
-            raise RuntimeError("recorded")
+    def make_job(name, *args, options=None, **config):  # records what the method's job is made with
+        made.update(name=name, **options)
+        raise RuntimeError("recorded")
 
-    monkeypatch.setattr(tempera.methods.lazyfluids.lazyfluids, "FluidJob", Job)
-    monkeypatch.setattr(tempera.methods.fluidymation.fluidymation, "MediaJob", Job)
+    monkeypatch.setattr(registry, "make_job", make_job)
     run = StylizeRun.from_settings(media_scene, "ANIMATION")
     with pytest.raises(RuntimeError, match="recorded"):
         run.make_method_job()
-    for option, value in PANEL_CHANGES[method].values():
-        assert made[option] == pytest.approx(value), option
+    assert made["name"] == method.lower()
+    for prop, (option, value) in PANEL_CHANGES[method].items():
+        flag = limits.PANEL_OPTIONS[prop][0][option]["flag"]
+        assert made[flag] == pytest.approx(value), flag
 
 
 def _iou(a, b):

@@ -95,7 +95,7 @@ def test_natural_media_on_the_liquid_takes_its_fluid_velocity(liquid, tmp_path):
     run = StylizeRun.from_settings(scene, "ANIMATION")
     while not run.finished:
         run.step()
-    assert run.job.flow_guide == "fluid_velocity"
+    assert run.job.summary == "flow from fluid_velocity"
     assert [r["status"] for r in run.results] == ["stylized"] * len(FRAMES)
     for frame, img in zip(FRAMES, _frames(liquid["tmp"] / "out" / "fluidymation" / "frames", FRAMES)):
         alpha = _guides(liquid["tmp"], frame)["alpha"]

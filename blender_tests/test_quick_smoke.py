@@ -201,7 +201,8 @@ def test_natural_media_on_the_smoke_takes_its_fluid_velocity(smoke, tmp_path):
     run = StylizeRun.from_settings(scene, "ANIMATION")
     while not run.finished:
         run.step()
-    assert run.job.flow_guide == "fluid_velocity"  # s.fm_flow = AUTO: not the zero Vector pass
+    assert run.job.summary == "flow from fluid_velocity"  # s.fm_flow = AUTO: not the zero Vector pass
+    assert run.summary().endswith("; flow from fluid_velocity")  # what the artist reads
     assert [r["status"] for r in run.results] == ["stylized"] * len(FRAMES)
     for frame, img in zip(FRAMES, _frames(smoke["tmp"] / "out" / "fluidymation" / "frames")):
         alpha = _guides(smoke["tmp"], frame)["alpha"]

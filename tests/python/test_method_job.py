@@ -75,3 +75,28 @@ def test_a_registered_job_cancels_and_names_bad_options(shot):
         registry.make_job("rigid", shot / "smoke.png", shot / "guides", [1, 2], shot / "o")
     with pytest.raises(ValueError, match="unknown --method 'ebsynth'"):
         registry.make_job("ebsynth", shot / "smoke.png", shot / "guides", [1, 2], shot / "o")
+
+
+def test_fluidymation_by_the_registry_equals_its_own_class(tmp_path):
+    """What the panel gives Fluidymation (its masks folder, the target mask, the
+    flow, the two passes, a table option) as flags gives MediaJob's frames,
+    byte for byte: the panel runs it through make_job."""
+    from test_fluidymation import ink_frames, make_inputs
+    from tempera.methods.fluidymation import fluidymation
+
+    _, cache = make_inputs(tmp_path, frames=2)
+    rgb, masks = tmp_path / "rgb", tmp_path / "masks"
+    rgb.mkdir(), masks.mkdir()
+    for i, f in enumerate(ink_frames()):
+        tempera.write_image(str(rgb / f"f{i:02d}.png"), np.ascontiguousarray(f[..., :3]))
+        tempera.write_image(str(masks / f"m{i:02d}.png"), np.ascontiguousarray(f[..., 3:]))
+    own = fluidymation.MediaJob(rgb, cache, [1, 2], tmp_path / "own", exemplar_masks=masks, target_mask="alpha",
+                                flow="masks", bidirectional=True, boundary_weight=1.5, shape_blur=6, levels=2, threads=2, seed=3)
+    job = registry.make_job("fluidymation", rgb, cache, [1, 2], tmp_path / "by_registry",
+                            options={"exemplar-masks": masks, "target-mask": "alpha", "flow": "masks",
+                                     "bidirectional": True, "boundary-weight": 1.5, "shape-blur": 6, "levels": 2, "threads": 2,
+                                     "seed": 3})
+    for i, frame in enumerate(job.frames):
+        assert job.run_frame(i)["status"] == own.run_frame(i)["status"] == "stylized"
+        assert np.array_equal(read_image(job.output_path(frame)), read_image(own.output_path(frame)))
+    assert job.output_path(2) == str(tmp_path / "by_registry" / "frames" / "frame_0002.png")

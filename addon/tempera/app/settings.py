@@ -57,7 +57,7 @@ PANEL_SOFT_MAX = {"temporal_weight": 1.0, "motion_blur": 16.0}
 RIGID_OPTIONS = {row["name"]: row for row in _native.RigidOptions.table()}
 # Table options the panel shows as they are (default, limits and tooltip from
 # the table row): Scene.tempera property -> (table, option name, label, soft
-# maximum), in panel order. The job gets each under its option name.
+# maximum), in panel order. The job gets each under its command-line flag.
 PANEL_OPTIONS = {
     "lf_eta": (LAZYFLUIDS_OPTIONS, "alpha_guide_weight", "Boundary Shape (η)", 10.0),
     "lf_alpha_weight": (LAZYFLUIDS_OPTIONS, "alpha_weight", "Alpha Weight", 10.0),
@@ -70,8 +70,9 @@ PANEL_OPTIONS = {
 }
 
 
-def panel_options(settings, prefix):
+def panel_flags(settings, prefix):
     """The PANEL_OPTIONS values of `settings` whose property starts with
-    `prefix` ("lf_", "fm_"), by option name (the jobs' keywords)."""
-    return {option: getattr(settings, prop) for prop, (_table, option, _label, _soft) in PANEL_OPTIONS.items()
-            if prop.startswith(prefix)}
+    `prefix` ("lf_", "fm_"), by command-line flag without the dashes, as
+    tempera.methods.registry.make_job takes a method's options."""
+    return {table[option]["flag"]: getattr(settings, prop)
+            for prop, (table, option, _label, _soft) in PANEL_OPTIONS.items() if prop.startswith(prefix)}

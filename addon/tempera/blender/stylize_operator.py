@@ -471,10 +471,11 @@ RENDER_DIR = "render"  # the render under an RGBA result (tempera.app.beauty), i
 
 
 class RgbaRun(StylizeRun):
-    """Guides of every frame, then an RGBA method's job a frame per step:
-    the frames go over the render (tempera.app.beauty) in a composite scene."""
+    """Guides of every frame, then an RGBA method's job (its registry entry's
+    job factory, tempera.methods.registry.make_job) a frame per step: the
+    frames go over the render (tempera.app.beauty) in a composite scene."""
 
-    folder = None  # the method's folder in the Output Folder
+    folder = None  # the method's registry name, and its folder in the Output Folder
     method_label = None  # the method's name in messages
     seconds_per_mpix = None  # a frame's rough cost, for the confirmation of long runs
     kinds = ("STILL", "SEQUENCE", "MOVIE")  # the exemplars the method takes
@@ -499,13 +500,13 @@ class RgbaRun(StylizeRun):
             from ..app.exemplar_cli import generated_folder
             from ..methods import registry
 
-            kind = registry.find(settings.method.lower())["default_exemplar"]
+            kind = registry.find(self.folder)["default_exemplar"]
             self.exemplar = str(generated_folder(self.method_out, kind))
         require_consecutive(self.frames, f"The {self.method_label} method")
         self.guides = GuideJob.from_settings(scene, self.frames)
         self.config = {"out": os.path.join(self.method_out, FRAMES_DIR), "format": settings.output_format,
-                       "quality": "final"}
-        self.options = self.job_options(settings)
+                       "quality": "final"}  # the one layout: make_job writes the frames to OUT/frames
+        self.options = self.job_options(settings)  # by command-line flag, as make_job takes them
         self.noise = None
         self.job = None  # the method's job, made once the guides exist
         self.index = 0
@@ -532,6 +533,16 @@ class RgbaRun(StylizeRun):
             print(f"Tempera: {self.method_label} frame {self.frames[i]} {result['status']} "
                   f"in {result['seconds']:.1f} s", flush=True)
 
+    def summary(self):
+        said = self.job.summary if self.job is not None else ""  # the method's own ("flow from fluid_velocity")
+        return super().summary() + (f"; {said}" if said else "")
+
+    def make_method_job(self):
+        from ..methods import registry
+
+        return registry.make_job(self.folder, self.exemplar, self.guides.folder, self.frames, self.method_out,
+                                 format=self.config["format"], options=self.options)
+
     def estimate_seconds(self, scene):
         return (estimate_guide_seconds(scene, self.guides.params, len(self.frames))
                 + megapixels(scene) * self.seconds_per_mpix * len(self.frames))
@@ -544,27 +555,20 @@ class RgbaRun(StylizeRun):
 
 
 class FluidRun(RgbaRun):
-    """Guides, then LazyFluids (tempera.methods.lazyfluids.lazyfluids.FluidJob): smoke, fire and liquids."""
+    """Guides, then LazyFluids: smoke, fire and liquids."""
 
     folder = "lazyfluids"
     method_label = "Fluid"
     seconds_per_mpix = 20.0  # wall, loaded 2-core machine (docs/benchmarks.md: 4.6-8.6 s per 0.26 Mpix)
 
     def job_options(self, settings):
-        return {"temporal_weight": float(settings.lf_lambda), "rotations": bool(settings.lf_rotations),
-                "motion_blur": float(settings.lf_motion_blur), "seed": int(settings.seed),
-                **limits.panel_options(settings, "lf_")}
-
-    def make_method_job(self):
-        from ..methods.lazyfluids.lazyfluids import FluidJob
-
-        return FluidJob(self.exemplar, self.guides.folder, self.frames, self.config["out"],
-                        format=self.config["format"], **self.options)
+        return {"lambda": float(settings.lf_lambda), "rotations": bool(settings.lf_rotations),
+                "motion-blur": float(settings.lf_motion_blur), "seed": int(settings.seed),
+                **limits.panel_flags(settings, "lf_")}
 
 
 class MediaRun(RgbaRun):
-    """Guides (with the target's mask), then Fluidymation
-    (tempera.methods.fluidymation.fluidymation.MediaJob): a moving object or collection as a medium."""
+    """Guides (with the target's mask), then Fluidymation: a moving object or collection as a medium."""
 
     folder = "fluidymation"
     method_label = "Natural Media"
@@ -586,17 +590,13 @@ class MediaRun(RgbaRun):
             kind = "OB" if settings.fm_target_object is not None else "CO"
             self.target_mask = guide_cache.mask_guide(kind, target.name)
             self.guides.params["masks"] = guide_cache.masks_including(self.guides.params["masks"], kind)
+        self.options["target-mask"] = self.target_mask
+        if self.exemplar_masks is not None:
+            self.options["exemplar-masks"] = self.exemplar_masks
 
     def job_options(self, settings):
         return {"flow": settings.fm_flow.lower(), "bidirectional": bool(settings.fm_bidirectional),
-                "seed": int(settings.seed), **limits.panel_options(settings, "fm_")}
-
-    def make_method_job(self):
-        from ..methods.fluidymation.fluidymation import MediaJob
-
-        return MediaJob(self.exemplar, self.guides.folder, self.frames, self.config["out"],
-                        exemplar_masks=self.exemplar_masks, target_mask=self.target_mask,
-                        format=self.config["format"], **self.options)
+                "seed": int(settings.seed), **limits.panel_flags(settings, "fm_")}
 
 
 RGBA_RUNS = {"LAZYFLUIDS": FluidRun, "FLUIDYMATION": MediaRun}
