@@ -497,8 +497,17 @@ int run_stylit_or_tcia(const Args& args) {
     config.stylit = o.stylit;
     config.resume = o.resume;
     if (o.method == "tcia") {
-      TciaJob job({config, o.keys, o.tcia, o.lines, o.layers, o.layer_order.value_or("depth"), o.segment,
-                   o.orientation});
+      TciaJobConfig coherent;
+      static_cast<LightPathShotConfig&>(coherent) = config;
+      coherent.weights = o.stylit.weights;
+      coherent.keys = o.keys;
+      coherent.tcia = o.tcia;
+      coherent.lines = o.lines;
+      coherent.layers = o.layers;
+      coherent.layer_order = o.layer_order.value_or("depth");
+      coherent.segment = o.segment;
+      coherent.orientation = o.orientation;
+      TciaJob job(coherent);
       for (const auto& w : job.warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
       if (!run_segments(job, o)) return report_interrupted("stylize", "segment");
       if (!o.segment) write_extras(job.shot(), o);  // a segment is a farm task: the finish writes them

@@ -26,15 +26,14 @@ ImageView keep_view(const py::handle& array, const std::string& what, std::vecto
 // The job's configuration from tempera.methods.tcia.tcia.ShotJob's keywords (checked there).
 TciaJobConfig job_config(const py::dict& d, const TciaOptions& options) {
   TciaJobConfig c;
-  StylizeJobConfig& f = c.frames;
-  py_bridge::read_job_config(d, f, "ShotJob config");
-  f.exemplar_guides = d["exemplar_guides"].cast<std::string>();
-  if (!d["exemplar_frame"].is_none()) f.exemplar_frame = d["exemplar_frame"].cast<int>();
+  py_bridge::read_job_config(d, c, "ShotJob config");
+  c.exemplar_guides = d["exemplar_guides"].cast<std::string>();
+  if (!d["exemplar_frame"].is_none()) c.exemplar_frame = d["exemplar_frame"].cast<int>();
   std::string weights;
   for (const auto& [name, weight] : d["weights"].cast<py::dict>())
     weights += concat(weights.empty() ? "" : ",", std::string(py::str(name)), "=", py::str(weight).cast<std::string>());
-  parse_guide_weights(weights, f.stylit.weights);
-  active_guides(f.stylit);
+  parse_guide_weights(weights, c.weights);
+  active_guides(c.weights);
   for (const auto& key : d["keys"].cast<py::list>()) {
     const auto t = key.cast<py::tuple>();
     c.keys.push_back({t[0].cast<int>(), t[1].cast<std::string>(), t[2].is_none() ? "" : t[2].cast<std::string>()});

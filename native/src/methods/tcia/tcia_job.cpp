@@ -101,12 +101,12 @@ Image ink_distance(const ImageView& style, const TciaLineOptions& o) {
 // The painting, the exemplar's guides and the frames to solve (a farm task's
 // segment only), read and checked; the output folder made.
 LightPathShot checked_shot(const TciaJobConfig& c, std::vector<std::string>& warnings) {
-  LightPathShotConfig shot = c.frames;
+  LightPathShotConfig shot = c;
   if (c.segment) {
     shot.frames.clear();
     for (int f = c.segment->first; f <= c.segment->second; ++f) shot.frames.push_back(f);
   }
-  LightPathShot out(shot, active_guide_names(c.frames.stylit.weights), warnings);
+  LightPathShot out(shot, active_guide_names(c.weights), warnings);
   out.prepare_output();
   return out;
 }
@@ -129,7 +129,7 @@ KeyFile parse_key(const std::string& text) {
 // Options, keys and segments are checked before the shot's files are read.
 TciaJob::TciaJob(TciaJobConfig config)
     : config_(checked(std::move(config))),
-      segments_(key_segments(config_.frames.frames, key_frames(config_))),
+      segments_(key_segments(config_.frames, key_frames(config_))),
       selected_(select_segments(segments_, config_.segment)),
       shot_(checked_shot(config_, warnings_)) {
   // Motion: a segment's frames link to their neighbours inside it; its first
@@ -158,20 +158,20 @@ TciaJob::TciaJob(TciaJobConfig config)
     read_keys(l.keys, layer_key_paintings_.emplace_back(), layer_key_masks_.emplace_back());
   std::ostringstream s;
   s << kTciaRecordFormat << ";weights=";
-  for (const auto& [name, weight] : active_guides(config_.frames.stylit)) s << name << ":" << weight << ",";
+  for (const auto& [name, weight] : active_guides(config_.weights)) s << name << ":" << weight << ",";
   s << ";" << settings_text(config_.tcia, tcia_option_table())
     << settings_text(config_.tcia.synthesis, synthesis_option_table())
     << settings_text(config_.lines, tcia_line_option_table())
-    << settings_text(config_.orientation, tcia_orientation_option_table()) << "format=" << config_.frames.format << ";"
-    << file_stamp(config_.frames.exemplar) << ";" << file_stamp(shot_.exemplar_path());
+    << settings_text(config_.orientation, tcia_orientation_option_table()) << "format=" << config_.format << ";"
+    << file_stamp(config_.exemplar) << ";" << file_stamp(shot_.exemplar_path());
   settings_ = s.str();
   check_layers();
   std::error_code ec;
-  fs::create_directories(fs::path(config_.frames.out) / "tempera_tcia", ec);
+  fs::create_directories(fs::path(config_.out) / "tempera_tcia", ec);
 }
 
 TciaJobConfig TciaJob::checked(TciaJobConfig c) {
-  check_job_config(c.frames, FrameOrder::Consecutive,
+  check_job_config(c, FrameOrder::Consecutive,
                    "the coherent method needs consecutive frames (the motion links frame f to f - 1 and f + 1)");
   validate_fields(c.tcia, tcia_option_table());
   validate_fields(c.lines, tcia_line_option_table());
@@ -179,8 +179,8 @@ TciaJobConfig TciaJob::checked(TciaJobConfig c) {
   validate(c.tcia.synthesis);
   if (c.layer_order != "depth" && c.layer_order != "given")
     throw ValueError(concat("the layer order must be 'depth' or 'given', got '", c.layer_order, "'"));
-  c.keys = sorted_keys(std::move(c.keys), c.frames.frames);
-  for (LayerFile& l : c.layers) l.keys = sorted_keys(std::move(l.keys), c.frames.frames);
+  c.keys = sorted_keys(std::move(c.keys), c.frames);
+  for (LayerFile& l : c.layers) l.keys = sorted_keys(std::move(l.keys), c.frames);
   return c;
 }
 
@@ -224,7 +224,7 @@ bool TciaJob::is_read(int frame) const {
 
 std::string TciaJob::record_path(std::size_t index) const {
   const Segment& s = segments_.at(index);
-  return (fs::path(config_.frames.out) / "tempera_tcia" / concat("segment_", s.first, "-", s.last, ".txt")).string();
+  return (fs::path(config_.out) / "tempera_tcia" / concat("segment_", s.first, "-", s.last, ".txt")).string();
 }
 
 // Everything the segment's frames depend on: the settings, the painting and
@@ -256,7 +256,7 @@ Shot TciaJob::load_shot(const Segment& segment, std::deque<Image>& keep) const {
   const std::vector<std::string>& names = shot_.guides();
   Shot shot;
   shot.style = shot_.style().view();
-  for (const auto& [name, weight] : active_guides(config_.frames.stylit)) {
+  for (const auto& [name, weight] : active_guides(config_.weights)) {
     shot.guide_names.push_back(name);
     shot.style_guides.push_back(keep.emplace_back(tonemap_guide(shot_.exemplar().get(name).view())).view());
     shot.guide_weights.push_back(weight);
@@ -305,7 +305,7 @@ SegmentResult TciaJob::run_segment(std::size_t index, const SegmentProgress& pro
     throw ValueError(concat("segment ", index, " is not one this job runs"));
   const Segment& segment = segments_[index];
   SegmentResult result;
-  if (config_.frames.resume && is_current(index)) {
+  if (config_.resume && is_current(index)) {
     result.status = "skipped";
     return result;
   }

@@ -83,14 +83,14 @@ void add_layer_keys(std::vector<LayerFile>& layers, const std::vector<std::pair<
 }
 
 std::string TciaJob::layer_path(std::size_t layer, int frame) const {
-  return (fs::path(config_.frames.out) / "layers" / config_.layers.at(layer).name /
+  return (fs::path(config_.out) / "layers" / config_.layers.at(layer).name /
           fs::path(shot_.output_path(frame)).filename())
       .string();
 }
 
 std::string TciaJob::layer_record_path(std::size_t index, std::size_t layer) const {
   const Segment& s = segments_.at(index);
-  return (fs::path(config_.frames.out) / "tempera_tcia" /
+  return (fs::path(config_.out) / "tempera_tcia" /
           concat("segment_", s.first, "-", s.last, ".layer_", config_.layers.at(layer).name, ".txt"))
       .string();
 }
@@ -185,7 +185,7 @@ std::vector<Image> TciaJob::run_layers(std::size_t index, const Shot& shot, cons
   for (std::size_t l = 0; l < n; ++l) {
     std::vector<std::string> files;
     for (int f : segment.writes) files.push_back(layer_path(l, f));
-    if (config_.frames.resume &&
+    if (config_.resume &&
         record_current(layer_record_path(index, l), kTciaRecordFormat, layer_key(segment, l), files))
       continue;
     ShotLayer layer{config_.layers[l].name, {}, layer_paintings_[l].view(), layer_style_masks_[l].view()};

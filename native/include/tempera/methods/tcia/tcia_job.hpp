@@ -14,7 +14,8 @@
 #include <vector>
 
 #include "tempera/app/segments.hpp"
-#include "tempera/methods/stylit/stylize_job.hpp"
+#include "tempera/app/light_path_guides.hpp"
+#include "tempera/app/light_path_shot.hpp"
 #include "tempera/methods/tcia/tcia.hpp"
 
 namespace tempera {
@@ -89,8 +90,11 @@ inline const auto& tcia_orientation_option_table() {
   return table;
 }
 
-struct TciaJobConfig {
-  StylizeJobConfig frames;  // painting, guide caches, frames (consecutive), output, guide weights
+// The painting, the guide caches, the frames (consecutive) and the output
+// folder as StyLit's (LightPathShotConfig), the light-path guides' weights,
+// and the coherent method's own.
+struct TciaJobConfig : LightPathShotConfig {
+  GuideWeights weights = default_guide_weights();
   std::vector<KeyFile> keys;
   TciaOptions tcia = default_tcia_options();
   TciaLineOptions lines;
