@@ -3,6 +3,7 @@
 // error into a Python exception.
 #include <pybind11/stl.h>
 
+#include "bind_method.hpp"
 #include "numpy_bridge.hpp"
 #include "tempera/app/image_io.hpp"
 #include "tempera/app/job_inputs.hpp"
@@ -121,13 +122,12 @@ void bind_io(py::module_& m) {
 void bind_registry(py::module_& m);   // bind_registry.cpp
 void bind_synthesis(py::module_& m);  // bind_synthesis.cpp
 void bind_guides(py::module_& m);     // bind_guides.cpp
-void bind_stylize(py::module_& m);    // bind_stylize.cpp
 void bind_tracer(py::module_& m);     // bind_tracer.cpp
-void bind_noisy(py::module_& m);      // bind_noisy.cpp
-void bind_tcia(py::module_& m);       // bind_tcia.cpp
-void bind_rigid(py::module_& m);      // bind_rigid.cpp
-void bind_lazyfluids(py::module_& m); // bind_lazyfluids.cpp
-void bind_fluidymation(py::module_& m);  // bind_fluidymation.cpp
+
+std::map<std::string, py_bridge::BindMethod>& py_bridge::method_bindings() {
+  static std::map<std::string, BindMethod> bindings;  // made at first use: static init order is unknown
+  return bindings;
+}
 
 PYBIND11_MODULE(_native, m) {
   m.doc() = "Tempera native engine";
@@ -137,11 +137,6 @@ PYBIND11_MODULE(_native, m) {
   bind_registry(m);  // FrameJob, the base of the jobs bound after it
   bind_synthesis(m);
   bind_guides(m);
-  bind_stylize(m);
   bind_tracer(m);
-  bind_noisy(m);
-  bind_tcia(m);
-  bind_rigid(m);
-  bind_lazyfluids(m);
-  bind_fluidymation(m);
+  for (const auto& [name, bind] : py_bridge::method_bindings()) bind(m);  // each method's folder (bind_method.hpp)
 }

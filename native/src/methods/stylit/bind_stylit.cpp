@@ -8,6 +8,7 @@
 #include <cmath>
 #include <set>
 
+#include "bind_method.hpp"
 #include "bind_frame_job.hpp"
 #include "bind_job_config.hpp"
 #include "bind_options.hpp"
@@ -151,9 +152,7 @@ void bind_job(py::module_& m) {
       .def_property_readonly("report_path", &StylizeJob::report_path);
 }
 
-}  // namespace
-
-void bind_stylize(py::module_& m) {
+void bind_stylit(py::module_& m) {
   bind_job(m);
   m.def("stylize_frame", &stylize_frame_py, py::arg("style"), py::arg("exemplar"), py::arg("target"),
         py::arg("options"), py::arg("temporal") = py::none(), py::arg("progress") = py::none(),
@@ -216,3 +215,8 @@ void bind_stylize(py::module_& m) {
       py::arg("pattern"), py::arg("first_frame"), py::arg("fps"), py::arg("out"),
       "H.264 MP4 of numbered frames with ffmpeg, atomically; False (no file) without ffmpeg.");
 }
+
+// module.cpp runs it after the core's bindings (py_bridge::method_bindings).
+const py_bridge::MethodBinding kBinding("stylit", bind_stylit);
+
+}  // namespace

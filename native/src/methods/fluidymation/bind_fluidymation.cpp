@@ -3,6 +3,7 @@
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
+#include "bind_method.hpp"
 #include "bind_job_config.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
@@ -43,8 +44,6 @@ FluidymationJobConfig job_config(const py::dict& d, const FluidymationOptions& o
   c.options = options;
   return c;
 }
-
-}  // namespace
 
 void bind_fluidymation(py::module_& m) {
   py_bridge::bind_options_class<FluidymationOptions>(m, "FluidymationOptions", fluidymation_option_table(),
@@ -118,3 +117,8 @@ void bind_fluidymation(py::module_& m) {
            py::arg("config"), py::arg("options"))
       .def_property_readonly("flow_guide", &FluidymationJob::flow_guide);
 }
+
+// module.cpp runs it after the core's bindings (py_bridge::method_bindings).
+const py_bridge::MethodBinding kBinding("fluidymation", bind_fluidymation);
+
+}  // namespace

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <optional>
 
+#include "bind_method.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
 #include "tempera/engine/error.hpp"
@@ -95,8 +96,6 @@ const TrackFrame& frame_of(const Track& t, int f) {
   if (f < 0 || f >= int(t.frames.size())) throw ValueError(concat("frame ", f, " is outside the track's ", t.frames.size()));
   return t.frames[std::size_t(f)];
 }
-
-}  // namespace
 
 void bind_rigid(py::module_& m) {
   py_bridge::bind_options_class<RigidOptions>(m, "RigidOptions", rigid_option_table(),
@@ -261,3 +260,8 @@ void bind_rigid(py::module_& m) {
       "Every target frame: [(RGBA, D_hat, contact shift)] (None for frames not in `only`); progress(frame) "
       "returning False cancels.");
 }
+
+// module.cpp runs it after the core's bindings (py_bridge::method_bindings).
+const py_bridge::MethodBinding kBinding("rigid", bind_rigid);
+
+}  // namespace

@@ -4,6 +4,7 @@
 
 #include <tuple>
 
+#include "bind_method.hpp"
 #include "bind_job_config.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
@@ -38,8 +39,6 @@ void bind_sequence(py::module_& m) {
            }),
            py::arg("config"), py::arg("options"));
 }
-
-}  // namespace
 
 void bind_noisy(py::module_& m) {
   bind_sequence(m);
@@ -84,3 +83,8 @@ void bind_noisy(py::module_& m) {
       },
       py::arg("style"), py::arg("options"), py::arg("frame"), "The exemplar's MLS pre-deformation for a frame.");
 }
+
+// module.cpp runs it after the core's bindings (py_bridge::method_bindings).
+const py_bridge::MethodBinding kBinding("noisy", bind_noisy);
+
+}  // namespace

@@ -3,6 +3,7 @@
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
+#include "bind_method.hpp"
 #include "bind_job_config.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
@@ -23,8 +24,6 @@ std::vector<ImageView> views(const py::list& arrays, const char* what, std::vect
   }
   return out;
 }
-
-}  // namespace
 
 void bind_lazyfluids(py::module_& m) {
   py_bridge::bind_options_class<LazyFluidsOptions>(m, "LazyFluidsOptions", lazyfluids_option_table(),
@@ -67,3 +66,8 @@ void bind_lazyfluids(py::module_& m) {
            }),
            py::arg("config"), py::arg("options"));
 }
+
+// module.cpp runs it after the core's bindings (py_bridge::method_bindings).
+const py_bridge::MethodBinding kBinding("lazyfluids", bind_lazyfluids);
+
+}  // namespace

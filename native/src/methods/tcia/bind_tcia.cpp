@@ -5,6 +5,7 @@
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
+#include "bind_method.hpp"
 #include "bind_job_config.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
@@ -94,8 +95,6 @@ Shot shot_from(const FloatArray& style, const py::list& guides, const py::list& 
   }
   return shot;
 }
-
-}  // namespace
 
 void bind_tcia(py::module_& m) {
   py::class_<TciaJob>(m, "TciaJob", "The coherent method over a guide cache; use tempera.methods.tcia.tcia.ShotJob.")
@@ -231,3 +230,8 @@ void bind_tcia(py::module_& m) {
       py::arg("images"), py::arg("masks"), py::arg("depth") = py::none(),
       "The layers composited back to front (tcia_layers.hpp); use tempera.methods.tcia.tcia.composite.");
 }
+
+// module.cpp runs it after the core's bindings (py_bridge::method_bindings).
+const py_bridge::MethodBinding kBinding("tcia", bind_tcia);
+
+}  // namespace
