@@ -1,6 +1,6 @@
 // `tempera stylize --method NAME` for a method the registry runs by its job
 // factory (methods/registry.hpp, make_job): one command for every such
-// method (LazyFluids, Fluidymation, a plug-in), with the core's flags,
+// method, built in or a plug-in, with the core's flags,
 // resume, progress lines, Ctrl-C and contact sheet, so that a method needs
 // no command of its own (docs/adding_a_method.md).
 #include <filesystem>

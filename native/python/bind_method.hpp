@@ -17,7 +17,7 @@ using BindMethod = void (*)(pybind11::module_&);
 // Every method's binding by name (filled before the module initializes).
 std::map<std::string, BindMethod>& method_bindings();
 
-// `const MethodBinding kBinding("lazyfluids", bind_lazyfluids);` at namespace
+// `const MethodBinding kBinding("NAME", bind_NAME);` at namespace
 // scope in the method's bind file registers it.
 struct MethodBinding {
   MethodBinding(const std::string& name, BindMethod bind) { method_bindings().emplace(name, bind); }

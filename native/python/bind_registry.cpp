@@ -1,8 +1,7 @@
 // Python binding of the method registry (methods/registry.hpp) and of the
 // job core's per-frame job (app/frame_job.hpp): the registry's entries as
-// dicts, FrameJob as the one base class of every per-frame job (StylizeJob,
-// NoisySequence, LazyFluidsJob, FluidymationJob derive from it in Python
-// too), and method_job, the job of any method with a job factory (make_job),
+// dicts, FrameJob as the one base class of every per-frame job (each
+// method's job class derives from it in Python too), and method_job, the job of any method with a job factory (make_job),
 // so that a registered method runs from Python with no binding of its own
 // (tempera.methods.registry.make_job).
 #include <pybind11/stl.h>

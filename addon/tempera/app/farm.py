@@ -2,15 +2,14 @@
 
     tempera farm [SCENE.blend] --exemplar STYLE.png (--exemplar-guides DIR | --exemplar-scene EX.blend)
                  --frames 1-48 --out DIR [--chunk-size 8] [--scheduler tcp://HOST:8786] [stylize options]
-    tempera farm [SCENE.blend] --method lazyfluids|fluidymation|rigid --exemplar EXEMPLAR
-                 --frames 1-48 --out DIR [method options]
+    tempera farm [SCENE.blend] --method NAME --exemplar EXEMPLAR --frames 1-48 --out DIR [method options]
     tempera stylize ... --scheduler ADDRESS            (the same)
 
 Every method of the registry (native/include/tempera/methods/registry.hpp) is
-planned by its unit of work and its guide needs: StyLit and tcia (guided by
-light paths) take the exemplar's guides, --temporal and write a video; the
-others take their exemplar as it is. Frames split anywhere, one task per
-segment, one task for chained frames (LazyFluids, Fluidymation).
+planned by its unit of work and its guide needs: the methods guided by light
+paths take the exemplar's guides, --temporal and write a video; the others
+take their exemplar as it is. Frames split anywhere, one task per segment,
+one task for chained frames.
 
 `plan()` cuts the shot into tasks, each one run of the batch CLI:
 

@@ -1,8 +1,8 @@
 """The job core's per-frame job (native/include/tempera/app/frame_job.hpp) as
-Python sees it, whatever the method: StyLit's StylizeJob, LazyFluids'
-FluidJob, Fluidymation's MediaJob, the noise pass's NoisySequence and the
-MethodJob of any method with a job factory (tempera.methods.registry.make_job)
-wrap a native job ``_job`` (a _native.FrameJob) and show it the same way."""
+Python sees it, whatever the method: each method's job class (tempera.methods.NAME),
+the noise pass's and the MethodJob of any method with a job factory
+(tempera.methods.registry.make_job) wrap a native job ``_job`` (a
+_native.FrameJob) and show it the same way."""
 from __future__ import annotations
 
 import os

@@ -1,1 +1,2 @@
-"""One package per paper (native/src/methods/<method>): stylit, tcia, noisy, lazyfluids, fluidymation, rigid."""
+"""One package per paper, beside its native folder (native/src/methods/<method>): each method of the
+registry (tempera.methods.registry) and the noise pass."""

@@ -49,8 +49,8 @@ def _option_text(value) -> str:
 
 def make_job(name: str, exemplar, guides, frames, out, *, format: str = "png", resume: bool = True,
              options: dict = None):
-    """The job of a method with a job factory (its entry's ``job``: LazyFluids,
-    Fluidymation, a registered plug-in), as ``tempera stylize --method NAME``
+    """The job of a method with a job factory (its entry's ``job``: built in or
+    a registered plug-in), as ``tempera stylize --method NAME``
     runs it: a tempera.app.frame_job.MethodJob; run ``run_frame(i)`` for each
     frame index. Its frames go to OUT/frames, as for every method.
 

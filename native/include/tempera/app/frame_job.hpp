@@ -1,8 +1,9 @@
 #pragma once
-// A job whose unit of work is one frame: StyLit's sequence, the noise pass,
-// LazyFluids and Fluidymation. The command line's frame loop (and, through
-// their bindings, the panel's modal operators) drive every one of them the
-// same way, a frame at a time, so that progress, cancel and resume look alike.
+// A job whose unit of work is one frame (independent or chained): every
+// method's per-frame job and the noise pass derive from it. The command
+// line's frame loop (and, through their bindings, the panel's modal
+// operators) drive every one of them the same way, a frame at a time, so that
+// progress, cancel and resume look alike.
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -37,9 +38,8 @@ class FrameJob {
   virtual std::string summary() const { return ""; }
 };
 
-// The unit "chained frame": a frame that continues the one before
-// (LazyFluids advects the previous state, Fluidymation starts from the
-// previous matches). The core makes a frame's missing predecessors first, in
+// The unit "chained frame": a frame that continues the one before (the
+// previous frame's state advected, or its matches as the start). The core makes a frame's missing predecessors first, in
 // order, so that any frame may be asked for (the panel's "this frame", a
 // script, a resumed run) and the result equals an uninterrupted run's.
 class ChainedFrameJob : public FrameJob {
