@@ -24,7 +24,7 @@ const std::map<std::string, Command>& commands() {
       {"synth", {"guided patch synthesis of one image (StyLit / image analogies)", tempera::cli::run_synth}},
       {"render-guides",
        {"render a .blend scene's guide cache with background Blender", tempera::cli::run_render_guides}},
-      {"stylize", {"stylize an animation from a painted exemplar (StyLit, resumable)", tempera::cli::run_stylize}},
+      {"stylize", {"stylize an animation by example, with any method (--method; resumable)", tempera::cli::run_stylize}},
       {"noisy", {"add temporal noise to a coherent sequence (Color Me Noisy, resumable)", tempera::cli::run_noisy}},
   };
   return table;

@@ -2,6 +2,7 @@
 // background Blender when given .blend files (or takes existing guide caches,
 // as a render farm does), runs the StylizeJob frame by frame with resume, and
 // writes a contact sheet and a video.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -70,16 +71,12 @@ const char* kStylizeHelpText =
     "  --no-resume             stylize every frame again, even if current\n"
     "\n"
     "method:\n"
-    "  --method M              stylit (default: per frame) | tcia (temporally coherent,\n"
-    "                          Benard et al. 2013: the whole shot in forward and backward\n"
-    "                          sweeps along the motion; needs consecutive frames with\n"
-    "                          velocity_forward/backward and occlusion_forward/backward)\n"
-    "                          | lazyfluids (fluid elements from an RGBA exemplar along the\n"
-    "                          flow; own options: tempera stylize --method lazyfluids --help)\n"
-    "                          | fluidymation (natural media from a video exemplar; see\n"
-    "                          'tempera stylize --method fluidymation --help')\n"
-    "                          | rigid (hand-drawn rigid bodies, Dvoroznak 2017: run by the\n"
-    "                          Python package, 'python -m tempera stylize --method rigid --help')\n"
+    "  --method M              the method (default stylit); each has its own options\n"
+    "                          (tempera stylize --method M --help):\n"
+    "@METHODS@"
+    "                          tcia solves the whole shot in forward and backward sweeps along\n"
+    "                          the motion: consecutive frames with velocity_forward/backward and\n"
+    "                          occlusion_forward/backward\n"
     "  --key F=PATH[,MASK]     tcia: a painted keyframe (repeatable); comes out as painted\n"
     "                          (where MASK > 0.5 if given) and steers its neighbours\n"
     "  --segment A-B           tcia: solve only the segment from key A to key B (a farm\n"
@@ -123,13 +120,25 @@ const char* kStylizeHelpText =
     "lock; a damaged record is set aside with a warning and its frames are redone.\n"
     "Exit status: 0 done, 1 error (files, Blender), 2 bad usage or bad values, 130 interrupted.\n";
 
-// The help, with the guide weights' defaults from the guide table.
+// One line per method of the registry: its name and title ("stylit  Per-Frame StyLit").
+std::string methods_help() {
+  std::string out;
+  for (const MethodEntry& m : method_registry()) {
+    std::string name = "                            " + m.name;
+    name.resize(std::max<std::size_t>(name.size() + 1, 42), ' ');
+    out += concat(name, m.title, m.python_command.empty() ? "" : " (run by the Python package's tempera)", "\n");
+  }
+  return out;
+}
+
+// The help, with the guide weights' defaults from the guide table and the methods from the registry.
 std::string stylize_help() {
   std::string defaults;
   for (const auto& g : light_path_guides())
     defaults += (defaults.empty() ? "" : ",") + std::string(g.name) + "=" + format_value(g.weight);
   std::string text = kStylizeHelpText;
   text.replace(text.find("@WEIGHTS@"), 9, defaults);
+  text.replace(text.find("@METHODS@"), 9, methods_help());
   text.replace(text.find("@STYLIT@"), 8, flags_help<StylitOptions>(stylit_option_table()));
   text.replace(text.find("@TCIA@"), 6, flags_help<TciaOptions>(tcia_option_table()));
   text.replace(text.find("@LINES@"), 7,

@@ -144,6 +144,11 @@ TEST(RegisteredMethod, RunsThroughTheOneCommandWithResumeAndNamedErrors) {
     register_method(tint_entry());
   EXPECT_THROW(register_method(tint_entry()), ValueError);  // a name once
   EXPECT_EQ(find_method("tint").unit, "frame");
+  testing::internal::CaptureStdout();
+  EXPECT_EQ(cli::run_stylize({"--help"}), 0);  // the --method list is the registry's
+  const std::string help = testing::internal::GetCapturedStdout();
+  EXPECT_NE(help.find("tint"), std::string::npos) << help;
+  EXPECT_NE(help.find("tint          Tint (example)"), std::string::npos) << help;
 
   Shot shot;
   EXPECT_EQ(cli::run_stylize(shot.args("out", {"--strength", "1"})), 0);
