@@ -113,16 +113,18 @@ PANEL_CHANGES = {"LAZYFLUIDS": {"lf_eta": ("alpha_guide_weight", 1.25), "lf_alph
 
 @pytest.mark.parametrize("method", sorted(PANEL_CHANGES))
 def test_panel_options_reach_the_job(media_scene, tmp_path, monkeypatch, method):
-    from tempera.app import settings as limits
+    from tempera.blender import methods
     from tempera.methods import registry
     from tempera.blender.stylize_operator import StylizeRun
 
+    side = methods.side(method)  # the method's own module holds its table options
     s = media_scene.tempera
     s.method = method
     if method == "FLUIDYMATION":
         s.media_exemplar_kind, s.media_exemplar = "SEQUENCE", str(tmp_path / "ink")
     for prop, (option, value) in PANEL_CHANGES[method].items():
-        table = limits.PANEL_OPTIONS[prop][0]
+        table = side.OPTIONS
+        assert side.TABLE_OPTIONS[prop][0] == option
         assert getattr(s, prop) == table[option]["default"]
         assert s.bl_rna.properties[prop].description.lower() == table[option]["help"].lower()
         assert value != table[option]["default"]
@@ -139,7 +141,7 @@ def test_panel_options_reach_the_job(media_scene, tmp_path, monkeypatch, method)
         run.make_method_job()
     assert made["name"] == method.lower()
     for prop, (option, value) in PANEL_CHANGES[method].items():
-        flag = limits.PANEL_OPTIONS[prop][0][option]["flag"]
+        flag = side.OPTIONS[option]["flag"]
         assert made[flag] == pytest.approx(value), flag
 
 
@@ -185,7 +187,8 @@ def _rerun(scene):
 
 
 def test_fluid_method_end_to_end_and_resume(media_scene, tmp_path):
-    from tempera.blender.stylize_operator import FluidRun, StylizeRun
+    from tempera.blender.methods.lazyfluids import FluidRun
+    from tempera.blender.stylize_operator import StylizeRun
 
     media_scene.tempera.method = "LAZYFLUIDS"
     run = StylizeRun.from_settings(media_scene, "ANIMATION")

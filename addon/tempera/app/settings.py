@@ -44,35 +44,6 @@ PANEL_NOISE_GUIDES = 0.5
 DEFAULT_QUALITY = STYLIT_OPTIONS["quality"]["default"]
 OUTPUT_FORMATS = ("png", "exr")
 
-# The fluid methods' option tables (name -> row, as ENGINE_OPTIONS):
-# LazyFluids (lazyfluids.hpp) and Fluidymation (fluidymation.hpp). The panel
-# shows λ, rotations and motion blur of the one, bidirectional of the other,
-# and the options of PANEL_OPTIONS; its sliders stop at these soft maxima
-# (the tables take more, for scripts).
-LAZYFLUIDS_OPTIONS = {row["name"]: row for row in _native.LazyFluidsOptions.table()}
-FLUIDYMATION_OPTIONS = {row["name"]: row for row in _native.FluidymationOptions.table()}
-PANEL_SOFT_MAX = {"temporal_weight": 1.0, "motion_blur": 16.0}
 # The rigid-body method's option table (rigid.hpp, name -> row); the panel
 # shows K, augmentation, damping and the stroke guide's weight.
 RIGID_OPTIONS = {row["name"]: row for row in _native.RigidOptions.table()}
-# Table options the panel shows as they are (default, limits and tooltip from
-# the table row): Scene.tempera property -> (table, option name, label, soft
-# maximum), in panel order. The job gets each under its command-line flag.
-PANEL_OPTIONS = {
-    "lf_eta": (LAZYFLUIDS_OPTIONS, "alpha_guide_weight", "Boundary Shape (η)", 10.0),
-    "lf_alpha_weight": (LAZYFLUIDS_OPTIONS, "alpha_weight", "Alpha Weight", 10.0),
-    "lf_warm_start": (LAZYFLUIDS_OPTIONS, "warm_start", "Warm Start", None),
-    "fm_boundary_weight": (FLUIDYMATION_OPTIONS, "boundary_weight", "Boundary (w_b)", 10.0),
-    "fm_direction_weight": (FLUIDYMATION_OPTIONS, "direction_weight", "Direction (w_d)", 10.0),
-    "fm_extent_weight": (FLUIDYMATION_OPTIONS, "extent_weight", "Motion Extent (w_e)", 2.0),
-    "fm_temporal_weight": (FLUIDYMATION_OPTIONS, "temporal_weight", "Temporal (w_t)", 10.0),
-    "fm_uniformity_weight": (FLUIDYMATION_OPTIONS, "uniformity_weight", "Uniformity (w_u)", 10.0),
-}
-
-
-def panel_flags(settings, prefix):
-    """The PANEL_OPTIONS values of `settings` whose property starts with
-    `prefix` ("lf_", "fm_"), by command-line flag without the dashes, as
-    tempera.methods.registry.make_job takes a method's options."""
-    return {table[option]["flag"]: getattr(settings, prop)
-            for prop, (table, option, _label, _soft) in PANEL_OPTIONS.items() if prop.startswith(prefix)}

@@ -7,7 +7,7 @@ and come back when the add-on is enabled again).
 """
 import bpy
 
-from . import job_operator, keyframes, kit_operators, layers
+from . import job_operator, keyframes, kit_operators, layers, methods
 from .guide_operator import TEMPERA_OT_render_guides
 from .panels import TEMPERA_PT_output
 from .preferences import TemperaPreferences
@@ -35,6 +35,7 @@ def register(addon_id="tempera"):
     registered under it."""
     TemperaPreferences.bl_idname = addon_id
     job_operator._set_running(None, False)  # a run cut short by disabling the add-on is over
+    methods.add_properties(TemperaSettings)  # each method's own (tempera.blender.methods), before registering
     registered = []
     try:
         for cls in CLASSES:

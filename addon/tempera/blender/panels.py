@@ -8,7 +8,7 @@ import bpy
 from bpy.types import Panel
 
 from .. import __version__
-from ..app import settings as limits
+from . import methods
 from .guide_operator import TEMPERA_OT_render_guides, cache_status
 from .keyframes import TEMPERA_OT_add_keyframe, TEMPERA_OT_import_keyframe, TEMPERA_OT_remove_keyframe
 from .layers import TEMPERA_OT_add_tcia_layer, TEMPERA_OT_remove_tcia_layer
@@ -73,8 +73,9 @@ class TEMPERA_PT_output(Panel):
         col.operator(TEMPERA_OT_render_guides.bl_idname, text="Render Guides Only", icon="RENDERLAYERS")
         draw_frames(layout.column(), settings)
 
-        if settings.method in MEDIA_METHODS:  # an exemplar of the medium, no light-path guides
-            draw_media_exemplar(layout.box(), settings)
+        side = methods.side(settings.method)
+        if side is not None and side.MEDIUM:  # an exemplar of the medium, no light-path guides
+            draw_media_exemplar(layout.box(), settings, side.EXEMPLAR_MASKS)
         else:
             draw_exemplar(layout.box(), settings)
             draw_light_paths(layout.box(), settings)
@@ -144,9 +145,10 @@ def draw_synthesis(box, settings):
     if settings.method == "RIGID":
         draw_rigid(box, settings)
         return  # the StyLit settings below do not apply
-    if settings.method in MEDIA_METHODS:
+    side = methods.side(settings.method)
+    if side is not None:  # the method's own module (tempera.blender.methods)
         col = box.column()
-        MEDIA_METHODS[settings.method](col, settings)
+        side.draw(col, settings)
         col.prop(settings, "seed")
         return
     col = box.column()
@@ -193,41 +195,14 @@ def draw_rigid(box, settings):
         wide_prop(col, settings, "rigid_stroke_weight")
 
 
-def draw_media_exemplar(box, settings):
-    """The exemplar of the fluid methods: a still, a sequence or a movie (and masks)."""
+def draw_media_exemplar(box, settings, masks):
+    """The exemplar of a medium: a still, a sequence or a movie (and, where
+    the method takes them, its masks)."""
     box.label(text="Exemplar", icon="BRUSH_DATA")
     box.prop(settings, "media_exemplar_kind")
     box.prop(settings, "media_exemplar")
-    if settings.method == "FLUIDYMATION":
+    if masks:
         box.prop(settings, "media_masks")
-
-
-def draw_lazyfluids(col, settings):
-    """LazyFluids: the temporal pull, the rotated exemplars, the motion blur."""
-    wide_prop(col, settings, "lf_lambda")
-    col.prop(settings, "lf_rotations")
-    col.prop(settings, "lf_motion_blur")
-    draw_panel_options(col, settings, "lf_")
-
-
-def draw_fluidymation(col, settings):
-    """Fluidymation: the target (its mask guide), the flow, the two passes."""
-    col.prop(settings, "fm_target_object")
-    if settings.fm_target_object is None:
-        col.prop(settings, "fm_target_collection")
-    col.prop(settings, "fm_flow")
-    col.prop(settings, "fm_bidirectional")
-    draw_panel_options(col, settings, "fm_")
-
-
-def draw_panel_options(col, settings, prefix):
-    """The method's table options the panel shows (settings.PANEL_OPTIONS)."""
-    for prop in limits.PANEL_OPTIONS:
-        if prop.startswith(prefix):
-            wide_prop(col, settings, prop)
-
-
-MEDIA_METHODS = {"LAZYFLUIDS": draw_lazyfluids, "FLUIDYMATION": draw_fluidymation}
 
 
 def draw_list(box, settings, items, index, add, remove, rows):

@@ -9,6 +9,7 @@ from ..methods import registry
 from ..methods.noisy import noisy
 from ..app import settings as limits
 from ..app.frames import MAX_FRAME
+from .methods import tooltip
 
 DEFAULT_GUIDE_DIR = "//tempera/guides/"
 
@@ -73,22 +74,6 @@ def _weight(guide):
                          description=f"Weight of {guide['help']} ({guide['expression']})")
 
 
-def _tooltip(row):
-    """A native option table row's help as a tooltip: a sentence."""
-    return row["help"][0].upper() + row["help"][1:]
-
-
-def _option_property(prop):
-    """The panel property `prop` of settings.PANEL_OPTIONS: default, limits
-    and tooltip from its row of the method's native option table."""
-    table, option, label, soft_max = limits.PANEL_OPTIONS[prop]
-    row = table[option]
-    common = dict(name=label, default=row["default"], description=_tooltip(row))
-    if isinstance(row["default"], bool):
-        return BoolProperty(**common)
-    return FloatProperty(min=row["min"], max=row["max"], soft_max=soft_max, **common)
-
-
 def _keep_patch_size_odd(self, _context):
     size = limits.odd_patch_size(self.patch_size)
     if size != self.patch_size:
@@ -113,17 +98,9 @@ def _keep_guide_end_after_start(self, _context):
 
 METHOD_ITEMS = registry.panel_items()  # the method registry (native/include/tempera/methods/registry.hpp)
 MEDIA_EXEMPLAR_KINDS = (
-    ("STILL", "Still Image", "One RGBA image (LazyFluids only: Fluidymation needs the medium's motion)"),
+    ("STILL", "Still Image", "One RGBA image (not for Natural Media, which needs the medium's motion)"),
     ("SEQUENCE", "Image Sequence", "A folder of frames, or the first file of a numbered sequence (ink_0001.png)"),
     ("MOVIE", "Movie", "A movie file, decoded to PNG frames once by ffmpeg (into Output Folder/exemplar_frames)"),
-)
-MEDIA_FLOWS = (
-    ("AUTO", "Automatic", "Fluid Velocity when the scene has smoke or liquids, else Blender Motion"),
-    ("FLUID", "Fluid Velocity", "A smoke or liquid's velocity from its simulation (the guide cache's "
-     "fluid_velocity; the render's motion is zero on volumes)"),
-    ("GUIDES", "Blender Motion", "The target's exact motion from the render (the guide cache's velocity)"),
-    ("MASKS", "From Masks", "Motion estimated from the target's masks alone (signed distance, diffusion fill, "
-     "temporal smoothing; Fluidymation App. A)"),
 )
 RIGID_SHAPES = (
     ("circle", "Circle", "The bodies and the drawn examples are balls"),
@@ -139,7 +116,6 @@ RIGID_OUTPUTS = (
     ("PAPER", "On Paper", "Opaque frames: the drawn bodies on paper"),
 )
 DEFAULT_KEYFRAME_DIR = "//tempera/keys/"
-_LF = limits.LAZYFLUIDS_OPTIONS
 _RIGID = limits.RIGID_OPTIONS
 
 
@@ -316,10 +292,10 @@ class TemperaSettings(PropertyGroup):
     usage: EnumProperty(name="Patch Usage", items=USAGE_ITEMS, default=limits.ENGINE_OPTIONS["usage"]["default"],
                         description="How evenly the exemplar's patches are used")
     quality: EnumProperty(name="Quality", items=QUALITY_ITEMS, default=limits.DEFAULT_QUALITY,
-                          description=_tooltip(limits.STYLIT_OPTIONS["quality"]))
+                          description=tooltip(limits.STYLIT_OPTIONS["quality"]))
     temporal_weight: FloatProperty(
         name="Temporal Coherence",
-        description=_tooltip(limits.STYLIT_OPTIONS["temporal_weight"]),
+        description=tooltip(limits.STYLIT_OPTIONS["temporal_weight"]),
         default=limits.PANEL_TEMPORAL_WEIGHT,
         min=limits.STYLIT_OPTIONS["temporal_weight"]["min"],
         soft_max=2.0,
@@ -414,7 +390,9 @@ class TemperaSettings(PropertyGroup):
         soft_max=16.0,
         description="How closely the re-made strokes keep to the drawn lines (the stroke-position guide's weight)")
 
-    # The fluid methods (docs/lazyfluids.md, docs/fluidymation.md): the exemplar they share.
+    # The exemplar of a medium, for the methods whose module says MEDIUM
+    # (tempera.blender.methods); each method's own properties come from its
+    # module (methods.add_properties, at registration).
     media_exemplar_kind: EnumProperty(name="Exemplar", items=MEDIA_EXEMPLAR_KINDS, default="SEQUENCE",
                                       description="What the exemplar of the medium is")
     media_exemplar: StringProperty(
@@ -424,31 +402,3 @@ class TemperaSettings(PropertyGroup):
     media_masks: StringProperty(
         name="Masks", subtype="DIR_PATH", default="",
         description="Optional: a folder of the exemplar's mask frames (white = medium); empty: its alpha")
-    lf_lambda: FloatProperty(
-        name="Temporal Coherence", default=_LF["temporal_weight"]["default"], min=_LF["temporal_weight"]["min"],
-        soft_max=limits.PANEL_SOFT_MAX["temporal_weight"],
-        description="λ, the pull of the previous frame carried along the flow (thesis eq. 5.6): higher flickers less "
-        "but lets the texture smear; 0 paints every frame afresh")
-    lf_rotations: BoolProperty(
-        name="Rotations", default=_LF["rotations"]["default"],
-        description="Also use the exemplar turned by 90, 180 and 270 degrees (more patches, for swirling flows)")
-    lf_motion_blur: FloatProperty(
-        name="Motion Blur", default=_LF["motion_blur"]["default"], min=_LF["motion_blur"]["min"],
-        soft_max=limits.PANEL_SOFT_MAX["motion_blur"],
-        subtype="PIXEL", description="Length in pixels of the blur along the flow; 0 = none")
-    for _prop in limits.PANEL_OPTIONS:
-        __annotations__[_prop] = _option_property(_prop)
-    del _prop
-    fm_target_object: PointerProperty(
-        name="Target Object", type=bpy.types.Object,
-        description="The object the medium fills (its mask guide); empty: the collection below, else everything "
-        "rendered (the render's alpha)")
-    fm_target_collection: PointerProperty(
-        name="Target Collection", type=bpy.types.Collection,
-        description="The collection the medium fills (its mask guide), when no Target Object is set")
-    fm_flow: EnumProperty(name="Flow", items=MEDIA_FLOWS, default="AUTO",
-                          description="Where the target's motion comes from")
-    fm_bidirectional: BoolProperty(
-        name="Bidirectional", default=limits.FLUIDYMATION_OPTIONS["bidirectional"]["default"],
-        description="A forward and a backward pass merged (the paper's future work): the medium also leads "
-        "into where the target will be; twice the time")

@@ -43,7 +43,7 @@ from .guide_render import GuideRenderError
 from .job_operator import JobOperator
 from .properties import MEDIA_EXEMPLAR_KINDS, WEIGHT_PROPERTIES
 from .setting_paths import FRAMES_DIR, exemplar_paths, output_dir, resolve_path
-from . import results
+from . import methods, results
 
 # Rough stylizing cost per megapixel on a 2-core machine (docs/benchmarks.md).
 STYLIZE_SECONDS_PER_MPIX = {"final": 40.0, "preview": 8.0}
@@ -136,8 +136,9 @@ class StylizeRun:
             return CoherentRun(scene, frames, mode)
         if mode == "ANIMATION" and scene.tempera.method == "RIGID":
             return RigidRun(scene, frames, mode)
-        if scene.tempera.method in RGBA_RUNS:  # Stylize Frame too: the method on that frame alone
-            return RGBA_RUNS[scene.tempera.method](scene, frames, mode)
+        side = methods.side(scene.tempera.method)  # a method with its own module (tempera.blender.methods)
+        if side is not None:  # Stylize Frame too: the method on that frame alone
+            return side.RUN(scene, frames, mode)
         return cls(scene, frames, mode)
 
     @property
@@ -552,54 +553,6 @@ class RgbaRun(StylizeRun):
         from ..app.beauty import write_render_frames
 
         return write_render_frames(self.guides.folder, self.frames, os.path.join(self.method_out, RENDER_DIR))
-
-
-class FluidRun(RgbaRun):
-    """Guides, then LazyFluids: smoke, fire and liquids."""
-
-    folder = "lazyfluids"
-    method_label = "Fluid"
-    seconds_per_mpix = 20.0  # wall, loaded 2-core machine (docs/benchmarks.md: 4.6-8.6 s per 0.26 Mpix)
-
-    def job_options(self, settings):
-        return {"lambda": float(settings.lf_lambda), "rotations": bool(settings.lf_rotations),
-                "motion-blur": float(settings.lf_motion_blur), "seed": int(settings.seed),
-                **limits.panel_flags(settings, "lf_")}
-
-
-class MediaRun(RgbaRun):
-    """Guides (with the target's mask), then Fluidymation: a moving object or collection as a medium."""
-
-    folder = "fluidymation"
-    method_label = "Natural Media"
-    seconds_per_mpix = 25.0  # wall, 2 cores (docs/benchmarks.md: 2.5 s idle, 14 s loaded per 0.3 Mpix)
-    kinds = ("SEQUENCE", "MOVIE")
-
-    def __init__(self, scene, frames, mode="ANIMATION"):
-        from ..app import guide_cache
-
-        super().__init__(scene, frames, mode)
-        settings = scene.tempera
-        masks = settings.media_masks.strip()
-        self.exemplar_masks = resolve_path(masks, "exemplar Masks folder") if masks else None
-        if self.exemplar_masks is not None and not os.path.isdir(self.exemplar_masks):
-            raise FileNotFoundError(f"The exemplar Masks folder '{self.exemplar_masks}' does not exist.")
-        self.target_mask = "alpha"  # everything rendered
-        target = settings.fm_target_object or settings.fm_target_collection
-        if target is not None:
-            kind = "OB" if settings.fm_target_object is not None else "CO"
-            self.target_mask = guide_cache.mask_guide(kind, target.name)
-            self.guides.params["masks"] = guide_cache.masks_including(self.guides.params["masks"], kind)
-        self.options["target-mask"] = self.target_mask
-        if self.exemplar_masks is not None:
-            self.options["exemplar-masks"] = self.exemplar_masks
-
-    def job_options(self, settings):
-        return {"flow": settings.fm_flow.lower(), "bidirectional": bool(settings.fm_bidirectional),
-                "seed": int(settings.seed), **limits.panel_flags(settings, "fm_")}
-
-
-RGBA_RUNS = {"LAZYFLUIDS": FluidRun, "FLUIDYMATION": MediaRun}
 
 
 def flicker_text(flicker):

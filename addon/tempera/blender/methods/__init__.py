@@ -1,0 +1,65 @@
+"""Each method's side of the panel, one module per method, named as in the
+registry (tempera.blender.methods.NAME for --method NAME). A
+module holds what the panel, the operator and Scene.tempera need of its
+method, so that nothing outside it names the method:
+
+    PROPERTIES      Scene.tempera properties: name -> bpy property (added by add_properties)
+    draw(col, settings)   the method's options in the Synthesis box
+    RUN             its run (a tempera.blender.stylize_operator.StylizeRun)
+    MEDIUM          True: the exemplar is a medium (a still, an image sequence
+                    or a movie: the media_exemplar settings), not a painting
+    EXEMPLAR_MASKS  True: the medium may come with a folder of mask frames
+
+A method without a module here (StyLit, the coherent method, the rigid
+bodies) is drawn and run by panels.py and stylize_operator.py, until it
+moves here."""
+import importlib
+
+from bpy.props import BoolProperty, FloatProperty
+
+from ...methods import registry
+
+
+def side(method):
+    """The module of `method` (the panel's item in capitals, or the
+    registry's name), or None if it has none."""
+    name = f"{__name__}.{method.lower()}"
+    try:
+        return importlib.import_module(name)
+    except ModuleNotFoundError as error:
+        if error.name != name:  # a module that is there but fails to import
+            raise
+        return None
+
+
+def add_properties(settings_class):
+    """Every method's PROPERTIES into the property group's annotations;
+    call before the group is registered (Blender reads them then)."""
+    for name in registry.names():
+        module = side(name)
+        if module is not None:
+            settings_class.__annotations__.update(module.PROPERTIES)
+
+
+def tooltip(row):
+    """A native option table row's help as a tooltip: a sentence."""
+    return row["help"][0].upper() + row["help"][1:]
+
+
+def table_properties(table, shown):
+    """Properties of options the panel shows as they are: `shown` maps a
+    property to (option of `table`, label, soft maximum); the default,
+    limits and tooltip come from the option's row of the native table."""
+    out = {}
+    for prop, (option, label, soft_max) in shown.items():
+        row = table[option]
+        common = dict(name=label, default=row["default"], description=tooltip(row))
+        out[prop] = (BoolProperty(**common) if isinstance(row["default"], bool)
+                     else FloatProperty(min=row["min"], max=row["max"], soft_max=soft_max, **common))
+    return out
+
+
+def table_flags(settings, table, shown):
+    """The values of `shown`'s properties (table_properties) by their
+    command-line flags, as tempera.methods.registry.make_job takes them."""
+    return {table[option]["flag"]: getattr(settings, prop) for prop, (option, _label, _soft) in shown.items()}
