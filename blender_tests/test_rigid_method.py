@@ -151,11 +151,11 @@ def test_panel_options_reach_the_job(rigid_scene):
     """K, augmentation, damping and the strokes of the panel are the job's
     (names of the method's option table), and the panel shows them."""
     from test_addon import _Recorder
-    from tempera.app import settings as limits
+    from tempera.blender.methods import rigid
     from tempera.blender.stylize_operator import StylizeRun
 
     settings = rigid_scene.tempera
-    assert settings.rigid_k == limits.RIGID_OPTIONS["k"]["default"]
+    assert settings.rigid_k == rigid.OPTIONS["k"]["default"]
     settings.rigid_k, settings.rigid_augment, settings.rigid_damp = 1, False, False
     settings.rigid_strokes, settings.rigid_stroke_weight = "GENERATED", 2.5
     calls = []

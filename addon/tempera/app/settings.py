@@ -43,7 +43,3 @@ PANEL_TEMPORAL_WEIGHT = 0.5
 PANEL_NOISE_GUIDES = 0.5
 DEFAULT_QUALITY = STYLIT_OPTIONS["quality"]["default"]
 OUTPUT_FORMATS = ("png", "exr")
-
-# The rigid-body method's option table (rigid.hpp, name -> row); the panel
-# shows K, augmentation, damping and the stroke guide's weight.
-RIGID_OPTIONS = {row["name"]: row for row in _native.RigidOptions.table()}

@@ -142,14 +142,9 @@ def draw_synthesis(box, settings):
     box.prop(settings, "method")
     if settings.method == "TCIA":
         draw_keyframes(box, settings)
-    if settings.method == "RIGID":
-        draw_rigid(box, settings)
-        return  # the StyLit settings below do not apply
     side = methods.side(settings.method)
-    if side is not None:  # the method's own module (tempera.blender.methods)
-        col = box.column()
-        side.draw(col, settings)
-        col.prop(settings, "seed")
+    if side is not None:  # the method's own module (tempera.blender.methods); StyLit's settings below do not apply
+        side.draw(box, settings)
         return
     col = box.column()
     col.prop(settings, "quality")
@@ -175,24 +170,6 @@ def draw_noise(box, settings):
              "GUIDE": "noise_map_guide"}.get(settings.noise_map_source)
     if field:
         col.prop(settings, field)
-
-
-def draw_rigid(box, settings):
-    """The rigid-body method: the drawn examples, the targets, the result,
-    the method's options (from its option table) and the strokes."""
-    col = box.column()
-    col.prop(settings, "rigid_examples")
-    col.prop(settings, "rigid_collection")
-    col.prop(settings, "rigid_shape")
-    col.prop(settings, "rigid_output")
-    col.prop(settings, "rigid_k")
-    col.prop(settings, "rigid_augment")
-    col.prop(settings, "rigid_damp")
-    col.prop(settings, "rigid_strokes")
-    if settings.rigid_strokes == "IMAGE":
-        col.prop(settings, "rigid_stroke_image")
-    if settings.rigid_strokes != "NONE":
-        wide_prop(col, settings, "rigid_stroke_weight")
 
 
 def draw_media_exemplar(box, settings, masks):

@@ -102,21 +102,7 @@ MEDIA_EXEMPLAR_KINDS = (
     ("SEQUENCE", "Image Sequence", "A folder of frames, or the first file of a numbered sequence (ink_0001.png)"),
     ("MOVIE", "Movie", "A movie file, decoded to PNG frames once by ffmpeg (into Output Folder/exemplar_frames)"),
 )
-RIGID_SHAPES = (
-    ("circle", "Circle", "The bodies and the drawn examples are balls"),
-    ("box", "Box", "The bodies and the drawn examples are boxes (4-fold symmetric)"),
-)
-RIGID_STROKES = (
-    ("NONE", "As Drawn", "The examples' own lines"),
-    ("GENERATED", "Brush Pen", "Lines re-made by the engine from the bundled blue brush-pen strokes"),
-    ("IMAGE", "Stroke Image", "Lines re-made by the engine from your scan of strokes (RGBA, or dark ink on white)"),
-)
-RIGID_OUTPUTS = (
-    ("RGBA", "Over the Render", "Transparent RGBA frames of the drawn bodies, to lay over the render"),
-    ("PAPER", "On Paper", "Opaque frames: the drawn bodies on paper"),
-)
 DEFAULT_KEYFRAME_DIR = "//tempera/keys/"
-_RIGID = limits.RIGID_OPTIONS
 
 
 class TemperaKeyframe(PropertyGroup):
@@ -354,41 +340,6 @@ class TemperaSettings(PropertyGroup):
         name="Keyframe Folder",
         description="Where Add Keyframe saves the images to paint over ('//' is beside the .blend file)",
         subtype="DIR_PATH", default=DEFAULT_KEYFRAME_DIR)
-
-    # The rigid-body method (Dvorožňák et al. 2017, docs/rigid_bodies.md).
-    rigid_examples: StringProperty(
-        name="Examples",
-        description="The drawn examples: a folder with a source simulation's tracks.json and its drawn frames "
-        "drawn/NNNN.png (as `tempera rigid --exemplar` takes them), or a folder of such folders; "
-        "'//' is relative to the .blend file. Empty: the project's own drawn bouncing ball",
-        subtype="DIR_PATH", default="")
-    rigid_collection: PointerProperty(
-        name="Targets", type=bpy.types.Collection,
-        description="The rigid bodies to draw; empty: every active body of the scene's rigid-body world")
-    rigid_shape: EnumProperty(name="Shape", items=RIGID_SHAPES, default="circle",
-                              description="The proxy shape of the bodies and of the drawn examples")
-    rigid_output: EnumProperty(name="Result", items=RIGID_OUTPUTS, default="RGBA",
-                               description="What the drawn bodies are drawn on")
-    rigid_k: IntProperty(
-        name="Blended Examples", default=_RIGID["k"]["default"], min=int(_RIGID["k"]["min"]),
-        max=int(_RIGID["k"]["max"]), soft_max=8,
-        description="K: how many of the closest drawn sub-sequences are blended around each collision")
-    rigid_augment: BoolProperty(
-        name="Augment Examples", default=_RIGID["augment"]["default"],
-        description="Also match the examples rotated, scaled and flipped (more close matches from few drawings)")
-    rigid_damp: BoolProperty(
-        name="Damp by Speed", default=_RIGID["damp"]["default"],
-        description="Slower bodies than the examples' deform less (the speed ratio, clamped)")
-    rigid_strokes: EnumProperty(name="Strokes", items=RIGID_STROKES, default="NONE",
-                                description="Re-synthesize the lines with the engine on a stroke-position guide")
-    rigid_stroke_image: StringProperty(
-        name="Stroke Image", subtype="FILE_PATH", default="",
-        description="Your strokes (RGBA ink on transparent paper, or dark ink on white); '//' is relative to the "
-        ".blend file")
-    rigid_stroke_weight: FloatProperty(
-        name="Stroke Guide", default=_RIGID["stroke_weight"]["default"], min=_RIGID["stroke_weight"]["min"],
-        soft_max=16.0,
-        description="How closely the re-made strokes keep to the drawn lines (the stroke-position guide's weight)")
 
     # The exemplar of a medium, for the methods whose module says MEDIUM
     # (tempera.blender.methods); each method's own properties come from its

@@ -22,12 +22,9 @@ painted keyframes (each resumable, Esc stops within a segment and nothing of
 it is written). Stylize Frame stays per-frame StyLit: a quick look, and the
 ground Add Keyframe paints over.
 
-With Method "Rigid Bodies (hand-drawn)", Stylize Animation is RigidRun:
-the guides (which write tracks.json for a rigid-body world), then
-tempera.methods.rigid.rigid_job.RigidJob, one step per target object and chunk of frames,
-then the composites by depth, into Output Folder/rigid/frames (each step
-resumable; Esc stops within a step and nothing of it is written). Stylize
-Frame stays per-frame StyLit.
+A method with a module of its own (tempera.blender.methods.NAME) makes its
+run there (its run(scene, frames, mode)); RgbaRun below is the base of the
+runs that make RGBA frames from a medium.
 """
 import os
 import time
@@ -47,7 +44,6 @@ from . import methods, results
 
 # Rough stylizing cost per megapixel on a 2-core machine (docs/benchmarks.md).
 STYLIZE_SECONDS_PER_MPIX = {"final": 40.0, "preview": 8.0}
-RIGID_SECONDS_PER_FRAME = 0.2  # per object and frame at 640 x 360, loaded machine (docs/benchmarks.md)
 CONTACT_SHEET = "contact_sheet.png"
 VIDEO = "stylized.mp4"
 NOISY_DIR = "noisy"  # the Temporal Noise pass (Color Me Noisy) writes here
@@ -134,12 +130,9 @@ class StylizeRun:
         frames = [scene.frame_current] if mode == "FRAME" else guide_frames(scene, scene.tempera)
         if mode == "ANIMATION" and scene.tempera.method == "TCIA":
             return CoherentRun(scene, frames, mode)
-        if mode == "ANIMATION" and scene.tempera.method == "RIGID":
-            return RigidRun(scene, frames, mode)
         side = methods.side(scene.tempera.method)  # a method with its own module (tempera.blender.methods)
-        if side is not None:  # Stylize Frame too: the method on that frame alone
-            return side.RUN(scene, frames, mode)
-        return cls(scene, frames, mode)
+        run = side.run(scene, frames, mode) if side is not None else None
+        return run if run is not None else cls(scene, frames, mode)
 
     @property
     def stylize_steps(self):
@@ -330,141 +323,6 @@ class CoherentRun(StylizeRun):
         eta_text = "" if eta is None else f", ETA {format_duration(eta)}"
         return (f"Tempera: coherent segment {i + 1}/{len(self.segments)} (frames {first}-{last}){eta_text} "
                 "(Esc to stop)")
-
-
-RIGID_DIR = "rigid"  # the rigid-body method's folder in the Output Folder
-
-
-def rigid_options(settings):
-    """The panel's RigidOptions keywords (names of the method's option table)."""
-    return {"k": int(settings.rigid_k), "augment": bool(settings.rigid_augment), "damp": bool(settings.rigid_damp),
-            "stroke_weight": float(settings.rigid_stroke_weight)}
-
-
-class RigidRun(StylizeRun):
-    """Guides of every frame, then the rigid-body method (RigidJob), a step
-    per object and chunk of frames, then its composites."""
-
-    def __init__(self, scene, frames, mode="ANIMATION"):
-        from .rigid_tracks import rigid_body_objects
-
-        settings = scene.tempera
-        self.mode = mode
-        self.frames = list(frames)
-        self.out = output_dir(settings)
-        from ..methods.rigid.rigid_job import exemplar_folders
-
-        self.examples = None  # empty: the project's own drawn exemplar, written with the results
-        if settings.rigid_examples.strip():
-            self.examples = resolve_path(settings.rigid_examples, "rigid-body Examples folder")
-            exemplar_folders(self.examples)  # a named error now, not after the guides
-        bodies = {o.name for o in rigid_body_objects(scene)}
-        if not bodies:
-            raise ValueError("Rigid Bodies needs a rigid-body world with active bodies in the scene.")
-        self.objects = None  # every body the tracks hold
-        if settings.rigid_collection is not None:
-            self.objects = sorted(o.name for o in settings.rigid_collection.all_objects if o.name in bodies)
-            if not self.objects:
-                raise ValueError(f"The collection '{settings.rigid_collection.name}' holds no active rigid body.")
-        self.guides = GuideJob.from_settings(scene, self.frames)
-        self.config = {"out": os.path.join(self.out, RIGID_DIR, FRAMES_DIR), "format": "png", "quality": "final"}
-        self.shape, self.paper = settings.rigid_shape, settings.rigid_output == "PAPER"
-        self.options = rigid_options(settings)
-        self.strokes = None
-        if settings.rigid_strokes == "GENERATED":
-            from ..methods.rigid.rigid_strokes import GENERATED
-
-            self.strokes = GENERATED
-        elif settings.rigid_strokes == "IMAGE":
-            from ..methods.rigid.rigid_strokes import load_stroke_exemplar
-
-            self.strokes = resolve_path(settings.rigid_stroke_image, "rigid-body Stroke Image")
-            load_stroke_exemplar(self.strokes)  # a named error now, not after the guides
-        self.noise = None
-        self.job = None  # the RigidJob, made once the guides (and tracks.json) exist
-        self.index = 0
-        self.results = []
-        self.step_results = []
-        self.stylize_seconds = 0.0
-        self.warnings = []
-
-    def _rigid_job(self):
-        from ..methods.rigid.rigid_job import RigidJob
-
-        if self.job is None:
-            examples = self.examples
-            if examples is None:
-                from ..methods.rigid.rigid_cli import generated_exemplar_folder
-
-                examples = os.path.join(self.out, RIGID_DIR, "generated_examples")
-                generated_exemplar_folder(examples, self.shape)
-            self.job = RigidJob(self.guides.folder, examples, os.path.join(self.out, RIGID_DIR), self.frames,
-                                objects=self.objects, shape=self.shape, paper=self.paper, strokes=self.strokes,
-                                **self.options)
-        return self.job
-
-    @property
-    def stylize_steps(self):
-        # Known once the first rigid step has read the tracks; until then, an estimate.
-        return self.job.total if self.job is not None else len(self.frames)
-
-    @property
-    def in_noise_phase(self):
-        return False  # no Temporal Noise after the rigid-body method
-
-    def _stylize(self, progress):
-        job = self._rigid_job()
-        i = self.index - len(self.frames)
-        started = time.monotonic()
-        result = job.run_step(i, progress)
-        if result["status"] != "kept":
-            self.stylize_seconds += time.monotonic() - started
-        self.step_results.append(result)
-        if result["object"] is None:  # a composite step: these frames are the result
-            self.results += [{"frame": f, "path": str(job.output_path(f)), "status": result["status"]}
-                             for f in result["frames"]]
-        if bpy.app.background:
-            what = result["object"] or "composite"
-            print(f"Tempera: rigid {what} frames {result['frames'][0]}-{result['frames'][-1]} {result['status']} "
-                  f"in {time.monotonic() - started:.1f} s", flush=True)
-
-    def current_frame(self):
-        if self.in_guide_phase or self.job is None:
-            return super().current_frame()
-        return self.job.steps[min(self.index - len(self.frames), self.job.total - 1)][1][0]
-
-    def eta_seconds(self):
-        done = [r for r in self.step_results if r["status"] == "stylized"]
-        left = self.stylize_steps - len(self.step_results)
-        if not done or left <= 0:
-            return None
-        return self.stylize_seconds / len(self.step_results) * left
-
-    def status_text(self):
-        if self.in_guide_phase:
-            return self.guides.status_text()
-        job = self.job
-        if job is None:
-            return "Tempera: rigid bodies, fitting the drawn examples (Esc to stop)"
-        i = min(self.index - len(self.frames), job.total - 1)
-        name, frames = job.steps[i]
-        eta = self.eta_seconds()
-        eta_text = "" if eta is None else f", ETA {format_duration(eta)}"
-        what = f"drawing {name}" if name else "compositing"
-        return (f"Tempera: rigid bodies, {what} frames {frames[0]}-{frames[-1]} (step {i + 1}/{job.total})"
-                f"{eta_text} (Esc to stop)")
-
-    def estimate_seconds(self, scene):
-        return estimate_guide_seconds(scene, self.guides.params, len(self.frames)) + RIGID_SECONDS_PER_FRAME * len(
-            self.frames) * (len(self.objects) if self.objects else 1)
-
-    def summary(self):
-        made = sum(r["status"] != "kept" for r in self.step_results)
-        kept = len(self.step_results) - made
-        left = self.stylize_steps - len(self.step_results) if self.job is not None else self.stylize_steps
-        parts = [f"{made} rigid-body steps done"] + ([f"{kept} already done"] if kept else []) + (
-            [f"{left} not done"] if left > 0 else [])
-        return f"Tempera: {', '.join(parts)} in {self.config['out']}"
 
 
 EXEMPLAR_FRAMES_DIR = "exemplar_frames"  # decoded movies and linked sequences, in the Output Folder

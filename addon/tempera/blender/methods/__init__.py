@@ -4,15 +4,15 @@ module holds what the panel, the operator and Scene.tempera need of its
 method, so that nothing outside it names the method:
 
     PROPERTIES      Scene.tempera properties: name -> bpy property (added by add_properties)
-    draw(col, settings)   the method's options in the Synthesis box
-    RUN             its run (a tempera.blender.stylize_operator.StylizeRun)
+    draw(box, settings)   the method's options in the Synthesis box
+    run(scene, frames, mode)   its run (a tempera.blender.stylize_operator.StylizeRun)
+                    for mode "ANIMATION" or "FRAME", or None for per-frame StyLit
     MEDIUM          True: the exemplar is a medium (a still, an image sequence
                     or a movie: the media_exemplar settings), not a painting
     EXEMPLAR_MASKS  True: the medium may come with a folder of mask frames
 
-A method without a module here (StyLit, the coherent method, the rigid
-bodies) is drawn and run by panels.py and stylize_operator.py, until it
-moves here."""
+A method without a module here (StyLit, the coherent method) is drawn and
+run by panels.py and stylize_operator.py, until it moves here."""
 import importlib
 
 from bpy.props import BoolProperty, FloatProperty

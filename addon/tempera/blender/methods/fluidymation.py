@@ -50,8 +50,9 @@ PROPERTIES = {
 }
 
 
-def draw(col, settings):
-    """The target (its mask guide), the flow, the two passes, the table's options."""
+def draw(box, settings):
+    """The target (its mask guide), the flow, the two passes, the table's options, the seed."""
+    col = box.column()
     col.prop(settings, "fm_target_object")
     if settings.fm_target_object is None:
         col.prop(settings, "fm_target_collection")
@@ -59,6 +60,7 @@ def draw(col, settings):
     col.prop(settings, "fm_bidirectional")
     for prop in TABLE_OPTIONS:
         wide_prop(col, settings, prop)
+    col.prop(settings, "seed")
 
 
 class MediaRun(RgbaRun):
@@ -91,4 +93,6 @@ class MediaRun(RgbaRun):
                 "seed": int(settings.seed), **table_flags(settings, OPTIONS, TABLE_OPTIONS)}
 
 
-RUN = MediaRun
+def run(scene, frames, mode):
+    """Stylize Animation's run, and Stylize Frame's (the method on that frame alone)."""
+    return MediaRun(scene, frames, mode)

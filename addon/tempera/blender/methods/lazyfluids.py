@@ -33,13 +33,15 @@ PROPERTIES = {
 }
 
 
-def draw(col, settings):
-    """The temporal pull, the rotated exemplars, the motion blur, the table's options."""
+def draw(box, settings):
+    """The temporal pull, the rotated exemplars, the motion blur, the table's options, the seed."""
+    col = box.column()
     wide_prop(col, settings, "lf_lambda")
     col.prop(settings, "lf_rotations")
     col.prop(settings, "lf_motion_blur")
     for prop in TABLE_OPTIONS:
         wide_prop(col, settings, prop)
+    col.prop(settings, "seed")
 
 
 class FluidRun(RgbaRun):
@@ -55,4 +57,6 @@ class FluidRun(RgbaRun):
                 **table_flags(settings, OPTIONS, TABLE_OPTIONS)}
 
 
-RUN = FluidRun
+def run(scene, frames, mode):
+    """Stylize Animation's run, and Stylize Frame's (the method on that frame alone)."""
+    return FluidRun(scene, frames, mode)
