@@ -7,24 +7,22 @@ and come back when the add-on is enabled again).
 """
 import bpy
 
-from . import job_operator, keyframes, kit_operators, layers, methods
+from . import job_operator, kit_operators, methods
 from .guide_operator import TEMPERA_OT_render_guides
 from .panels import TEMPERA_PT_output
 from .preferences import TemperaPreferences
-from .properties import TemperaKeyframe, TemperaLayer, TemperaSettings
+from .properties import TemperaSettings
 from .stylize_operator import TEMPERA_OT_stylize
 
-# Registration order: property groups before the pointers and panels using them.
+# Registration order: property groups before the pointers and panels using
+# them; each method's own (tempera.blender.methods) before Scene.tempera's group.
 CLASSES = (
     TemperaPreferences,
-    TemperaKeyframe,
-    TemperaLayer,
+    *methods.classes(),
     TemperaSettings,
     TEMPERA_OT_render_guides,
     TEMPERA_OT_stylize,
     *kit_operators.CLASSES,
-    *keyframes.CLASSES,
-    *layers.CLASSES,
     TEMPERA_PT_output,
 )
 

@@ -10,8 +10,6 @@ from bpy.types import Panel
 from .. import __version__
 from . import methods
 from .guide_operator import TEMPERA_OT_render_guides, cache_status
-from .keyframes import TEMPERA_OT_add_keyframe, TEMPERA_OT_import_keyframe, TEMPERA_OT_remove_keyframe
-from .layers import TEMPERA_OT_add_tcia_layer, TEMPERA_OT_remove_tcia_layer
 from .kit_operators import (TEMPERA_OT_choose_painting, TEMPERA_OT_painting_template, TEMPERA_OT_register_painting,
                             painting_preview)
 from .properties import WEIGHT_PROPERTIES
@@ -140,12 +138,15 @@ def draw_light_paths(box, settings):
 def draw_synthesis(box, settings):
     box.label(text="Synthesis", icon="MOD_REMESH")
     box.prop(settings, "method")
-    if settings.method == "TCIA":
-        draw_keyframes(box, settings)
     side = methods.side(settings.method)
-    if side is not None:  # the method's own module (tempera.blender.methods); StyLit's settings below do not apply
+    if side is not None:  # the method's own module (tempera.blender.methods)
         side.draw(box, settings)
-        return
+    else:
+        draw_stylit(box, settings)
+
+
+def draw_stylit(box, settings):
+    """StyLit's settings and the Temporal Noise pass after it."""
     col = box.column()
     col.prop(settings, "quality")
     col.prop(settings, "usage")
@@ -180,51 +181,6 @@ def draw_media_exemplar(box, settings, masks):
     box.prop(settings, "media_exemplar")
     if masks:
         box.prop(settings, "media_masks")
-
-
-def draw_list(box, settings, items, index, add, remove, rows):
-    """The list `settings.<items>` (drawn by TEMPERA_UL_<items>, selection
-    `settings.<index>`) with its add and remove operators' buttons beside it."""
-    row = box.row()
-    row.template_list(f"TEMPERA_UL_{items}", "", settings, items, settings, index, rows=rows)
-    side = row.column(align=True)
-    side.operator(add.bl_idname, text="", icon="ADD")
-    side.operator(remove.bl_idname, text="", icon="REMOVE")
-
-
-def draw_keyframes(box, settings):
-    """The coherent method's painted keyframes: the list and its buttons."""
-    box.label(text="Keyframes (painted frames the shot follows)")
-    draw_list(box, settings, "keyframes", "keyframe_index", TEMPERA_OT_add_keyframe, TEMPERA_OT_remove_keyframe,
-              rows=3)
-    row = box.row(align=True)
-    row.operator(TEMPERA_OT_add_keyframe.bl_idname, text="Add Keyframe", icon="KEYFRAME")
-    row.operator(TEMPERA_OT_import_keyframe.bl_idname, text="Import Key", icon="IMPORT")
-    if 0 <= settings.keyframe_index < len(settings.keyframes):
-        key = settings.keyframes[settings.keyframe_index]
-        col = box.column(align=True)
-        col.prop(key, "painting")
-        col.prop(key, "mask")
-        if len(settings.tcia_layers):
-            col.prop(key, "layer")
-    box.prop(settings, "keyframe_dir")
-    box.prop(settings, "line_weight")
-    box.prop(settings, "tcia_orientation")
-    draw_layers(box, settings)
-
-
-def draw_layers(box, settings):
-    """The coherent method's layers, picked from collections."""
-    box.label(text="Layers (collections painted separately)")
-    draw_list(box, settings, "tcia_layers", "tcia_layer_index", TEMPERA_OT_add_tcia_layer,
-              TEMPERA_OT_remove_tcia_layer, rows=2)
-    if 0 <= settings.tcia_layer_index < len(settings.tcia_layers):
-        layer = settings.tcia_layers[settings.tcia_layer_index]
-        col = box.column(align=True)
-        col.prop(layer, "collection")
-        col.prop(layer, "painting")
-    if len(settings.tcia_layers):
-        box.prop(settings, "tcia_layer_order")
 
 
 def draw_output(box, settings):

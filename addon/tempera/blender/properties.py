@@ -1,6 +1,6 @@
 """Per-scene Tempera settings, stored in the .blend file as Scene.tempera."""
 import bpy
-from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty,
+from bpy.props import (BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty,
                        StringProperty)
 from bpy.types import PropertyGroup
 
@@ -102,39 +102,6 @@ MEDIA_EXEMPLAR_KINDS = (
     ("SEQUENCE", "Image Sequence", "A folder of frames, or the first file of a numbered sequence (ink_0001.png)"),
     ("MOVIE", "Movie", "A movie file, decoded to PNG frames once by ffmpeg (into Output Folder/exemplar_frames)"),
 )
-DEFAULT_KEYFRAME_DIR = "//tempera/keys/"
-
-
-class TemperaKeyframe(PropertyGroup):
-    """A painted keyframe of the coherent method (tempera.blender.keyframes)."""
-
-    frame: IntProperty(name="Frame", description="The frame this painting is of", default=1, min=0,
-                       max=MAX_FRAME)
-    painting: StringProperty(name="Painting", subtype="FILE_PATH", default="",
-                             description="The painted frame (the frame's size); '//' is relative to the .blend file")
-    mask: StringProperty(name="Mask", subtype="FILE_PATH", default="",
-                         description="Optional: where the key is painted (white); empty: the whole frame")
-    layer: PointerProperty(name="Layer", type=bpy.types.Collection,
-                           description="Optional: the key of this layer only (a collection of the Layers list); "
-                           "empty: a key of the whole frame")
-
-
-class TemperaLayer(PropertyGroup):
-    """A layer of the coherent method (tempera.blender.layers): a collection painted and synthesized alone."""
-
-    collection: PointerProperty(name="Collection", type=bpy.types.Collection,
-                                description="The collection of this layer (its mask guide)")
-    painting: StringProperty(name="Painting", subtype="FILE_PATH", default="",
-                             description="Optional: this layer's own painting over the exemplar render (the "
-                             "exemplar's size); empty: the shared painting")
-
-
-LAYER_ORDERS = (
-    ("depth", "By Depth", "Per frame, the nearer layer (median depth of its pixels) on top"),
-    ("given", "List Order", "The first layer of the list at the back, the last on top"),
-)
-
-
 class TemperaSettings(PropertyGroup):
     output_dir: StringProperty(
         name="Output Folder",
@@ -317,29 +284,9 @@ class TemperaSettings(PropertyGroup):
     noise_map_guide: StringProperty(name="Map Guide",
                                     description="Name of a guide of the guide cache (an attribute or AOV)")
 
-    # The coherent method (Bénard et al. 2013) and its painted keyframes.
+    # The method (tempera.methods.registry); its own settings come from its module.
     method: EnumProperty(name="Method", items=METHOD_ITEMS, default="STYLIT",
                          description="How Stylize Animation paints the shot")
-    keyframes: CollectionProperty(type=TemperaKeyframe, name="Keyframes")
-    keyframe_index: IntProperty(name="Active Keyframe", default=0, min=0)
-    line_weight: FloatProperty(
-        name="Line Term",
-        description="For line paintings (ink on paper): pulls the painting's ink onto the scene's lines (the "
-        "guide cache's line distance, Bénard 2013 eq. 9); 0 = off, 4 typical",
-        default=0.0, min=0.0, soft_max=10.0)
-    tcia_orientation: BoolProperty(
-        name="Orientation from Guides",
-        description="Patches turn with the guide cache's orientation (the render's structure, or your "
-        "Orientation AOV), so strokes follow the surfaces (Bénard 2013 §3.1); needs the exemplar's too",
-        default=False)
-    tcia_layers: CollectionProperty(type=TemperaLayer, name="Layers")
-    tcia_layer_index: IntProperty(name="Active Layer", default=0, min=0)
-    tcia_layer_order: EnumProperty(name="Layer Order", items=LAYER_ORDERS, default="depth",
-                                   description="How the layers' frames are stacked into the composite")
-    keyframe_dir: StringProperty(
-        name="Keyframe Folder",
-        description="Where Add Keyframe saves the images to paint over ('//' is beside the .blend file)",
-        subtype="DIR_PATH", default=DEFAULT_KEYFRAME_DIR)
 
     # The exemplar of a medium, for the methods whose module says MEDIUM
     # (tempera.blender.methods); each method's own properties come from its

@@ -16,15 +16,11 @@ runs them: modal with progress and Esc in the UI, all at once in background):
 After the last frame of an animation: a contact sheet, an mp4 (when ffmpeg
 is present) and the result loaded back into Blender (Load Result).
 
-With Method "Temporally Coherent (Bénard 2013)", Stylize Animation's second
-phase is CoherentRun: tempera.methods.tcia.tcia.ShotJob, one step per segment between
-painted keyframes (each resumable, Esc stops within a segment and nothing of
-it is written). Stylize Frame stays per-frame StyLit: a quick look, and the
-ground Add Keyframe paints over.
-
-A method with a module of its own (tempera.blender.methods.NAME) makes its
-run there (its run(scene, frames, mode)); RgbaRun below is the base of the
-runs that make RGBA frames from a medium.
+Every other method has a module of its own (tempera.blender.methods.NAME)
+and makes its run there (run(scene, frames, mode); None: per-frame StyLit,
+as the coherent method and the rigid bodies answer for Stylize Frame).
+StylizeRun is also the base of the coherent method's run, and RgbaRun
+below of the runs that make RGBA frames from a medium.
 """
 import os
 import time
@@ -128,8 +124,6 @@ class StylizeRun:
     @classmethod
     def from_settings(cls, scene, mode="ANIMATION"):
         frames = [scene.frame_current] if mode == "FRAME" else guide_frames(scene, scene.tempera)
-        if mode == "ANIMATION" and scene.tempera.method == "TCIA":
-            return CoherentRun(scene, frames, mode)
         side = methods.side(scene.tempera.method)  # a method with its own module (tempera.blender.methods)
         run = side.run(scene, frames, mode) if side is not None else None
         return run if run is not None else cls(scene, frames, mode)
@@ -250,79 +244,6 @@ class StylizeRun:
             made = sum(r["status"] == "made" for r in self.noise_results)
             parts.append(f"{made} boiled (Temporal Noise) in {self.noise['out']}")
         return f"Tempera: {', '.join(parts)} in {self.config['out']}{tail}"
-
-
-class CoherentRun(StylizeRun):
-    """Guides of every frame, then the coherent method, one segment per step."""
-
-    def __init__(self, scene, frames, mode="ANIMATION"):
-        from ..app import guide_cache
-        from ..methods.tcia import tcia
-        from .keyframes import key_list
-        from .layers import layer_list
-
-        super().__init__(scene, frames, mode)
-        require_consecutive(self.frames, "The coherent method")
-        self.keys = [k for k in key_list(scene.tempera) if self.frames[0] <= k[0] <= self.frames[-1]]
-        self.layers = layer_list(scene.tempera, (self.frames[0], self.frames[-1]))
-        layer_keys = [k[0] for layer in self.layers for k in layer[3]]
-        self.segments = tcia.segments(self.frames, [k[0] for k in self.keys] + layer_keys)
-        self.segment_results = []
-        self.line_weight = float(scene.tempera.line_weight)
-        self.orientation = bool(scene.tempera.tcia_orientation)
-        self.layer_order = scene.tempera.tcia_layer_order
-        if self.layers:  # their collections' masks
-            self.guides.params["masks"] = guide_cache.masks_including(self.guides.params["masks"], "CO")
-
-    @property
-    def stylize_steps(self):
-        return len(self.segments)
-
-    def _stylize(self, progress):
-        from ..methods.tcia.tcia import ShotJob
-
-        c = self.config
-        if self.job is None:
-            self.job = ShotJob(c["style"], c["exemplar_guides"], c["guides"], self.frames, c["out"],
-                               exemplar_frame=c.get("exemplar_frame"), keys=self.keys, weights=c["weights"],
-                               format=c["format"], seed=c["seed"],
-                               lines={"weight": self.line_weight, "d_max": self.guides.params["line_d_max"]},
-                               layers=self.layers, layer_order=self.layer_order, orientation=self.orientation)
-            self.warnings = list(self.job.warnings)
-        i = self.index - len(self.frames)
-        started = time.monotonic()
-        result = self.job.run_segment(i, None if progress is None else lambda d: progress(d["fraction"]))
-        if result["status"] == "stylized":
-            self.stylize_seconds += time.monotonic() - started
-        self.segment_results.append(result)
-        for frame in self.job.segments[i][2]:
-            self.results.append({"frame": frame, "path": self.job.output_path(frame), "status": result["status"]})
-        if bpy.app.background:
-            first, last = self.segments[i]
-            print(f"Tempera: segment {i + 1}/{len(self.segments)} (frames {first}-{last}) {result['status']} "
-                  f"in {time.monotonic() - started:.1f} s", flush=True)
-
-    def current_frame(self):
-        if self.in_guide_phase or self.in_noise_phase:
-            return super().current_frame()
-        return self.segments[min(self.index - len(self.frames), len(self.segments) - 1)][0]
-
-    def eta_seconds(self):
-        stylized = [r for r in self.segment_results if r["status"] == "stylized"]
-        left = len(self.segments) - len(self.segment_results)
-        if not stylized or left <= 0:
-            return None
-        return self.stylize_seconds / len(stylized) * left
-
-    def status_text(self):
-        if self.in_guide_phase or self.in_noise_phase:
-            return super().status_text()
-        i = min(len(self.segment_results), len(self.segments) - 1)
-        eta = self.eta_seconds()
-        first, last = self.segments[i]
-        eta_text = "" if eta is None else f", ETA {format_duration(eta)}"
-        return (f"Tempera: coherent segment {i + 1}/{len(self.segments)} (frames {first}-{last}){eta_text} "
-                "(Esc to stop)")
 
 
 EXEMPLAR_FRAMES_DIR = "exemplar_frames"  # decoded movies and linked sequences, in the Output Folder

@@ -10,9 +10,10 @@ method, so that nothing outside it names the method:
     MEDIUM          True: the exemplar is a medium (a still, an image sequence
                     or a movie: the media_exemplar settings), not a painting
     EXEMPLAR_MASKS  True: the medium may come with a folder of mask frames
+    CLASSES         optional: its property groups, lists and operators, to register
 
-A method without a module here (StyLit, the coherent method) is drawn and
-run by panels.py and stylize_operator.py, until it moves here."""
+StyLit, the method without a module here, is the default: panels.py draws
+its settings (draw_stylit) and stylize_operator.StylizeRun runs it."""
 import importlib
 
 from bpy.props import BoolProperty, FloatProperty
@@ -39,6 +40,12 @@ def add_properties(settings_class):
         module = side(name)
         if module is not None:
             settings_class.__annotations__.update(module.PROPERTIES)
+
+
+def classes():
+    """Every method's CLASSES (its property groups, lists and operators), in
+    the registry's order: Blender registers them before Scene.tempera's group."""
+    return tuple(cls for name in registry.names() for cls in getattr(side(name), "CLASSES", ()))
 
 
 def tooltip(row):
