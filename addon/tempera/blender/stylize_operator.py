@@ -286,7 +286,8 @@ class RgbaRun(StylizeRun):
         self.guides = GuideJob.from_settings(scene, self.frames)
         self.config = {"out": os.path.join(self.method_out, FRAMES_DIR), "format": settings.output_format,
                        "quality": "final"}  # the one layout: make_job writes the frames to OUT/frames
-        self.options = self.job_options(settings)  # by command-line flag, as make_job takes them
+        # By command-line flag, as make_job takes them.
+        self.options = {"seed": int(settings.seed), **self.job_options(settings)}
         self.noise = None
         self.job = None  # the method's job, made once the guides exist
         self.index = 0

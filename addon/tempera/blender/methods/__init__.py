@@ -14,6 +14,7 @@ method, so that nothing outside it names the method:
 
 StyLit, the method without a module here, is the default: panels.py draws
 its settings (draw_stylit) and stylize_operator.StylizeRun runs it."""
+import functools
 import importlib
 
 from bpy.props import BoolProperty, FloatProperty
@@ -24,7 +25,12 @@ from ...methods import registry
 def side(method):
     """The module of `method` (the panel's item in capitals, or the
     registry's name), or None if it has none."""
-    name = f"{__name__}.{method.lower()}"
+    return _side(method.lower())
+
+
+@functools.lru_cache(maxsize=None)  # the panel asks at every redraw; a missing module costs a path search
+def _side(method):
+    name = f"{__name__}.{method}"
     try:
         return importlib.import_module(name)
     except ModuleNotFoundError as error:

@@ -90,7 +90,7 @@ class MediaRun(RgbaRun):
 
     def job_options(self, settings):
         return {"flow": settings.fm_flow.lower(), "bidirectional": bool(settings.fm_bidirectional),
-                "seed": int(settings.seed), **table_flags(settings, OPTIONS, TABLE_OPTIONS)}
+                **table_flags(settings, OPTIONS, TABLE_OPTIONS)}
 
 
 def run(scene, frames, mode):

@@ -53,8 +53,7 @@ class FluidRun(RgbaRun):
 
     def job_options(self, settings):
         return {"lambda": float(settings.lf_lambda), "rotations": bool(settings.lf_rotations),
-                "motion-blur": float(settings.lf_motion_blur), "seed": int(settings.seed),
-                **table_flags(settings, OPTIONS, TABLE_OPTIONS)}
+                "motion-blur": float(settings.lf_motion_blur), **table_flags(settings, OPTIONS, TABLE_OPTIONS)}
 
 
 def run(scene, frames, mode):
