@@ -10,6 +10,9 @@ from tempera import _native, read_image
 from tempera.app import guide_cache
 from tempera.methods import registry
 from tempera.methods.lazyfluids import lazyfluids
+from tempera.methods.stylit.stylize import StylizeJob
+
+from synthetic_cache import make_cache, make_exemplar
 
 H, W = 32, 40
 
@@ -35,7 +38,7 @@ def shot(tmp_path):
 
 def test_the_registry_says_which_methods_have_a_job_factory():
     jobs = {m["name"] for m in registry.METHODS if m["job"]}
-    assert {"lazyfluids", "fluidymation"} <= jobs and not {"stylit", "tcia", "rigid"} & jobs
+    assert {"stylit", "lazyfluids", "fluidymation"} <= jobs and not {"tcia", "rigid"} & jobs
     assert "--lambda" in registry.find("lazyfluids")["options_help"]
     for job_class in (_native.StylizeJob, _native.NoisySequence, _native.LazyFluidsJob, _native.FluidymationJob):
         assert issubclass(job_class, _native.FrameJob)
@@ -70,11 +73,42 @@ def test_a_registered_job_cancels_and_names_bad_options(shot):
     with pytest.raises(ValueError, match="temporal weight"):  # --lambda is λ, the temporal weight
         registry.make_job("lazyfluids", shot / "smoke.png", shot / "guides", [1, 2], shot / "o", options={"lambda": -1})
     with pytest.raises(ValueError, match="no job factory"):
-        registry.make_job("stylit", shot / "smoke.png", shot / "guides", [1, 2], shot / "o")
+        registry.make_job("tcia", shot / "smoke.png", shot / "guides", [1, 2], shot / "o")
     with pytest.raises(ValueError, match="runs in Python"):
         registry.make_job("rigid", shot / "smoke.png", shot / "guides", [1, 2], shot / "o")
     with pytest.raises(ValueError, match="unknown --method 'ebsynth'"):
         registry.make_job("ebsynth", shot / "smoke.png", shot / "guides", [1, 2], shot / "o")
+
+
+def test_stylit_by_the_registry_equals_its_own_class(tmp_path):
+    """StyLit's options as the command line's flags (the exemplar render's
+    guides, weights, --temporal, engine flags) give the frames of its own
+    class, byte for byte, in OUT/frames."""
+    make_cache(tmp_path / "cache")
+    make_exemplar(tmp_path / "exemplar", tmp_path / "paint.png")
+    inputs = (tmp_path / "paint.png", tmp_path / "exemplar", tmp_path / "cache")
+    own = StylizeJob(*inputs, [1, 2, 3], tmp_path / "own", weights={"LDE": 3.0, "LDDE": 0}, temporal_weight=0.8,
+                     em_iterations=3, threads=2, seed=4)
+    job = registry.make_job("stylit", tmp_path / "paint.png", tmp_path / "cache", [1, 2, 3], tmp_path / "reg",
+                            options={"exemplar-guides": tmp_path / "exemplar", "weights": "LDE=3,LDDE=0",
+                                     "temporal": 0.8, "em-iters": 3, "threads": 2, "seed": 4})
+    assert job.has_contact_sheet and job.output_path(2) == str(tmp_path / "reg" / "frames" / "frame_0002.png")
+    for i, frame in enumerate(job.frames):
+        mine, theirs = job.run_frame(i), own.run_frame(i)
+        assert mine["status"] == theirs["status"] == "stylized"
+        assert np.array_equal(read_image(job.output_path(frame)), read_image(own.output_path(frame)))
+    different = registry.make_job("stylit", *inputs[::2], [1], tmp_path / "seed5",
+                                  options={"exemplar-guides": inputs[1], "em-iters": 3, "threads": 2, "seed": 5})
+    different.run_frame(0)
+    assert not np.array_equal(read_image(different.output_path(1)), read_image(own.output_path(1)))
+    with pytest.raises(ValueError, match="--exemplar-guides is required"):
+        registry.make_job("stylit", *inputs[::2], [1], tmp_path / "o")
+    with pytest.raises(ValueError, match="unknown guide 'GLOW'"):
+        registry.make_job("stylit", *inputs[::2], [1], tmp_path / "o",
+                          options={"exemplar-guides": inputs[1], "weights": "GLOW=1"})
+    with pytest.raises(ValueError, match="unknown option '--noise' for --method stylit"):
+        registry.make_job("stylit", *inputs[::2], [1], tmp_path / "o",
+                          options={"exemplar-guides": inputs[1], "noise": 2})
 
 
 def test_fluidymation_by_the_registry_equals_its_own_class(tmp_path):

@@ -58,8 +58,9 @@ def make_job(name: str, exemplar, guides, frames, out, *, format: str = "png", r
     the dashes (``{"lambda": 0.3, "motion_blur": 4, "rotations": True}``;
     ``_`` stands for ``-``), as ``tempera stylize --method NAME --help`` lists
     them. ValueError for an unknown method, option or value, or a method
-    without a job factory (StyLit and the coherent method have their own
-    classes; rigid runs in tempera.methods.rigid)."""
+    without a job factory (the coherent method solves segments, in
+    tempera.methods.tcia; rigid runs in tempera.methods.rigid). StyLit takes
+    the exemplar render's guide cache as ``{"exemplar-guides": DIR}``."""
     config = dict(exemplar=os.fspath(exemplar), guides=os.fspath(guides), frames=[int(f) for f in frames],
                   out=os.fspath(out), format=str(format), resume=bool(resume))
     flags = [(str(flag).replace("_", "-"), _option_text(value)) for flag, value in (options or {}).items()]

@@ -49,7 +49,8 @@ struct MethodEntry {
   std::string python_command;
   // The job, for a method that the registry's one command runs
   // (cli/method_command.cpp: flags, resume, progress, Ctrl-C, a .blend's
-  // guides); empty for the methods with a command of their own.
+  // guides; StyLit's too, though its command is still its own); empty for
+  // the coherent method, which solves segments in its own command.
   MakeJob make_job;
   // Its own options, for --help: "  --strength S   ...\n" lines. Given alone
   // (no value), an option arrives with the text "" (set_from_text: a switch).
