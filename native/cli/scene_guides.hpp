@@ -20,11 +20,4 @@ struct GuideRender {
 void render_scene_guides(const GuideRender& how, const std::string& scene, const std::string& frames,
                          const std::string& out);
 
-// For a method whose command reads a guide cache (--guides): when `args`
-// start with a scene file, renders its guides into --guides (default
-// OUT/guides) and returns the method's arguments, without the scene and the
-// render flags (--samples, --blender, --addon-path) and with --guides.
-// Otherwise (no scene, or --help) returns `args` as they are.
-Args with_scene_guides(const Args& args);
-
 }  // namespace tempera::cli

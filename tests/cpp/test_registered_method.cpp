@@ -166,6 +166,70 @@ TEST(RegisteredMethod, RunsThroughTheOneCommandWithResumeAndNamedErrors) {
   EXPECT_THROW(cli::run_stylize(shot.args("guides")), ValueError);  // would write into an input
 }
 
+namespace {
+
+// The example as a light-path method: it takes the exemplar render's guides
+// (and shades by FULL alone), so the one command gives it the exemplar
+// scene, the video and the noise pass as it gives StyLit.
+MethodEntry light_path_tint_entry() {
+  MethodEntry m = tint_entry();
+  m.name = "lighttint";
+  m.light_path_guides = true;
+  m.make_job = [](const JobConfig& c, const MethodOptions& given) {
+    MethodOptions own;
+    for (const auto& option : given)
+      if (option.first != "exemplar-guides") own.push_back(option);
+    return std::make_unique<TintJob>(c, own);
+  };
+  return m;
+}
+
+std::string error_of(const cli::Args& args) {
+  try {
+    cli::run_stylize(args);
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(RegisteredMethod, ALightPathMethodGetsTheExemplarSceneAndTheNoisePass) {
+  if (std::none_of(method_registry().begin(), method_registry().end(),
+                   [](const MethodEntry& m) { return m.name == "lighttint"; }))
+    register_method(light_path_tint_entry());
+  Shot shot;
+  Image paint(64, 64, 3);  // big enough for the noise pass's pyramid
+  for (std::size_t i = 0; i < paint.pixel_count() * 3; ++i) paint.data()[i] = float((i * 2654435761u) % 997) / 997;
+  write_image((shot.root / "paint.png").string(), paint.view());
+  const auto args = [&](const std::string& out, std::vector<std::string> extra) {
+    cli::Args a = shot.args(out, std::move(extra));
+    a[1] = "lighttint";
+    return a;
+  };
+  EXPECT_NE(error_of(args("none", {})).find("give one of --exemplar-scene"), std::string::npos);
+  const std::string guides = (shot.root / "guides").string();
+  testing::internal::CaptureStdout();
+  const int status = cli::run_stylize(args("out", {"--exemplar-guides", guides, "--noise", "1.3", "--no-video"}));
+  const std::string said = testing::internal::GetCapturedStdout();
+  EXPECT_EQ(status, 0) << said;
+  EXPECT_TRUE(fs::is_regular_file(shot.root / "out" / "frames" / "frame_0002.png"));
+  EXPECT_TRUE(fs::is_regular_file(shot.root / "out" / "noisy" / "frame_0002.png")) << said;  // boiled
+  EXPECT_NE(said.find("noisy frame 2/2"), std::string::npos) << said;
+  // The exemplar scene is rendered by Blender before the job: here there is none to run.
+  setenv("TEMPERA_BLENDER", (shot.root / "no_blender").c_str(), 1);
+  EXPECT_NE(error_of(args("scene", {"--exemplar-scene", (shot.root / "x.blend").string()})).find("scene file not found"),
+            std::string::npos);
+  unsetenv("TEMPERA_BLENDER");
+  // A method that is not a light-path one has none of it, and a flag of another method says whose it is.
+  EXPECT_NE(error_of(shot.args("bad", {"--noise", "1.3"})).find("unknown option '--noise' for --method tint"),
+            std::string::npos);
+  EXPECT_NE(error_of(shot.args("bad", {"--key", "1=k.png"})).find("--key needs --method tcia"), std::string::npos);
+  EXPECT_NE(error_of(shot.args("bad", {"--temporal", "1"})).find("--temporal needs --method stylit"),
+            std::string::npos);
+}
+
 TEST(RegisteredMethod, NamesMustBePlainAndNewAndAJobIsNeeded) {
   MethodEntry bad = tint_entry();
   bad.name = "Tint Me";

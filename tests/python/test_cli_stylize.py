@@ -84,6 +84,10 @@ def test_errors_and_exit_codes(cli_path, caches):
     assert help_text.returncode == 0
     for option in ("--exemplar-scene", "--weights", "--temporal", "--quality", "--no-resume", "--fps", "--samples"):
         assert option in help_text.stdout
+    own = stylize(cli_path, "--method", "stylit", "--help")  # StyLit's page of the one command
+    assert own.returncode == 0 and own.stdout.startswith("usage: tempera stylize --method stylit")
+    for option in ("--exemplar-guides", "--exemplar-scene", "--weights", "--temporal", "--noise", "--fps", "--samples"):
+        assert option in own.stdout, option
 
 
 def test_stylits_options_come_from_its_one_table(cli_path, caches):

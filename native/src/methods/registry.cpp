@@ -43,9 +43,33 @@ void register_method(MethodEntry entry) {
   registry().push_back(std::move(entry));
 }
 
+namespace {
+
+// The other methods whose --help lists `--flag` ("tcia", "lazyfluids or
+// fluidymation"), so that a flag given to the wrong method says which takes it.
+std::string methods_taking(const std::string& flag, const std::string& except) {
+  const std::string token = "  --" + flag;
+  std::string names;
+  for (const MethodEntry& m : method_registry()) {
+    const std::string& help = m.options_help;
+    for (std::size_t at = help.find(token); m.name != except && at != std::string::npos; at = help.find(token, at + 1)) {
+      const std::size_t end = at + token.size();
+      if (end == help.size() || help[end] == ' ' || help[end] == '\n') {
+        names += concat(names.empty() ? "" : " or ", m.name);
+        break;
+      }
+    }
+  }
+  return names;
+}
+
+}  // namespace
+
 ValueError unknown_method_option(const std::string& name, const std::string& flag) {
-  return ValueError(concat("unknown option '--", flag, "' for --method ", name, " (see tempera stylize --method ",
-                           name, " --help)"));
+  const std::string others = methods_taking(flag, name);
+  return ValueError(concat("unknown option '--", flag, "' for --method ", name,
+                           others.empty() ? "" : concat(": --", flag, " needs --method ", others),
+                           " (see tempera stylize --method ", name, " --help)"));
 }
 
 const MethodEntry& find_method(const std::string& name) {

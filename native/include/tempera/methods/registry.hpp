@@ -49,8 +49,9 @@ struct MethodEntry {
   std::string python_command;
   // The job, for a method that the registry's one command runs
   // (cli/method_command.cpp: flags, resume, progress, Ctrl-C, a .blend's
-  // guides; StyLit's too, though its command is still its own); empty for
-  // the coherent method, which solves segments in its own command.
+  // guides, and for a light-path method the exemplar scene, the video and
+  // the noise pass); empty for the coherent method, which solves segments
+  // in its own command (cli/stylize_command.cpp).
   MakeJob make_job;
   // Its own options, for --help: "  --strength S   ...\n" lines. Given alone
   // (no value), an option arrives with the text "" (set_from_text: a switch).

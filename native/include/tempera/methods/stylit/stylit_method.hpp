@@ -1,10 +1,10 @@
 #pragma once
 // StyLit's line of the method registry (methods/registry.hpp): its texts,
-// unit, guide needs and job factory (its options: --exemplar-guides,
+// unit, guide needs, job factory and help (its options: --exemplar-guides,
 // --exemplar-frame, --weights, --temporal, --quality and the engine's). The
-// command line still runs it through its own command
-// (cli/stylize_command.cpp, shared with the coherent method: the exemplar
-// scene, the noise pass, the video).
+// command line runs it through the registry's one command
+// (cli/method_command.cpp), which adds a light-path method's exemplar scene,
+// video and noise pass (cli/light_path_extras.hpp).
 #include "tempera/methods/registry.hpp"
 
 namespace tempera {

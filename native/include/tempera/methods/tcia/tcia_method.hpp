@@ -1,6 +1,7 @@
 #pragma once
-// The coherent method's line of the method registry (methods/registry.hpp): its texts,
-// unit and guide needs; it runs through StyLit's command (cli/stylize_command.cpp), by segments.
+// The coherent method's line of the method registry (methods/registry.hpp):
+// its texts, unit, guide needs and own flags; it runs by segments through
+// its command (cli/stylize_command.cpp), which also takes StyLit's options.
 #include "tempera/methods/registry.hpp"
 
 namespace tempera {
