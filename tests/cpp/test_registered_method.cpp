@@ -136,12 +136,17 @@ struct Shot {
   }
 };
 
+// Registers `entry` once per process (ctest runs each test alone, the test binary all together).
+void register_once(const MethodEntry& entry) {
+  if (std::none_of(method_registry().begin(), method_registry().end(),
+                   [&](const MethodEntry& m) { return m.name == entry.name; }))
+    register_method(entry);
+}
+
 }  // namespace
 
 TEST(RegisteredMethod, RunsThroughTheOneCommandWithResumeAndNamedErrors) {
-  if (std::none_of(method_registry().begin(), method_registry().end(),
-                   [](const MethodEntry& m) { return m.name == "tint"; }))
-    register_method(tint_entry());
+  register_once(tint_entry());
   EXPECT_THROW(register_method(tint_entry()), ValueError);  // a name once
   EXPECT_EQ(find_method("tint").unit, "frame");
   testing::internal::CaptureStdout();
@@ -196,9 +201,8 @@ std::string error_of(const cli::Args& args) {
 }  // namespace
 
 TEST(RegisteredMethod, ALightPathMethodGetsTheExemplarSceneAndTheNoisePass) {
-  if (std::none_of(method_registry().begin(), method_registry().end(),
-                   [](const MethodEntry& m) { return m.name == "lighttint"; }))
-    register_method(light_path_tint_entry());
+  register_once(tint_entry());
+  register_once(light_path_tint_entry());
   Shot shot;
   Image paint(64, 64, 3);  // big enough for the noise pass's pyramid
   for (std::size_t i = 0; i < paint.pixel_count() * 3; ++i) paint.data()[i] = float((i * 2654435761u) % 997) / 997;
