@@ -1,10 +1,11 @@
 // `tempera stylize --method NAME` for a method the registry runs by its job
-// factory (methods/registry.hpp, make_job): one command for every such
-// method, built in or a plug-in, with the core's flags, a scene's guides
+// factory (methods/registry.hpp: make_job, or make_segment_job for the
+// segment unit): one command for every such method, built in or a plug-in, with the core's flags, a scene's guides
 // rendered first, resume, progress lines, Ctrl-C and contact sheet, so that
 // a method needs no command of its own (docs/adding_a_method.md). A
 // light-path method (StyLit) also gets the exemplar scene, the video and
 // the noise pass (light_path_extras.hpp).
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
@@ -86,7 +87,7 @@ void check_required(const MethodEntry& method, const Request& q) {
   if (config.guides.empty() && !boil_only)
     throw ValueError("give SCENE.blend as the first argument, or --guides DIR with an existing guide cache");
   if (!method.light_path_guides) return;
-  check_light_path_extras(q.extras, config);
+  check_light_path_extras(q.extras, config, q.option("segment") != nullptr);
   if (!boil_only && q.extras.exemplar_scene.empty() == (q.option("exemplar-guides") == nullptr))
     throw ValueError("give one of --exemplar-scene EXEMPLAR.blend or --exemplar-guides DIR");
 }
@@ -120,10 +121,18 @@ Request parse(const MethodEntry& method, const Args& args) {
   return q;
 }
 
+// Boiling given frames (--noise-reference) reads the shot's guides only for
+// a guide as the noise map or for guided noise, the exemplar's only for the
+// latter: else their scenes are not rendered.
+bool reads_guides(const LightPathExtras& e, bool exemplar) {
+  if (e.noise_reference.empty() || e.noisy.noise_guides > 0) return true;
+  return !exemplar && !e.noise_map.empty() && !fs::is_regular_file(e.noise_map);
+}
+
 // A light-path method's exemplar scene rendered (into OUT/exemplar_guides,
 // its frame 1 unless --exemplar-frame says), passed on as --exemplar-guides.
 void render_exemplar_guides(Request& q) {
-  if (q.extras.exemplar_scene.empty() || !q.extras.noise_reference.empty()) return;
+  if (q.extras.exemplar_scene.empty() || !reads_guides(q.extras, true)) return;
   const std::string* given = q.option("exemplar-frame");
   const int frame = given ? parse_number<int>(*given, "--exemplar-frame") : 1;
   q.options.emplace_back("exemplar-guides", render_exemplar_scene(q.extras, q.render, q.config.out, frame));
@@ -180,6 +189,49 @@ bool make_frames(const MethodEntry& method, const Request& q) {
   return true;
 }
 
+// One line per finished stage of a segment: "segment 1/2 (frames 1-8):
+// level 4/4 forward sweep, 12%, ETA 0:40"; false (cancel) once interrupted.
+StageProgress stage_lines(std::size_t index, std::size_t count, const Segment& s) {
+  const auto start = std::chrono::steady_clock::now();
+  return [=](double fraction, const std::string& finished) {
+    if (!finished.empty()) {
+      const double spent = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::cout << "segment " << index + 1 << "/" << count << " (frames " << s.first << "-" << s.last << "): "
+                << finished << ", " << std::lround(100 * fraction) << "%, ETA "
+                << clock_text(spent / fraction * (1 - fraction)) << std::endl;
+    }
+    return !interrupted();
+  };
+}
+
+// The segments of a method whose unit is the segment (all, or a farm task's
+// one) through the one unit loop; a run over the whole shot also writes the
+// contact sheet (and a light-path method's video). False if interrupted.
+bool make_segments(const MethodEntry& method, const Request& q) {
+  const std::unique_ptr<SegmentJob> job = make_method_segment_job(method, q.config, q.options);  // OUT/frames
+  job->inputs().refuse_folder(q.config.out);  // the contact sheet goes there too
+  for (const auto& w : job->warnings()) std::cerr << "tempera stylize: warning: " << w << "\n";
+  const std::vector<Segment>& segments = job->segments();
+  const auto run = [&](std::size_t i, const ProgressCallback&) {
+    return job->run_unit(i, stage_lines(i, segments.size(), segments[i]));
+  };
+  FrameLine line;
+  line.label = "segment";
+  line.which = [&](std::size_t i, const FrameResult&) { return concat("frames ", segments[i].first, "-", segments[i].last); };
+  std::vector<FrameResult> results;
+  if (!run_units(job->selected(), segments.size(), run, results, line)) return false;
+  const FrameTally t = tally(results);
+  std::cout << "tempera stylize: " << t.made << " segment(s) stylized, " << t.skipped
+            << " skipped (already current) in " << std::fixed << std::setprecision(1) << t.seconds << " s"
+            << std::defaultfloat << "; results in " << q.config.out << "\n";
+  if (!job->whole_shot()) return true;  // a farm task: the finish writes the sheet and the video
+  const fs::path sheet = fs::path(q.config.out) / "contact_sheet.png";
+  if (write_beside_frames("stylize", "the contact sheet", [&] { job->write_contact_sheet(sheet.string()); }))
+    std::cout << "contact sheet: " << sheet.string() << "\n";
+  if (method.light_path_guides) write_video(q.extras, job->inputs(), q.config);
+  return true;
+}
+
 }  // namespace
 
 int run_registered_method(const MethodEntry& method, const Args& args) {
@@ -189,14 +241,18 @@ int run_registered_method(const MethodEntry& method, const Args& args) {
   }
   Request q = parse(method, args);  // usage errors: exit status 2
   catch_interrupts();
+  const bool segments = method.unit == "segment";
+  const auto stopped = [&] { return report_interrupted("stylize", segments ? "segment" : "frame"); };
   try {
-    if (!q.scene.empty()) render_scene_guides(q.render, q.scene, q.frames_text, q.config.guides);
+    if (!q.scene.empty() && reads_guides(q.extras, false))
+      render_scene_guides(q.render, q.scene, q.frames_text, q.config.guides);
     render_exemplar_guides(q);
-    const bool stylize = q.extras.noise_reference.empty();  // else boil the given frames only
-    if (stylize && !make_frames(method, q)) return report_interrupted("stylize");
-    if (q.extras.noise() && !run_noise_pass(q.extras, noise_inputs(q))) return report_interrupted("stylize");
+    if (q.extras.noise_reference.empty()) {  // else boil the given frames only
+      if (!(segments ? make_segments(method, q) : make_frames(method, q))) return stopped();
+    }
+    if (q.extras.noise() && !run_noise_pass(q.extras, noise_inputs(q))) return stopped();
   } catch (const CancelledError&) {
-    return report_interrupted("stylize");
+    return stopped();
   }  // ValueError (bad values in the files or options) reaches main(): exit status 2
   return 0;
 }

@@ -240,7 +240,28 @@ TEST(RegisteredMethod, NamesMustBePlainAndNewAndAJobIsNeeded) {
   EXPECT_THROW(register_method(bad), ValueError);
   bad.name = "stylit";
   EXPECT_THROW(register_method(bad), ValueError);
+  bad.name = "segmentless";
+  bad.unit = "segment";  // the segment unit runs a SegmentJob: a frame job factory is not one
+  EXPECT_THROW(register_method(bad), ValueError);
   bad.name = "jobless";
+  bad.unit = "frame";
   bad.make_job = nullptr;
   EXPECT_THROW(register_method(bad), ValueError);
+}
+
+TEST(RegisteredMethod, TheCoherentMethodIsASegmentJobOfTheOneCommand) {
+  const MethodEntry& tcia = find_method("tcia");
+  EXPECT_EQ(tcia.unit, "segment");
+  EXPECT_TRUE(tcia.make_segment_job && !tcia.make_job);
+  EXPECT_NE(tcia.options_help.find("--segment A-B"), std::string::npos);
+  JobConfig config;  // the options are read before any file
+  config.exemplar = "nowhere.png", config.guides = "nowhere", config.frames = {1, 2}, config.out = "nowhere_out";
+  try {
+    make_method_segment_job(tcia, config, {{"segment", "3"}});
+    FAIL() << "--segment 3 is no segment";
+  } catch (const ValueError& e) {
+    EXPECT_NE(std::string(e.what()).find("--segment expects A-B"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(make_method_job(tcia, config, {}), ValueError);  // not a frame job
+  EXPECT_FALSE(fs::exists("nowhere_out"));
 }

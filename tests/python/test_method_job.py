@@ -72,7 +72,7 @@ def test_a_registered_job_cancels_and_names_bad_options(shot):
         registry.make_job("lazyfluids", shot / "smoke.png", shot / "guides", [1, 2], shot / "o", options={"bogus": 1})
     with pytest.raises(ValueError, match="temporal weight"):  # --lambda is λ, the temporal weight
         registry.make_job("lazyfluids", shot / "smoke.png", shot / "guides", [1, 2], shot / "o", options={"lambda": -1})
-    with pytest.raises(ValueError, match="no job factory"):
+    with pytest.raises(ValueError, match="no frame job factory: its unit is the segment"):
         registry.make_job("tcia", shot / "smoke.png", shot / "guides", [1, 2], shot / "o")
     with pytest.raises(ValueError, match="runs in Python"):
         registry.make_job("rigid", shot / "smoke.png", shot / "guides", [1, 2], shot / "o")

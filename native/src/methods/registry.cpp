@@ -38,8 +38,10 @@ void register_method(MethodEntry entry) {
   if (!plain) throw ValueError(concat("a method's name is a plain lower-case word, got '", entry.name, "'"));
   for (const MethodEntry& m : registry())
     if (m.name == entry.name) throw ValueError(concat("the method '", entry.name, "' is registered already"));
-  if (!entry.make_job && entry.python_command.empty())
-    throw ValueError(concat("the method '", entry.name, "' has no job (make_job) to run"));
+  const bool segments = entry.unit == "segment";
+  if (entry.python_command.empty() && !(segments ? bool(entry.make_segment_job) : bool(entry.make_job)))
+    throw ValueError(concat("the method '", entry.name, "' has no job (", segments ? "make_segment_job" : "make_job",
+                            ") to run"));
   registry().push_back(std::move(entry));
 }
 
@@ -82,13 +84,28 @@ const MethodEntry& find_method(const std::string& name) {
   throw ValueError(concat("unknown --method '", name, "' (choose ", choices, ")"));
 }
 
+namespace {
+
+// What a method without the asked kind of job runs by instead.
+ValueError no_job_factory(const MethodEntry& method, const char* kind) {
+  return ValueError(concat("--method ", method.name, " has no ", kind, " job factory: ",
+                           method.python_command.empty() ? concat("its unit is the ", method.unit, " (", method.docs, ")")
+                                                         : concat("it runs in Python (", method.python_command, ")")));
+}
+
+}  // namespace
+
 std::unique_ptr<FrameJob> make_method_job(const MethodEntry& method, JobConfig config, const MethodOptions& options) {
-  if (!method.make_job)
-    throw ValueError(concat("--method ", method.name, " has no job factory: ",
-                            method.python_command.empty() ? "it has a command and a binding of its own (" + method.docs + ")"
-                                                          : "it runs in Python (" + method.python_command + ")"));
+  if (!method.make_job) throw no_job_factory(method, "frame");
   config.out = (std::filesystem::path(config.out) / "frames").string();
   return method.make_job(config, options);
+}
+
+std::unique_ptr<SegmentJob> make_method_segment_job(const MethodEntry& method, JobConfig config,
+                                                    const MethodOptions& options) {
+  if (!method.make_segment_job) throw no_job_factory(method, "segment");
+  config.out = (std::filesystem::path(config.out) / "frames").string();
+  return method.make_segment_job(config, options);
 }
 
 }  // namespace tempera

@@ -16,6 +16,7 @@
 
 #include "tempera/app/frame_job.hpp"
 #include "tempera/app/job_config.hpp"
+#include "tempera/app/segment_job.hpp"
 #include "tempera/engine/error.hpp"
 
 namespace tempera {
@@ -28,6 +29,8 @@ using MethodOptions = std::vector<std::pair<std::string, std::string>>;
 // format, resume; out is the frames' folder, OUT/frames: make_method_job) and its own options: ValueError naming a bad or unknown
 // option, the errors of its inputs (files, sizes) as any job's.
 using MakeJob = std::function<std::unique_ptr<FrameJob>(const JobConfig&, const MethodOptions&)>;
+// The same for a method whose unit is the segment (app/segment_job.hpp).
+using MakeSegmentJob = std::function<std::unique_ptr<SegmentJob>(const JobConfig&, const MethodOptions&)>;
 
 struct MethodEntry {
   std::string name;     // --method NAME; the panel's item is NAME in capitals
@@ -47,12 +50,13 @@ struct MethodEntry {
   // Where it runs: "" for the native command; else the Python function that
   // runs `tempera stylize --method NAME ...` ("module:function").
   std::string python_command;
-  // The job, for a method that the registry's one command runs
-  // (cli/method_command.cpp: flags, resume, progress, Ctrl-C, a .blend's
-  // guides, and for a light-path method the exemplar scene, the video and
-  // the noise pass); empty for the coherent method, which solves segments
-  // in its own command (cli/stylize_command.cpp).
+  // The job, which the registry's one command runs (cli/method_command.cpp:
+  // flags, resume, progress, Ctrl-C, a .blend's guides, and for a
+  // light-path method the exemplar scene, the video and the noise pass):
+  // make_job for the units "frame" and "chained frame", make_segment_job for
+  // "segment"; neither for a method that runs in Python.
   MakeJob make_job;
+  MakeSegmentJob make_segment_job;
   // Its own options, for --help: "  --strength S   ...\n" lines. Given alone
   // (no value), an option arrives with the text "" (set_from_text: a switch).
   std::string options_help;
@@ -90,5 +94,8 @@ const MethodEntry& find_method(const std::string& name);
 // video, the generated exemplar, the guides). ValueError for a method
 // without a job factory.
 std::unique_ptr<FrameJob> make_method_job(const MethodEntry& method, JobConfig config, const MethodOptions& options);
+// The same for a method whose unit is the segment.
+std::unique_ptr<SegmentJob> make_method_segment_job(const MethodEntry& method, JobConfig config,
+                                                    const MethodOptions& options);
 
 }  // namespace tempera

@@ -332,4 +332,22 @@ SegmentResult TciaJob::run_segment(std::size_t index, const SegmentProgress& pro
   return result;
 }
 
+FrameResult TciaJob::run_unit(std::size_t index, const StageProgress& progress) {
+  const Segment& segment = segments_.at(index);
+  SegmentProgress sweeps;
+  if (progress)
+    sweeps = [&](const SweepProgress& p) {  // p.frame is a frame number here
+      const bool sweep_done = p.direction > 0 ? p.frame == segment.last : p.frame == segment.first;
+      return progress(p.fraction, sweep_done ? concat("level ", p.levels - p.level, "/", p.levels,
+                                                      p.direction > 0 ? " forward" : " backward", " sweep")
+                                             : "");
+    };
+  const SegmentResult r = run_segment(index, sweeps);
+  FrameResult unit;
+  unit.frame = segment.first;
+  unit.status = r.status;
+  unit.seconds = r.seconds;
+  return unit;
+}
+
 }  // namespace tempera

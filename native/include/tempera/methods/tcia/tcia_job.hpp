@@ -16,6 +16,7 @@
 #include "tempera/app/segments.hpp"
 #include "tempera/app/light_path_guides.hpp"
 #include "tempera/app/light_path_shot.hpp"
+#include "tempera/app/segment_job.hpp"
 #include "tempera/methods/tcia/tcia.hpp"
 
 namespace tempera {
@@ -122,18 +123,23 @@ struct SegmentResult {
 // Where a segment's sweeps are: SweepProgress with the frame as a frame number.
 using SegmentProgress = std::function<bool(const SweepProgress&)>;
 
-class TciaJob {
+class TciaJob : public SegmentJob {
  public:
   // Validates everything up front (files, guides, keys, sizes).
   explicit TciaJob(TciaJobConfig config);
 
-  const std::vector<Segment>& segments() const { return segments_; }
+  const std::vector<Segment>& segments() const override { return segments_; }
   // The indices of the segments to run: all, or the one of config.segment.
-  const std::vector<std::size_t>& selected() const { return selected_; }
+  const std::vector<std::size_t>& selected() const override { return selected_; }
+  bool whole_shot() const override { return !config_.segment; }
   // The painting, the exemplar's guides, the shot's frames (those read) and the outputs' names.
   const LightPathShot& shot() const { return shot_; }
+  const JobInputs& inputs() const override { return shot_.inputs(); }
   std::string output_path(int frame) const { return shot_.output_path(frame); }
-  const std::vector<std::string>& warnings() const { return warnings_; }
+  const std::vector<std::string>& warnings() const override { return warnings_; }
+  void write_contact_sheet(const std::string& path, int columns = 0) const override {
+    shot_.write_contact_sheet(path, columns);
+  }
   std::string record_path(std::size_t index) const;
   // Layer `layer`'s frame (OUT/layers/NAME/frame_0001.png) and its record for segment `index`.
   std::string layer_path(std::size_t layer, int frame) const;
@@ -143,6 +149,8 @@ class TciaJob {
   // writes its frames. `progress` returning false cancels: CancelledError,
   // nothing written.
   SegmentResult run_segment(std::size_t index, const SegmentProgress& progress = {});
+  // run_segment for the job core: a stage is a finished sweep.
+  FrameResult run_unit(std::size_t index, const StageProgress& progress = {}) override;
 
  private:
   std::string segment_key(const Segment& segment) const;
