@@ -45,7 +45,7 @@ struct FrameLine {
   bool eta = false;  // ", ETA 1:05" once a frame was made
 };
 
-// The one loop over a job's units of work (frames, tcia's segments): runs
+// The one loop over a job's units of work (frames, or a segment job's segments): runs
 // `run(unit)` for each of `units` in order, with until_interrupted() as its
 // cancel, one line each, "frame 3/24 (#3): 1.23 s" or "frame 3/24 (#3):
 // skipped, already current" (24 = `total`), and appends its result to

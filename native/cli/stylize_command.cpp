@@ -37,17 +37,11 @@ const char* kStylizeHelpText =
     "  --no-resume             stylize every frame again, even if current\n"
     "@EXTRAS@"
     "\n"
-    "StyLit (--method stylit, the default):\n"
-    "@STYLIT@"
-    "\n"
     "method:\n"
     "  --method M              the method (default stylit); each has its own options\n"
     "                          (tempera stylize --method M --help):\n"
     "@METHODS@"
-    "\n"
-    "the coherent method (--method tcia): the whole shot in forward and backward sweeps along\n"
-    "the motion: consecutive frames with velocity_forward/backward and occlusion_forward/backward:\n"
-    "@TCIA@"
+    "@LIGHT_PATH_METHODS@"
     "\n"
     "guide rendering (SCENE.blend / --exemplar-scene only):\n"
     "  --samples N             Cycles samples of the guide renders (default 16)\n"
@@ -69,17 +63,25 @@ std::string methods_help() {
   return out;
 }
 
-// The overview: StyLit's outputs and resume, the core's flags, the
-// light-path extras, StyLit's and the coherent method's options (their
-// registry entries') and the methods.
+// The options of each method that matches a painting by light-path guides,
+// under its title: the methods this overview is about.
+std::string light_path_methods_help() {
+  std::string out;
+  for (const MethodEntry& m : method_registry())
+    if (m.light_path_guides) out += concat("\n", m.title, " (--method ", m.name, "):\n", m.options_help);
+  return out;
+}
+
+// The overview: the default method's outputs and resume, the core's flags,
+// the light-path extras, the methods, and the light-path methods' options
+// (their registry entries').
 std::string stylize_help() {
   std::string text = kStylizeHelpText;
   const auto put = [&](const std::string& key, const std::string& value) { text.replace(text.find(key), key.size(), value); };
-  put("@DETAILS@", find_method("stylit").help_details);  // its outputs and resume
+  put("@DETAILS@", find_method(method_of({})).help_details);  // its outputs and resume
   put("@EXTRAS@", light_path_extras_help());
-  put("@STYLIT@", find_method("stylit").options_help);
   put("@METHODS@", methods_help());
-  put("@TCIA@", find_method("tcia").options_help);
+  put("@LIGHT_PATH_METHODS@", light_path_methods_help());
   return text;
 }
 

@@ -8,7 +8,7 @@
 #include "tempera/app/light_path_guides.hpp"
 #include "tempera/engine/distance_transform.hpp"
 #include "tempera/engine/motion.hpp"
-#include "tempera/methods/tcia/orientation.hpp"
+#include "tempera/engine/orientation.hpp"
 
 namespace py = pybind11;
 using namespace tempera;

@@ -11,7 +11,7 @@
 
 #include "tempera/engine/error.hpp"
 #include "tempera/tracer/lpe.hpp"
-#include "tempera/methods/tcia/orientation.hpp"
+#include "tempera/engine/orientation.hpp"
 #include "tempera/engine/parallel.hpp"
 #include "tempera/app/paths.hpp"
 

@@ -4,7 +4,7 @@
 #include <numbers>
 
 #include "tempera/engine/error.hpp"
-#include "tempera/methods/tcia/orientation.hpp"
+#include "tempera/engine/orientation.hpp"
 
 using namespace tempera;
 

@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "tempera/methods/tcia/orientation.hpp"
+#include "tempera/engine/orientation.hpp"
 #include "tempera/methods/tcia/tcia.hpp"
 #include "tcia_measures.hpp"
 

@@ -2,7 +2,7 @@
 // The resume record of a job's unit of work (a frame, a segment): the key of
 // everything the unit was made from and a digest of every file it wrote.
 //
-//   <format line>                  the job's record format, e.g. "tempera-tcia-segment 1"
+//   <format line>                  the job's record format, e.g. "tempera-<method>-frame 2"
 //   <key>                          hash of the settings and inputs
 //   <file name> <size> <checksum>  one line per file written, in order
 //

@@ -1,8 +1,8 @@
 #pragma once
 // The segment unit of work (the job core's third, after the independent and
 // the chained frame): a shot cut at its key frames into pieces solved
-// together, each independent of the others (the coherent method's painted
-// keys bound its sweeps on both sides: tcia_job.hpp). One rule, used by the coherent
+// together, each independent of the others (painted keys bound the solve
+// on both sides: app/segment_job.hpp). One rule, used by the segment
 // method's job, its Python wrapper and the farm planner (through the
 // binding); farm/flamenco/tempera.js holds the one copy that cannot call it,
 // tested against it.

@@ -11,7 +11,7 @@
 #include "tempera/app/file_keys.hpp"
 #include "tempera/app/image_io.hpp"
 #include "tempera/engine/option_table.hpp"
-#include "tempera/methods/tcia/orientation.hpp"
+#include "tempera/engine/orientation.hpp"
 #include "tempera/app/paths.hpp"
 #include "tempera/app/record.hpp"
 #include "tempera/app/text_file.hpp"

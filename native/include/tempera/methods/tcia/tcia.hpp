@@ -36,7 +36,7 @@ struct ShotFrame {
   ImageView velocity_backward, velocity_forward;   // V-, V+: 2 channels, pixels, x right, y down
   ImageView occlusion_backward, occlusion_forward; // χ-, χ+: 1 channel, 1 = visible in the neighbour frame
   // O(I_t) (§3.1), optional: 1 channel, radians, the edge direction
-  // (orientation.hpp): the tensor's angle or the artist's AOV. With the
+  // (engine/orientation.hpp): the tensor's angle or the artist's AOV. With the
   // style's orientation too, patches are compared rotated by the smallest
   // angle between the two, so hatching follows the frame's field.
   ImageView orientation;

@@ -1,4 +1,4 @@
-#include "tempera/methods/tcia/orientation.hpp"
+#include "tempera/engine/orientation.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -16,10 +16,10 @@ import numpy as np
 from bpy.props import IntProperty
 from bpy.types import Operator, UIList
 
-from . import compat, results
-from .guide_operator import resolve_guide_dir
-from .kit_operators import ImageFileChooser
-from .setting_paths import FRAMES_DIR, output_dir, resolve_path
+from ... import compat, results
+from ...guide_operator import resolve_guide_dir
+from ...kit_operators import ImageFileChooser
+from ...setting_paths import FRAMES_DIR, output_dir, resolve_path
 
 LOW_CONTRAST = 0.4  # the render's tones squeezed around mid grey: a ground to paint on, not a picture
 

@@ -7,9 +7,9 @@ import re
 
 from bpy.types import Operator, UIList
 
-from ..app import guide_cache
+from ....app import guide_cache
 from .keyframes import remove_selected
-from .setting_paths import resolve_path
+from ...setting_paths import resolve_path
 
 
 def layer_name(collection_name):

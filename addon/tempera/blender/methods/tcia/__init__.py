@@ -1,5 +1,5 @@
 """The coherent method in the panel (Bénard et al. 2013, docs/engine.md):
-its painted keyframes and layers (tempera.blender.keyframes, .layers), its
+its painted keyframes and layers (.keyframes, .layers), its
 settings, and Stylize Animation's run, one segment between keys per step
 (tempera.methods.tcia.tcia.ShotJob; each resumable, Esc stops within a
 segment and nothing of it is written). It shares StyLit's settings (quality,
@@ -13,15 +13,15 @@ from bpy.props import BoolProperty, CollectionProperty, EnumProperty, FloatPrope
     StringProperty
 from bpy.types import PropertyGroup
 
-from ...app import guide_cache
-from ...app.frames import MAX_FRAME
-from ...methods.tcia import tcia
-from .. import keyframes, layers
-from ..guide_operator import format_duration
-from ..keyframes import TEMPERA_OT_add_keyframe, TEMPERA_OT_import_keyframe, TEMPERA_OT_remove_keyframe, key_list
-from ..layers import TEMPERA_OT_add_tcia_layer, TEMPERA_OT_remove_tcia_layer, layer_list
-from ..panels import draw_stylit
-from ..stylize_operator import StylizeRun, require_consecutive
+from ....app import guide_cache
+from ....app.frames import MAX_FRAME
+from ....methods.tcia import tcia
+from . import keyframes, layers
+from ...guide_operator import format_duration
+from .keyframes import TEMPERA_OT_add_keyframe, TEMPERA_OT_import_keyframe, TEMPERA_OT_remove_keyframe, key_list
+from .layers import TEMPERA_OT_add_tcia_layer, TEMPERA_OT_remove_tcia_layer, layer_list
+from ...panels import draw_stylit
+from ...stylize_operator import StylizeRun, require_consecutive
 
 MEDIUM = False
 EXEMPLAR_MASKS = False
@@ -30,7 +30,7 @@ DEFAULT_KEYFRAME_DIR = "//tempera/keys/"
 
 
 class TemperaKeyframe(PropertyGroup):
-    """A painted keyframe of the coherent method (tempera.blender.keyframes)."""
+    """A painted keyframe of the coherent method (.keyframes)."""
 
     frame: IntProperty(name="Frame", description="The frame this painting is of", default=1, min=0,
                        max=MAX_FRAME)
@@ -44,7 +44,7 @@ class TemperaKeyframe(PropertyGroup):
 
 
 class TemperaLayer(PropertyGroup):
-    """A layer of the coherent method (tempera.blender.layers): a collection painted and synthesized alone."""
+    """A layer of the coherent method (.layers): a collection painted and synthesized alone."""
 
     collection: PointerProperty(name="Collection", type=bpy.types.Collection,
                                 description="The collection of this layer (its mask guide)")
