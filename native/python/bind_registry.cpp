@@ -1,9 +1,10 @@
 // Python binding of the method registry (methods/registry.hpp) and of the
-// job core's per-frame job (app/frame_job.hpp): the registry's entries as
-// dicts, FrameJob as the one base class of every per-frame job (each
-// method's job class derives from it in Python too), and method_job, the job of any method with a job factory (make_job),
-// so that a registered method runs from Python with no binding of its own
-// (tempera.methods.registry.make_job).
+// job core's units of work: the registry's entries as dicts, FrameJob
+// (app/frame_job.hpp) and SegmentJob (app/segment_job.hpp) as the base
+// classes of every method's job (each method's job class derives from one
+// in Python too), and method_job / method_segment_job, the job of any method
+// with a job factory, so that a registered method runs from Python with no
+// binding of its own (tempera.methods.registry.make_job).
 #include <pybind11/stl.h>
 
 #include "bind_frame_job.hpp"
@@ -21,7 +22,7 @@ py::dict method_dict(const MethodEntry& e) {
   d["name"] = e.name, d["title"] = e.title, d["summary"] = e.summary, d["paper"] = e.paper;
   d["unit"] = e.unit, d["light_path_guides"] = e.light_path_guides, d["docs"] = e.docs;
   d["python_command"] = e.python_command;
-  d["job"] = bool(e.make_job);
+  d["job"] = bool(e.make_job) || bool(e.make_segment_job);
   d["options_help"] = e.options_help;
   d["default_exemplar"] = e.default_exemplar;
   return d;
@@ -58,6 +59,42 @@ void bind_frame_job_class(py::module_& m) {
           "The exemplar followed by the frames written so far, as one image (atomic).");
 }
 
+void bind_segment_job_class(py::module_& m) {
+  py::class_<SegmentJob>(m, "SegmentJob",
+                         "The job core's segment job (app/segment_job.hpp); use tempera.app.segment_job.")
+      .def_property_readonly("segments",
+                             [](const SegmentJob& job) {
+                               py::list out;
+                               for (const auto& s : job.segments()) out.append(py::make_tuple(s.first, s.last, s.writes));
+                               return out;
+                             })
+      .def_property_readonly("selected", &SegmentJob::selected)
+      .def_property_readonly("whole_shot", &SegmentJob::whole_shot)
+      .def_property_readonly("warnings", &SegmentJob::warnings)
+      .def(
+          "run_unit",
+          [](SegmentJob& job, std::size_t index, const py::object& progress) {
+            const StageProgress callback = py_bridge::python_stage_progress(progress);
+            FrameResult r;
+            {
+              py::gil_scoped_release release;
+              r = job.run_unit(index, callback);
+            }
+            return py_bridge::frame_result(r);
+          },
+          py::arg("index"), py::arg("progress") = py::none(),
+          "Solves segments[index] or skips it when current; progress(fraction, finished stage or '') returning "
+          "False cancels.")
+      .def(
+          "write_contact_sheet",
+          [](const SegmentJob& job, const std::string& path, int columns) {
+            py::gil_scoped_release release;
+            job.write_contact_sheet(path, columns);
+          },
+          py::arg("path"), py::arg("columns") = 0,
+          "The exemplar followed by the frames written so far, as one image (atomic).");
+}
+
 // The job of `name` from the core's config (a dict: exemplar, guides, frames,
 // out, format, resume; the frames go to OUT/frames) and the method's options as the command line takes
 // them ((flag without "--", text) pairs; "" for a switch alone).
@@ -69,10 +106,21 @@ std::unique_ptr<FrameJob> method_job(const std::string& name, const py::dict& co
   return make_method_job(method, c, options);
 }
 
+// The same for a method whose unit is the segment.
+std::unique_ptr<SegmentJob> method_segment_job(const std::string& name, const py::dict& config,
+                                               const MethodOptions& options) {
+  const MethodEntry& method = find_method(name);
+  JobConfig c;
+  py_bridge::read_job_config(config, c, concat("the ", name, " job's config"));
+  py::gil_scoped_release release;  // the job reads its inputs' headers
+  return make_method_segment_job(method, c, options);
+}
+
 }  // namespace
 
 void bind_registry(py::module_& m) {
   bind_frame_job_class(m);
+  bind_segment_job_class(m);
   m.def(
       "methods",
       [] {
@@ -81,10 +129,14 @@ void bind_registry(py::module_& m) {
         return out;
       },
       "The method registry (methods/registry.hpp): a dict per method (name, title, summary, paper, unit, "
-      "light_path_guides, docs, python_command, job: has a job factory, options_help, default_exemplar), in the panel's order.");
+      "light_path_guides, docs, python_command, job: has a job factory (a segment job's for the unit 'segment'), "
+      "options_help, default_exemplar), in the panel's order.");
   m.def(
       "find_method", [](const std::string& name) { return method_dict(find_method(name)); }, py::arg("name"),
       "The registry's entry of `name`; ValueError naming every method.");
+  m.def("method_segment_job", &method_segment_job, py::arg("name"), py::arg("config"),
+        py::arg("options") = MethodOptions{},
+        "The SegmentJob of a method whose unit is the segment, as tempera stylize --method NAME runs it.");
   m.def("method_job", &method_job, py::arg("name"), py::arg("config"), py::arg("options") = MethodOptions{},
         "The FrameJob of a method with a job factory, as tempera stylize --method NAME runs it; ValueError for "
         "an unknown method, option or value, or a method without one.");

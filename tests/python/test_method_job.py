@@ -38,10 +38,11 @@ def shot(tmp_path):
 
 def test_the_registry_says_which_methods_have_a_job_factory():
     jobs = {m["name"] for m in registry.METHODS if m["job"]}
-    assert {"stylit", "lazyfluids", "fluidymation"} <= jobs and not {"tcia", "rigid"} & jobs
+    assert {"stylit", "tcia", "lazyfluids", "fluidymation"} <= jobs and "rigid" not in jobs
     assert "--lambda" in registry.find("lazyfluids")["options_help"]
     for job_class in (_native.StylizeJob, _native.NoisySequence, _native.LazyFluidsJob, _native.FluidymationJob):
         assert issubclass(job_class, _native.FrameJob)
+    assert issubclass(_native.TciaJob, _native.SegmentJob)
 
 
 def test_lazyfluids_by_the_registry_equals_its_own_class(shot):
@@ -72,8 +73,6 @@ def test_a_registered_job_cancels_and_names_bad_options(shot):
         registry.make_job("lazyfluids", shot / "smoke.png", shot / "guides", [1, 2], shot / "o", options={"bogus": 1})
     with pytest.raises(ValueError, match="temporal weight"):  # --lambda is λ, the temporal weight
         registry.make_job("lazyfluids", shot / "smoke.png", shot / "guides", [1, 2], shot / "o", options={"lambda": -1})
-    with pytest.raises(ValueError, match="no frame job factory: its unit is the segment"):
-        registry.make_job("tcia", shot / "smoke.png", shot / "guides", [1, 2], shot / "o")
     with pytest.raises(ValueError, match="runs in Python"):
         registry.make_job("rigid", shot / "smoke.png", shot / "guides", [1, 2], shot / "o")
     with pytest.raises(ValueError, match="unknown --method 'ebsynth'"):
@@ -109,6 +108,42 @@ def test_stylit_by_the_registry_equals_its_own_class(tmp_path):
     with pytest.raises(ValueError, match="unknown option '--noise' for --method stylit"):
         registry.make_job("stylit", *inputs[::2], [1], tmp_path / "o",
                           options={"exemplar-guides": inputs[1], "noise": 2})
+
+
+def test_the_coherent_method_by_the_registry_equals_its_own_class(tmp_path):
+    """The segment unit from Python: make_job("tcia") gives a segment job
+    whose frames equal the coherent method's own class, byte for byte, with
+    the stages of its sweeps as progress; it resumes and cancels the same."""
+    from tempera.methods.tcia.tcia import ShotJob
+
+    frames = range(1, 6)
+    make_cache(tmp_path / "cache", frames=tuple(frames), forward=True)
+    make_exemplar(tmp_path / "exemplar", tmp_path / "paint.png")
+    key = tmp_path / "key3.png"
+    tempera.write_image(str(key), np.roll(read_image(str(tmp_path / "paint.png")), 5, axis=1)[::-1].copy())
+    inputs = (tmp_path / "paint.png", tmp_path / "cache", frames)
+    own = ShotJob(tmp_path / "paint.png", tmp_path / "exemplar", tmp_path / "cache", frames, tmp_path / "own",
+                  keys=[(3, key)], weights={"LDE": 3}, levels=2, patch_size=7, threads=2)
+    flags = [("exemplar-guides", tmp_path / "exemplar"), ("key", f"3={key}"), ("weights", "LDE=3"),
+             ("levels", 2), ("patch-size", 7), ("threads", 2)]
+    job = registry.make_job("tcia", *inputs, tmp_path / "reg", options=flags)
+    assert [s[:2] for s in job.segments] == [(1, 3), (3, 5)] and job.selected == [0, 1] and job.whole_shot
+    stages = []
+    for i in job.selected:
+        made = job.run_segment(i, progress=lambda fraction, finished: stages.append(finished) or True)
+        assert made["status"] == own.run_segment(i)["status"] == "stylized" and made["frame"] == job.segments[i][0]
+    assert "level 2/2 backward sweep" in stages and "level 1/2 forward sweep" in stages
+    for f in frames:
+        assert (tmp_path / "reg" / "frames" / f"frame_{f:04d}.png").read_bytes() == \
+            open(own.output_path(f), "rb").read()
+    assert [job.run_segment(i)["status"] for i in job.selected] == ["skipped"] * 2  # resume
+    task = registry.make_job("tcia", *inputs, tmp_path / "task", options=flags + [("segment", "3-5")])
+    assert task.selected == [1] and not task.whole_shot  # a farm task
+    with pytest.raises(tempera.Cancelled):
+        task.run_segment(1, progress=lambda fraction, finished: False)
+    assert not (tmp_path / "task" / "frames" / "frame_0004.png").exists()
+    with pytest.raises(ValueError, match="--segment expects A-B"):
+        registry.make_job("tcia", *inputs, tmp_path / "o", options=flags + [("segment", "3")])
 
 
 def test_fluidymation_by_the_registry_equals_its_own_class(tmp_path):

@@ -5,12 +5,14 @@ from __future__ import annotations
 
 import importlib
 import os
+from collections.abc import Mapping
 
 from .. import _native
 from ..app.frame_job import MethodJob
+from ..app.segment_job import MethodSegmentJob
 
 # dicts: name, title, summary, paper, unit, light_path_guides, docs, python_command,
-# job (a job factory: make_job runs it), options_help
+# job (a job factory: make_job runs it), options_help, default_exemplar
 METHODS = tuple(_native.methods())
 
 
@@ -50,18 +52,24 @@ def _option_text(value) -> str:
 def make_job(name: str, exemplar, guides, frames, out, *, format: str = "png", resume: bool = True,
              options: dict = None):
     """The job of a method with a job factory (its entry's ``job``: built in or
-    a registered plug-in), as ``tempera stylize --method NAME``
-    runs it: a tempera.app.frame_job.MethodJob; run ``run_frame(i)`` for each
-    frame index. Its frames go to OUT/frames, as for every method.
+    a registered plug-in), as ``tempera stylize --method NAME`` runs it: a
+    tempera.app.frame_job.MethodJob (run ``run_frame(i)`` for each frame
+    index), or for a method whose unit is the segment (the coherent method) a
+    tempera.app.segment_job.MethodSegmentJob (``run_segment(i)`` for i in
+    ``selected``). Its frames go to OUT/frames, as for every method.
 
     ``options`` are the method's, keyed by their command-line flags without
     the dashes (``{"lambda": 0.3, "motion_blur": 4, "rotations": True}``;
     ``_`` stands for ``-``), as ``tempera stylize --method NAME --help`` lists
-    them. ValueError for an unknown method, option or value, or a method
-    without a job factory (the coherent method solves segments, in
-    tempera.methods.tcia; rigid runs in tempera.methods.rigid). StyLit takes
-    the exemplar render's guide cache as ``{"exemplar-guides": DIR}``."""
+    them. A flag given more than once (the coherent method's ``key``): a
+    list of (flag, value) pairs instead of the dict. ValueError for an
+    unknown method, option or value, or a method without a job factory
+    (rigid runs in tempera.methods.rigid). StyLit and the coherent method
+    take the exemplar render's guide cache as ``{"exemplar-guides": DIR}``."""
     config = dict(exemplar=os.fspath(exemplar), guides=os.fspath(guides), frames=[int(f) for f in frames],
                   out=os.fspath(out), format=str(format), resume=bool(resume))
-    flags = [(str(flag).replace("_", "-"), _option_text(value)) for flag, value in (options or {}).items()]
+    pairs = options.items() if isinstance(options, Mapping) else (options or ())
+    flags = [(str(flag).replace("_", "-"), _option_text(value)) for flag, value in pairs]
+    if find(name)["unit"] == "segment":
+        return MethodSegmentJob(_native.method_segment_job(str(name), config, flags))
     return MethodJob(_native.method_job(str(name), config, flags))

@@ -97,22 +97,14 @@ Shot shot_from(const FloatArray& style, const py::list& guides, const py::list& 
 }
 
 void bind_tcia(py::module_& m) {
-  py::class_<TciaJob>(m, "TciaJob", "The coherent method over a guide cache; use tempera.methods.tcia.tcia.ShotJob.")
+  py::class_<TciaJob, SegmentJob>(m, "TciaJob",
+                                  "The coherent method over a guide cache; use tempera.methods.tcia.tcia.ShotJob.")
       .def(py::init([](const py::dict& config, const TciaOptions& options) {
              TciaJobConfig c = job_config(config, options);
              py::gil_scoped_release release;  // reads the painting, keys and cache headers
              return std::make_unique<TciaJob>(std::move(c));
            }),
            py::arg("config"), py::arg("options"))
-      .def_property_readonly("segments",
-                             [](const TciaJob& job) {
-                               py::list out;
-                               for (const auto& s : job.segments())
-                                 out.append(py::make_tuple(s.first, s.last, s.writes));
-                               return out;
-                             })
-      .def_property_readonly("selected", &TciaJob::selected)
-      .def_property_readonly("warnings", &TciaJob::warnings)
       .def("output_path", &TciaJob::output_path, py::arg("frame"))
       .def("record_path", &TciaJob::record_path)
       .def("layer_path", &TciaJob::layer_path, py::arg("layer"), py::arg("frame"))
@@ -136,14 +128,7 @@ void bind_tcia(py::module_& m) {
             }
             return py::make_tuple(r.status, r.seconds);
           },
-          py::arg("index"), py::arg("progress") = nullptr)
-      .def(
-          "write_contact_sheet",
-          [](const TciaJob& job, const std::string& path, int columns) {
-            py::gil_scoped_release release;
-            job.shot().write_contact_sheet(path, columns);
-          },
-          py::arg("path"), py::arg("columns") = 0);
+          py::arg("index"), py::arg("progress") = nullptr);
   py_bridge::bind_options_class<TciaOptions>(m, "TciaOptions", tcia_option_table(),
                                              "Options of Bénard et al. 2013 (native/include/tempera/methods/tcia/tcia.hpp).")
       .def_readwrite("synthesis", &TciaOptions::synthesis, "engine options (defaults: tcia_defaults())");
