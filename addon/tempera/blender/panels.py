@@ -8,8 +8,9 @@ import bpy
 from bpy.types import Panel
 
 from .. import __version__
-from . import methods
+from . import methods, noise_pass
 from .guide_operator import TEMPERA_OT_render_guides, cache_status
+from .layout import wide_prop
 from .kit_operators import (TEMPERA_OT_choose_painting, TEMPERA_OT_painting_template, TEMPERA_OT_register_painting,
                             painting_preview)
 from .properties import WEIGHT_PROPERTIES
@@ -20,18 +21,7 @@ from .stylize_operator import TEMPERA_OT_stylize
 THUMBNAIL_SCALE = 6.0
 # Labels shortened in the panel to fit its default width (the tooltip keeps the full name).
 SHORT_LABELS = {"weight_ld12e": "Two Diffuse Bounces"}
-LABEL_FACTOR = 0.5  # share of a wide-label row given to its label
 STATUS_WIDTH = 38  # characters per status line at the default Properties width
-
-
-def wide_prop(layout, data, name, text=None):
-    """A two-column row whose label column is wider than property split's
-    40 %, for labels that would be cut at the default Properties width."""
-    row = layout.split(factor=LABEL_FACTOR, align=True)
-    label = row.column()
-    label.alignment = "RIGHT"
-    label.label(text=text if text is not None else data.bl_rna.properties[name].name)
-    row.prop(data, name, text="")
 
 
 def status_lines(layout, text, icon):
@@ -153,24 +143,7 @@ def draw_stylit(box, settings):
     wide_prop(col, settings, "temporal_weight")
     col.prop(settings, "patch_size")
     col.prop(settings, "seed")
-    draw_noise(box, settings)
-
-
-def draw_noise(box, settings):
-    """Temporal Noise (Color Me Noisy): the slider, its width f, the map picker."""
-    from ..methods.noisy import noisy
-
-    col = box.column()
-    wide_prop(col, settings, "noise_level")
-    if settings.noise_level == 0:
-        return
-    col.label(text=f"f = {noisy.noise_width(settings.noise_level)} px: frames boil into Output Folder/noisy")
-    col.prop(settings, "noise_guided")
-    col.prop(settings, "noise_map_source")
-    field = {"IMAGE": "noise_map_image", "OBJECT": "noise_map_object", "COLLECTION": "noise_map_collection",
-             "GUIDE": "noise_map_guide"}.get(settings.noise_map_source)
-    if field:
-        col.prop(settings, field)
+    noise_pass.draw(box, settings)
 
 
 def draw_media_exemplar(box, settings, masks):

@@ -1,14 +1,12 @@
 """Per-scene Tempera settings, stored in the .blend file as Scene.tempera."""
-import bpy
-from bpy.props import (BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty,
-                       StringProperty)
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 from bpy.types import PropertyGroup
 
 from ..app import guide_cache
 from ..methods import registry
-from ..methods.noisy import noisy
 from ..app import settings as limits
 from ..app.frames import MAX_FRAME
+from . import noise_pass
 from .methods import tooltip
 
 DEFAULT_GUIDE_DIR = "//tempera/guides/"
@@ -259,30 +257,8 @@ class TemperaSettings(PropertyGroup):
                              description="Also encode the stylized animation as an mp4 (needs ffmpeg)")
     load_result: EnumProperty(name="Load Result", items=RESULT_ITEMS, default="SEQUENCER",
                               description="What to load into Blender after Stylize Animation")
-    # Color Me Noisy (docs/noisy.md): steps 1..8 are the paper's tested widths f.
-    noise_level: IntProperty(
-        name="Temporal Noise",
-        description="Hand-drawn 'boiling' after the coherent pass: every frame re-synthesizes the medium's "
-        "texture above a width f (steps 1-8: f = " + ", ".join(map(str, noisy.TESTED_NOISE)) + " px; "
-        "0 = off, the coherent frames as they are)",
-        default=0, min=0, max=len(noisy.TESTED_NOISE),
-    )
-    noise_guided: BoolProperty(
-        name="Guided Noise",
-        description="Also keep the light-path guides while boiling, so thin strokes stay where the light "
-        "matches the exemplar's (slower; docs/noisy.md)",
-        default=False,
-    )
-    noise_map_source: EnumProperty(name="Noise Map", items=noisy.NOISE_MAP_SOURCES, default="NONE",
-                                   description="Where the temporal noise goes")
-    noise_map_image: StringProperty(name="Map Image", subtype="FILE_PATH",
-                                    description="Greyscale image of the render's size: 0 coherent, 1 full noise")
-    noise_map_object: PointerProperty(name="Map Object", type=bpy.types.Object,
-                                      description="The object that boils (its mask guide)")
-    noise_map_collection: PointerProperty(name="Map Collection", type=bpy.types.Collection,
-                                          description="The collection that boils (its mask guide)")
-    noise_map_guide: StringProperty(name="Map Guide",
-                                    description="Name of a guide of the guide cache (an attribute or AOV)")
+    # Temporal Noise, the pass after the frames (tempera.blender.noise_pass).
+    __annotations__.update(noise_pass.PROPERTIES)
 
     # The method (tempera.methods.registry); its own settings come from its module.
     method: EnumProperty(name="Method", items=METHOD_ITEMS, default="STYLIT",

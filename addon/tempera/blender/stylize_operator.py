@@ -34,6 +34,7 @@ from .guide_operator import (ETA_AFTER_FRAMES, GuideJob, estimate_guide_seconds,
                              long_run_question)
 from .guide_render import GuideRenderError
 from .job_operator import JobOperator
+from .noise_pass import NoisePass
 from .properties import MEDIA_EXEMPLAR_KINDS, WEIGHT_PROPERTIES
 from .setting_paths import FRAMES_DIR, exemplar_paths, output_dir, resolve_path
 from . import methods, results
@@ -42,7 +43,6 @@ from . import methods, results
 STYLIZE_SECONDS_PER_MPIX = {"final": 40.0, "preview": 8.0}
 CONTACT_SHEET = "contact_sheet.png"
 VIDEO = "stylized.mp4"
-NOISY_DIR = "noisy"  # the Temporal Noise pass (Color Me Noisy) writes here
 
 
 # --------------------------------------------------------------------------- settings -> job
@@ -58,29 +58,6 @@ def stylize_options(settings):
         "seed": int(settings.seed),
         "format": settings.output_format,
     }
-
-
-def noise_config(settings, out, config):
-    """The NoisySequence arguments of the Temporal Noise settings (None = off):
-    the coherent frames of this run boiled into OUT/noisy."""
-    from ..methods.noisy import noisy
-
-    if settings.noise_level == 0:
-        return None
-    if config["format"] != "png":
-        raise ValueError("Temporal Noise boils PNG frames: set Format to PNG.")
-    image = settings.noise_map_image.strip()
-    noise_map = noisy.noise_map_spec(
-        settings.noise_map_source, resolve_path(image, "noise map image") if image else "",
-        settings.noise_map_object.name if settings.noise_map_object else "",
-        settings.noise_map_collection.name if settings.noise_map_collection else "", settings.noise_map_guide.strip())
-    args = dict(exemplar=config["style"], reference=config["out"], frames=config["frames"],
-                out=os.path.join(out, NOISY_DIR), noise_map=noise_map, guides=config["guides"],
-                noise=noisy.noise_width(settings.noise_level), seed=config["seed"])
-    if settings.noise_guided:  # guided noise: the exemplar's guides and StyLit's weights
-        args.update(exemplar_guides=config["exemplar_guides"], exemplar_frame=config.get("exemplar_frame"),
-                    guide_weights=config["weights"], noise_guides=limits.PANEL_NOISE_GUIDES)
-    return args
 
 
 def megapixels(scene):
@@ -112,9 +89,7 @@ class StylizeRun:
                            out=os.path.join(self.out, FRAMES_DIR))
         if exemplar_frame is not None:
             self.config["exemplar_frame"] = exemplar_frame
-        self.noise = noise_config(settings, self.out, self.config)  # None: no Temporal Noise pass
-        self.noise_job = None  # its NoisySequence, made once the coherent frames exist
-        self.noise_results = []
+        self.noise = NoisePass.from_settings(settings, self.out, self.config)  # None: no Temporal Noise pass
         self.job = None  # the native StylizeJob, made once the guides exist
         self.index = 0
         self.results = []
@@ -148,6 +123,10 @@ class StylizeRun:
     def in_noise_phase(self):
         return self.index >= len(self.frames) + self.stylize_steps
 
+    @property
+    def noise_results(self):
+        return self.noise.results if self.noise else []
+
     def threaded(self):
         return not self.in_guide_phase  # the solver needs no bpy
 
@@ -155,7 +134,7 @@ class StylizeRun:
         if self.in_guide_phase:
             self.guides.step(progress)
         elif self.in_noise_phase:
-            self._boil(progress)
+            self.noise.step(self.index - len(self.frames) - self.stylize_steps, progress)
         else:
             self._stylize(progress)
         self.index += 1
@@ -178,16 +157,6 @@ class StylizeRun:
             flicker = result.get("flicker")
             note = f", flicker {flicker:.3f}" if flicker is not None and flicker == flicker else ""
             print(f"Tempera: frame {result['frame']} {result['status']} in {seconds:.1f} s{note}", flush=True)
-
-    def _boil(self, progress):
-        from ..methods.noisy.noisy import NoisySequence
-
-        if self.noise_job is None:
-            self.noise_job = NoisySequence(**self.noise)
-        result = self.noise_job.run_frame(self.index - len(self.frames) - self.stylize_steps, progress)
-        self.noise_results.append(result)
-        if bpy.app.background:
-            print(f"Tempera: noisy frame {result['frame']} {result['status']} in {result['seconds']:.1f} s", flush=True)
 
     def current_frame(self):
         index = min(self.index, self.total - 1)
@@ -212,8 +181,7 @@ class StylizeRun:
         if self.in_guide_phase:
             return self.guides.status_text()
         if self.in_noise_phase:
-            current = min(len(self.noise_results) + 1, len(self.frames))
-            return f"Tempera: temporal noise, frame {current}/{len(self.frames)} (Esc to stop)"
+            return self.noise.status_text()
         eta = self.eta_seconds()
         current = min(len(self.results) + 1, len(self.frames))
         eta_text = "" if eta is None else f", ETA {format_duration(eta)}"
@@ -241,8 +209,7 @@ class StylizeRun:
         flicker = self.mean_flicker()
         tail = f". {flicker_text(flicker)}" if flicker is not None else ""
         if self.noise:
-            made = sum(r["status"] == "made" for r in self.noise_results)
-            parts.append(f"{made} boiled (Temporal Noise) in {self.noise['out']}")
+            parts.append(self.noise.summary())
         return f"Tempera: {', '.join(parts)} in {self.config['out']}{tail}"
 
 

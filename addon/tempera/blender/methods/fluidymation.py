@@ -8,7 +8,7 @@ from bpy.props import BoolProperty, EnumProperty, PointerProperty
 
 from ... import _native
 from ...app import guide_cache
-from ..panels import wide_prop
+from ..layout import wide_prop
 from ..setting_paths import resolve_path
 from ..stylize_operator import RgbaRun
 from . import table_flags, table_properties

@@ -4,7 +4,7 @@ a frame per step, over the render."""
 from bpy.props import BoolProperty, FloatProperty
 
 from ... import _native
-from ..panels import wide_prop
+from ..layout import wide_prop
 from ..stylize_operator import RgbaRun
 from . import table_flags, table_properties
 

@@ -12,7 +12,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, Po
 
 from ... import _native
 from ..guide_operator import GuideJob, estimate_guide_seconds, format_duration
-from ..panels import wide_prop
+from ..layout import wide_prop
 from ..setting_paths import FRAMES_DIR, output_dir, resolve_path
 from ..stylize_operator import StylizeRun
 
