@@ -148,6 +148,6 @@ def test_fractured_cube_from_the_panel_and_the_cli(fractured_scene, tmp_path):
                  str(tmp_path / "examples" / "box"), "--object", name, "--shape", "box", "--frames",
                  f"{FRAMES[0]}-{FRAMES[1]}", "--out", str(cli_out)]) == 0
     for f in range(FRAMES[0], FRAMES[1] + 1):
-        a = tempera.read_image(str(cli_out / f"frame_{f:04d}.png"))
+        a = tempera.read_image(str(cli_out / "frames" / f"frame_{f:04d}.png"))
         b = tempera.read_image(str(out / "layers" / name / f"frame_{f:04d}.png"))
         assert np.abs(a - b).max() < 1e-3, f

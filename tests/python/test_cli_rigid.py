@@ -129,19 +129,23 @@ def _stylize(inputs, *extra):
 
 
 def test_stylize_method_rigid_is_the_same_run(inputs, capsys):
-    """`tempera stylize --method rigid` runs tempera rigid's job: the same
-    frames, the same resume record (a rigid run after it keeps them all)."""
+    """`tempera stylize --method rigid` runs tempera rigid's job with the
+    frames in OUT/frames, as every method's: the same frames, the same resume
+    record (a rigid run into OUT/frames after it keeps them all)."""
     assert _stylize(inputs, "--k", "2", "--frames", "3-6") == 0
-    assert sorted(p.name for p in (inputs / "out").glob("frame_*.png")) == [f"frame_{f:04d}.png" for f in range(3, 7)]
+    frames = inputs / "out" / "frames"
+    assert sorted(p.name for p in frames.glob("frame_*.png")) == [f"frame_{f:04d}.png" for f in range(3, 7)]
+    assert not list((inputs / "out").glob("frame_*.png"))  # the one layout
     assert "4 frames written" in capsys.readouterr().out
-    assert _run(inputs, "--k", "2") == 0
+    assert main(["rigid", "--cache", str(inputs / "cache"), "--exemplar", str(inputs / "ex"), "--out", str(frames),
+                 "--k", "2"]) == 0
     assert "20 frames written, 4 kept" in capsys.readouterr().out
-    first = _native.read_image(str(inputs / "out" / "frame_0004.png"), None)
-    (inputs / "out" / "frame_0004.png").unlink()
+    first = _native.read_image(str(frames / "frame_0004.png"), None)
+    (frames / "frame_0004.png").unlink()
     assert main(["stylize", "--method=rigid", "--guides", str(inputs / "cache"), "--exemplar", str(inputs / "ex"),
                  "--out", str(inputs / "out"), "--k", "2"]) == 0
     assert "1 frames written, 23 kept" in capsys.readouterr().out
-    np.testing.assert_array_equal(_native.read_image(str(inputs / "out" / "frame_0004.png"), None), first)
+    np.testing.assert_array_equal(_native.read_image(str(frames / "frame_0004.png"), None), first)
 
 
 def test_stylize_method_rigid_bad_input_exits_2(inputs, capsys):
@@ -154,7 +158,7 @@ def test_stylize_method_rigid_bad_input_exits_2(inputs, capsys):
     with pytest.raises(SystemExit) as exit_:  # argparse: a missing --guides
         main(["stylize", "--method", "rigid", "--exemplar", str(inputs / "ex"), "--out", str(inputs / "out")])
     assert exit_.value.code == 2 and "--cache/--guides" in capsys.readouterr().err
-    assert not list((inputs / "out").glob("frame_*.png"))
+    assert not list((inputs / "out").rglob("frame_*.png"))
 
 
 def test_native_cli_names_where_rigid_runs(cli_path, inputs):
@@ -276,7 +280,7 @@ def test_stylize_a_scene_renders_its_guides_and_tracks_first(tmp_path, cli_path)
     assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
     assert "rendering the guides of" in result.stderr
     assert (tmp_path / "out" / "guides" / rigid_tracks.TRACKS_NAME).is_file()
-    frames = sorted((tmp_path / "out").glob("frame_*.png"))
+    frames = sorted((tmp_path / "out" / "frames").glob("frame_*.png"))
     assert len(frames) == 12 and _native.read_image(str(frames[0]), None).shape == (64, 96, 4)
     assert max(_native.read_image(str(f), None)[:, :, 3].max() for f in frames) > 0.5  # the ball is drawn
     again = subprocess.run(command, capture_output=True, text=True, timeout=600, env=env)

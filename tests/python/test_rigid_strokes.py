@@ -78,8 +78,8 @@ def test_cli_strokes_option(tmp_path, capsys):
 
     assert run("plain") == 0 and run("strokes", "--strokes", "generated") == 0
     for f in (8, 9):
-        plain = _native.read_image(str(tmp_path / "plain" / f"frame_{f:04d}.png"), None)
-        made = _native.read_image(str(tmp_path / "strokes" / f"frame_{f:04d}.png"), None)
+        plain = _native.read_image(str(tmp_path / "plain" / "frames" / f"frame_{f:04d}.png"), None)
+        made = _native.read_image(str(tmp_path / "strokes" / "frames" / f"frame_{f:04d}.png"), None)
         outside, mass, colour = _measure(plain, made)
         assert outside <= 0.03 and 0.5 <= mass <= 2.0
         assert np.abs(colour - rigid_strokes.STROKE_COLOUR).max() < 0.05

@@ -5,7 +5,8 @@ tracks, with no Blender.
                   [--object NAME] [--frames A-B] [--shape circle|box] [--paper]
                   [--strokes IMAGE|generated] [method options]
     tempera stylize --method rigid --guides CACHE --exemplar EXEMPLAR ... (the same,
-                  in the form of the other methods: --guides names the cache)
+                  in the form of the other methods: --guides names the cache, and the
+                  frames go to OUT/frames, as every method's)
     tempera stylize SCENE.blend --method rigid --exemplar EXEMPLAR --frames A-B --out OUT
                   [--samples N] ... (the scene's guides and tracks rendered first, into
                   --guides, default OUT/guides, by the native tempera render-guides)
@@ -177,7 +178,9 @@ def _frame_indices(text, start, count):
     return [f - start for f in frames]
 
 
-def run(args):
+def run(args, frames_folder=""):
+    """Draws the frames into OUT/`frames_folder` (with their records); the
+    generated exemplar goes to OUT."""
     tracks = rigid_tracks.read_tracks(args.cache)
     name, target = _one_object(tracks, args.object, f"guide cache {args.cache}")
     width, height = rigid_tracks.frame_size(args.cache)
@@ -188,7 +191,7 @@ def run(args):
     folders = [generated_exemplar_folder(args.out, args.shape) if d == rigid.GENERATED else d
                for d in (args.exemplar or [rigid.GENERATED])]
     exemplars = [_read_exemplar(d, args.shape, fit_values) for d in folders]
-    out = Path(args.out)
+    out = Path(args.out) / frames_folder
     settings = _settings_key(args, [d for _, d in exemplars], {**rigid_values, **fit_values})
     wanted = _frame_indices(args.frames, tracks["frame_start"], len(target["centre"]))
     frame_of = {i: tracks["frame_start"] + i for i in wanted}
@@ -221,19 +224,22 @@ def run(args):
     return 0
 
 
-def main(argv=None, prog="tempera rigid"):
+def main(argv=None, prog="tempera rigid", frames_folder=""):
     args = _parser(prog).parse_args(argv)
-    return run_command(prog, lambda: run(args), "cancelled; rerun the same command to resume")
+    return run_command(prog, lambda: run(args, frames_folder), "cancelled; rerun the same command to resume")
 
 
 STYLIZE_PROG = "tempera stylize --method rigid"
+STYLIZE_FRAMES = "frames"  # the one output layout of `tempera stylize`: OUT/frames, as for every method
 
 
 def stylize_main(argv):
     """`tempera stylize [SCENE.blend] --method rigid ...`: `tempera rigid` in
     the form of the other methods (stylize's argv without "stylize"); the same
-    run. With a scene first, its guides (and tracks) are rendered into --guides
-    (default OUT/guides) first (tempera.app.scene_guides)."""
+    run, with the frames and their records in OUT/frames as every method's
+    (`tempera rigid --out OUT/frames` makes and keeps the same ones). With a
+    scene first, its guides (and tracks) are rendered into --guides (default
+    OUT/guides) first (tempera.app.scene_guides)."""
     rest, skip = [], False
     for a, b in zip(argv, argv[1:] + [""]):
         if skip:
@@ -249,4 +255,4 @@ def stylize_main(argv):
         return 0
 
     status = run_command(STYLIZE_PROG, render_guides, "cancelled while rendering the guides; rerun the same command")
-    return status or main(ready["argv"], STYLIZE_PROG)
+    return status or main(ready["argv"], STYLIZE_PROG, STYLIZE_FRAMES)
