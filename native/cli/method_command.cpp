@@ -118,6 +118,7 @@ Request parse(const MethodEntry& method, const Args& args) {
   if (config.guides.empty() && !q.scene.empty() && !config.out.empty())
     config.guides = (fs::path(config.out) / "guides").string();
   check_required(method, q);
+  if (method.check_options) method.check_options(q.options);  // before any render: a typo costs none
   return q;
 }
 

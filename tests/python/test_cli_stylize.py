@@ -257,3 +257,20 @@ def test_a_scene_for_a_fluid_method_is_checked_before_blender_runs(cli_path, tmp
     missing = stylize(cli_path, tmp_path / "none.blend", "--method", "fluidymation", "--exemplar", tmp_path,
                       "--frames", "1-2", "--out", tmp_path / "o")
     assert missing.returncode == 1 and "scene file not found" in missing.stderr
+
+
+def test_a_scene_form_names_a_bad_option_before_blender_runs(cli_path, tmp_path):
+    """The one command reads every method's options (its entry's
+    check_options) before Blender renders a scene's guides: a typo costs no
+    render. Here no Blender could run at all."""
+    blend = tmp_path / "shot.blend"
+    blend.write_bytes(b"BLENDER")  # never opened: the options come first
+    runs = {"stylit": (("--exemplar-guides", tmp_path, "--sparkle", "1"), "unknown option '--sparkle'"),
+            "tcia": (("--exemplar-guides", tmp_path, "--weights", "SSS=1"), "unknown guide 'SSS'"),
+            "lazyfluids": (("--lambda", "-1"), "temporal weight"),
+            "fluidymation": (("--flow", "wind"), "--flow")}
+    for method, (extra, message) in runs.items():
+        result = stylize(cli_path, blend, "--method", method, "--exemplar", tmp_path / "x.png", *extra,
+                         "--frames", "1-2", "--out", tmp_path / "o", "--blender", tmp_path / "no_blender")
+        assert result.returncode == 2 and message in result.stderr, (method, result.stderr)
+        assert "rendering the guides" not in result.stderr and not (tmp_path / "o").exists(), method

@@ -57,6 +57,11 @@ struct MethodEntry {
   // "segment"; neither for a method that runs in Python.
   MakeJob make_job;
   MakeSegmentJob make_segment_job;
+  // Reads the method's options as its job factory does, touching no file:
+  // ValueError naming an unknown option or a bad value. The command calls it
+  // before Blender renders a scene's guides, so a typo costs no render.
+  // Optional (the job factory checks them anyway).
+  std::function<void(const MethodOptions&)> check_options;
   // Its own options, for --help: "  --strength S   ...\n" lines. Given alone
   // (no value), an option arrives with the text "" (set_from_text: a switch).
   std::string options_help;

@@ -62,6 +62,7 @@ MethodEntry fluidymation_method() {
   m.make_job = [](const JobConfig& config, const MethodOptions& options) {
     return std::make_unique<FluidymationJob>(job_config(config, options));
   };
+  m.check_options = [](const MethodOptions& options) { validate(job_config({}, options).options); };
   m.options_help = kInputsHelp + flags_help<FluidymationOptions>(fluidymation_option_table(), true) +
                    "  (any engine option of 'tempera synth --help'; defaults: 5x5 patches, directed\n"
                    "  orientations, 3 EM iterations, exact guides)\n";

@@ -48,6 +48,7 @@ MethodEntry lazyfluids_method() {
   m.make_job = [](const JobConfig& config, const MethodOptions& options) {
     return std::make_unique<LazyFluidsJob>(job_config(config, options));
   };
+  m.check_options = [](const MethodOptions& options) { validate(job_config({}, options).options); };
   m.options_help = flags_help<LazyFluidsOptions>(lazyfluids_option_table(), true) +
                    "  (any engine option of 'tempera synth --help'; LazyFluids' defaults: --patch-size 5\n"
                    "  --usage uniform)\n";

@@ -56,8 +56,6 @@ StylizeJobConfig job_config(const JobConfig& given, const MethodOptions& options
              !set_from_text(config.stylit.synthesis, synthesis_option_table(), flag, text))
       throw unknown_method_option("stylit", flag);
   }
-  if (config.exemplar_guides.empty())
-    throw ValueError("--exemplar-guides is required (the guide cache of the exemplar render)");
   validate(config.stylit.synthesis);
   active_guides(config.stylit);  // errors now, not in the middle of a run
   return config;
@@ -77,8 +75,12 @@ MethodEntry stylit_method() {
   m.light_path_guides = true;
   m.docs = "docs/user_guide.md";
   m.make_job = [](const JobConfig& config, const MethodOptions& options) {
-    return std::make_unique<StylizeJob>(job_config(config, options));
+    StylizeJobConfig c = job_config(config, options);
+    if (c.exemplar_guides.empty())
+      throw ValueError("--exemplar-guides is required (the guide cache of the exemplar render)");
+    return std::make_unique<StylizeJob>(std::move(c));
   };
+  m.check_options = [](const MethodOptions& options) { job_config({}, options); };
   m.options_help = options_help();
   m.help_details = kDetails;
   return m;

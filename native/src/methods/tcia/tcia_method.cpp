@@ -41,8 +41,6 @@ TciaJobConfig job_config(const JobConfig& given, const MethodOptions& options) {
       throw unknown_method_option("tcia", flag);
   }
   add_layer_keys(c.layers, layer_keys);
-  if (c.exemplar_guides.empty())
-    throw ValueError("--exemplar-guides is required (the guide cache of the exemplar render)");
   return c;
 }
 
@@ -90,8 +88,12 @@ MethodEntry tcia_method() {
   m.light_path_guides = true;
   m.docs = "docs/coherent.md";
   m.make_segment_job = [](const JobConfig& config, const MethodOptions& options) {
-    return std::make_unique<TciaJob>(job_config(config, options));
+    TciaJobConfig c = job_config(config, options);
+    if (c.exemplar_guides.empty())
+      throw ValueError("--exemplar-guides is required (the guide cache of the exemplar render)");
+    return std::make_unique<TciaJob>(std::move(c));
   };
+  m.check_options = [](const MethodOptions& options) { job_config({}, options); };
   m.options_help = options_help();
   return m;
 }
