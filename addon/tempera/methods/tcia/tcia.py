@@ -17,6 +17,7 @@ import os
 import numpy as np
 
 from ... import _native
+from ...app.segment_job import SegmentJob
 from ...engine.synthesis import method_options
 
 TciaOptions = _native.TciaOptions
@@ -101,7 +102,7 @@ def segments(frames, key_frames=()):
     return [(first, last) for first, last, _ in _native.key_segments(frames, [int(k) for k in key_frames])]
 
 
-class ShotJob:
+class ShotJob(SegmentJob):
     """The coherent method over a guide cache, segment by segment.
 
     style, exemplar_guides, exemplar_frame, guides, frames (consecutive), out,
@@ -140,19 +141,6 @@ class ShotJob:
                       layer_order=str(layer_order), orientation={"from_cache": bool(orientation)})
         self._job = _native.TciaJob(config, options(**values))
 
-    @property
-    def segments(self) -> list:
-        """(first, last, frames it writes) per segment of the shot."""
-        return self._job.segments
-
-    @property
-    def selected(self) -> list:
-        return self._job.selected
-
-    @property
-    def warnings(self) -> list:
-        return self._job.warnings
-
     def output_path(self, frame: int) -> str:
         return self._job.output_path(int(frame))
 
@@ -168,6 +156,3 @@ class ShotJob:
         report = None if progress is None else (lambda d: progress(d) is not False)
         status, seconds = self._job.run_segment(int(index), report)
         return {"status": status, "seconds": seconds}
-
-    def write_contact_sheet(self, path, columns: int = 0) -> None:
-        self._job.write_contact_sheet(os.fspath(path), int(columns))
