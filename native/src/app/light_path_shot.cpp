@@ -70,6 +70,8 @@ LightPathShot::LightPathShot(const LightPathShotConfig& config, const std::vecto
   if (config_.prefix.find('/') != std::string::npos)
     throw ValueError(concat("prefix '", config_.prefix, "' must not contain '/'"));
   require_file(config_.exemplar, "painting");
+  if (config_.exemplar_guides.empty())
+    throw ValueError("--exemplar-guides is required (the guide cache of the exemplar render)");
   require_folder(config_.exemplar_guides, "exemplar guide");
   exemplar_path_ =
       guide_cache_frame(config_.exemplar_guides, exemplar_guide_frame(config_.exemplar_guides, config_.exemplar_frame));

@@ -75,10 +75,7 @@ MethodEntry stylit_method() {
   m.light_path_guides = true;
   m.docs = "docs/user_guide.md";
   m.make_job = [](const JobConfig& config, const MethodOptions& options) {
-    StylizeJobConfig c = job_config(config, options);
-    if (c.exemplar_guides.empty())
-      throw ValueError("--exemplar-guides is required (the guide cache of the exemplar render)");
-    return std::make_unique<StylizeJob>(std::move(c));
+    return std::make_unique<StylizeJob>(job_config(config, options));
   };
   m.check_options = [](const MethodOptions& options) { job_config({}, options); };
   m.options_help = options_help();

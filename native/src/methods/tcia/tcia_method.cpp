@@ -88,10 +88,7 @@ MethodEntry tcia_method() {
   m.light_path_guides = true;
   m.docs = "docs/coherent.md";
   m.make_segment_job = [](const JobConfig& config, const MethodOptions& options) {
-    TciaJobConfig c = job_config(config, options);
-    if (c.exemplar_guides.empty())
-      throw ValueError("--exemplar-guides is required (the guide cache of the exemplar render)");
-    return std::make_unique<TciaJob>(std::move(c));
+    return std::make_unique<TciaJob>(job_config(config, options));
   };
   m.check_options = [](const MethodOptions& options) { job_config({}, options); };
   m.options_help = options_help();
