@@ -2,9 +2,8 @@
 `python -m tempera`.
 
 `tempera farm ...` and `tempera stylize --scheduler ADDRESS ...` run a shot on
-a Dask cluster (tempera.app.farm); `tempera rigid ...` and `tempera stylize
---method M ...` for a method the registry says is written in Python (rigid:
-tempera.methods.rigid.rigid_cli) run that method; `tempera exemplar ...` writes one of the
+a Dask cluster (tempera.app.farm); `tempera rigid ...` runs the rigid-body
+method's own form (tempera.methods.rigid.rigid_cli); `tempera exemplar ...` writes one of the
 project's own smoke/fire/ink exemplars (tempera.app.exemplar_cli), which `tempera stylize --method M`
 also uses when M has a default exemplar and --exemplar is left out; every other command is the
 native batch CLI
@@ -62,9 +61,6 @@ def main(argv=None):
         from .app.exemplar_cli import with_default_exemplar
         from .methods import registry
 
-        python_command = registry.python_command(stylize_method(argv[1:]))  # a method written in Python
-        if python_command is not None:
-            return python_command(argv[1:])
         try:
             argv = ["stylize", *with_default_exemplar(argv[1:], registry.find(stylize_method(argv[1:])))]
         except (ValueError, OSError) as exc:  # an unknown method, an output folder that cannot be written

@@ -27,6 +27,9 @@ namespace {
 // The help's note on the default exemplar, if the method has one.
 std::string method_default_exemplar(const MethodEntry& m) {
   if (m.default_exemplar.empty()) return "";
+  if (m.default_exemplar == kJobMadeExemplar)
+    return " (left out, or 'generated': the project's own,\n"
+           "                          which the job writes into OUT/exemplar_generated_...)";
   return concat(" (left out: the Python package's tempera generates\n"
                 "                          the project's own ", m.default_exemplar, " into OUT/exemplar_generated_",
                 m.default_exemplar, ")");
@@ -76,11 +79,12 @@ struct Request {
 
 void check_required(const MethodEntry& method, const Request& q) {
   const JobConfig& config = q.config;
-  if (config.exemplar.empty() && !method.default_exemplar.empty())
+  const bool job_makes_one = method.default_exemplar == kJobMadeExemplar;
+  if (config.exemplar.empty() && !method.default_exemplar.empty() && !job_makes_one)
     throw ValueError(concat("--exemplar is required here; the Python package's 'tempera stylize' uses the project's "
                             "own ", method.default_exemplar, " exemplar when it is left out (or write it with "
                             "'tempera exemplar ", method.default_exemplar, " --out DIR')"));
-  if (config.exemplar.empty()) throw ValueError("--exemplar is required (the exemplar)");
+  if (config.exemplar.empty() && !job_makes_one) throw ValueError("--exemplar is required (the exemplar)");
   if (config.frames.empty()) throw ValueError("--frames is required (e.g. --frames 1-24)");
   if (config.out.empty()) throw ValueError("--out is required (the output folder)");
   const bool boil_only = !q.extras.noise_reference.empty();  // no stylization

@@ -58,7 +58,7 @@ std::string methods_help() {
   for (const MethodEntry& m : method_registry()) {
     std::string name = "                            " + m.name;
     name.resize(std::max<std::size_t>(name.size() + 1, 42), ' ');
-    out += concat(name, m.title, m.python_command.empty() ? "" : " (run by the Python package's tempera)", "\n");
+    out += concat(name, m.title, "\n");
   }
   return out;
 }
@@ -85,13 +85,6 @@ std::string stylize_help() {
   return text;
 }
 
-// A method written in Python (rigid): the wheel's `tempera` command and
-// `python -m tempera` run it before this CLI (tempera/__main__.py).
-std::string runs_in_python(const MethodEntry& method) {
-  return concat("--method ", method.name, " runs in the Python package: use the pip-installed 'tempera stylize --method ",
-                method.name, " ...' or 'python -m tempera stylize --method ", method.name, " ...' (", method.docs, ")");
-}
-
 bool names_a_method(const Args& args) { return std::find(args.begin(), args.end(), "--method") != args.end(); }
 
 }  // namespace
@@ -109,7 +102,6 @@ int run_stylize(const Args& args) {
     return args.empty() ? 2 : 0;
   }
   const MethodEntry& method = find_method(method_of(args));
-  if (!method.python_command.empty()) throw ValueError(runs_in_python(method));
   return run_registered_method(method, args);
 }
 

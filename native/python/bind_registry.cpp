@@ -21,7 +21,6 @@ py::dict method_dict(const MethodEntry& e) {
   py::dict d;
   d["name"] = e.name, d["title"] = e.title, d["summary"] = e.summary, d["paper"] = e.paper;
   d["unit"] = e.unit, d["light_path_guides"] = e.light_path_guides, d["docs"] = e.docs;
-  d["python_command"] = e.python_command;
   d["job"] = bool(e.make_job) || bool(e.make_segment_job);
   d["options_help"] = e.options_help;
   d["default_exemplar"] = e.default_exemplar;
@@ -121,6 +120,7 @@ std::unique_ptr<SegmentJob> method_segment_job(const std::string& name, const py
 void bind_registry(py::module_& m) {
   bind_frame_job_class(m);
   bind_segment_job_class(m);
+  m.attr("JOB_MADE_EXEMPLAR") = kJobMadeExemplar;
   m.def(
       "methods",
       [] {
@@ -129,7 +129,7 @@ void bind_registry(py::module_& m) {
         return out;
       },
       "The method registry (methods/registry.hpp): a dict per method (name, title, summary, paper, unit, "
-      "light_path_guides, docs, python_command, job: has a job factory (a segment job's for the unit 'segment'), "
+      "light_path_guides, docs, job: has a job factory (a segment job's for the unit 'segment'), "
       "options_help, default_exemplar), in the panel's order.");
   m.def(
       "find_method", [](const std::string& name) { return method_dict(find_method(name)); }, py::arg("name"),

@@ -123,52 +123,68 @@ def test_deep_tracks_and_huge_resolutions_are_named_with_exit_2(inputs, capsys):
         assert words in capsys.readouterr().err
 
 
-def _stylize(inputs, *extra):
-    return main(["stylize", "--method", "rigid", "--guides", str(inputs / "cache"), "--exemplar", str(inputs / "ex"),
-                 "--out", str(inputs / "out"), *extra])
+def _stylize(cli_path, inputs, out, *extra, exemplar=True):
+    given = ["--exemplar", str(inputs / "ex")] if exemplar else []
+    return subprocess.run([str(cli_path), "stylize", "--method", "rigid", "--guides", str(inputs / "cache"), *given,
+                           "--out", str(out), *extra], capture_output=True, text=True, timeout=300)
 
 
-def test_stylize_method_rigid_is_the_same_run(inputs, capsys):
-    """`tempera stylize --method rigid` runs tempera rigid's job with the
-    frames in OUT/frames, as every method's: the same frames, the same resume
-    record (a rigid run into OUT/frames after it keeps them all)."""
-    assert _stylize(inputs, "--k", "2", "--frames", "3-6") == 0
+def _same_frames(a, b, frames):
+    for f in frames:
+        name = f"frame_{f:04d}.png"
+        assert (a / name).read_bytes() == (b / name).read_bytes(), name
+
+
+@pytest.mark.parametrize("extra", [["--k", "2"], ["--shape", "box", "--paper"],
+                                   ["--strokes", "generated", "--stroke-weight", "2"]])
+def test_stylize_method_rigid_is_tempera_rigids_run(cli_path, inputs, extra, capsys):
+    """`tempera stylize --method rigid` is the native job of the registry's
+    one command (issue 41): the frames of `tempera rigid`, byte for byte, in
+    OUT/frames, with its resume: a lost frame is made again, the same."""
+    native = _stylize(cli_path, inputs, inputs / "out", "--frames", "3-6", *extra)
+    assert native.returncode == 0, native.stderr
+    assert "4 frame(s) stylized, 0 skipped" in native.stdout
     frames = inputs / "out" / "frames"
     assert sorted(p.name for p in frames.glob("frame_*.png")) == [f"frame_{f:04d}.png" for f in range(3, 7)]
-    assert not list((inputs / "out").glob("frame_*.png"))  # the one layout
-    assert "4 frames written" in capsys.readouterr().out
-    assert main(["rigid", "--cache", str(inputs / "cache"), "--exemplar", str(inputs / "ex"), "--out", str(frames),
-                 "--k", "2"]) == 0
-    assert "20 frames written, 4 kept" in capsys.readouterr().out
-    first = _native.read_image(str(frames / "frame_0004.png"), None)
+    assert (inputs / "out" / "contact_sheet.png").is_file()
+    assert main(["rigid", "--cache", str(inputs / "cache"), "--exemplar", str(inputs / "ex"),
+                 "--out", str(inputs / "python"), "--frames", "3-6", *extra]) == 0
+    _same_frames(frames, inputs / "python", range(3, 7))
+    first = (frames / "frame_0004.png").read_bytes()
     (frames / "frame_0004.png").unlink()
-    assert main(["stylize", "--method=rigid", "--guides", str(inputs / "cache"), "--exemplar", str(inputs / "ex"),
-                 "--out", str(inputs / "out"), "--k", "2"]) == 0
-    assert "1 frames written, 23 kept" in capsys.readouterr().out
-    np.testing.assert_array_equal(_native.read_image(str(frames / "frame_0004.png"), None), first)
+    again = _stylize(cli_path, inputs, inputs / "out", "--frames", "3-6", *extra)
+    assert again.returncode == 0 and "1 frame(s) stylized, 3 skipped" in again.stdout, again.stderr
+    assert (frames / "frame_0004.png").read_bytes() == first
 
 
-def test_stylize_method_rigid_bad_input_exits_2(inputs, capsys):
-    assert _stylize(inputs, "--frames", "20-40") == 2
-    assert "frame 25 is outside the tracked frames 1-24" in capsys.readouterr().err
-    assert _stylize(inputs, "--frames", "x") == 2
-    assert "cannot read 'x'" in capsys.readouterr().err
-    assert _stylize(inputs, "--lambda-dir", "-1") == 2
-    assert "lambda dir must be in [0," in capsys.readouterr().err
-    with pytest.raises(SystemExit) as exit_:  # argparse: a missing --guides
-        main(["stylize", "--method", "rigid", "--exemplar", str(inputs / "ex"), "--out", str(inputs / "out")])
-    assert exit_.value.code == 2 and "--cache/--guides" in capsys.readouterr().err
-    assert not list((inputs / "out").rglob("frame_*.png"))
+def test_stylize_method_rigid_draws_with_the_generated_exemplar_by_default(cli_path, inputs, capsys):
+    """Step 5 of issue 41: no drawings of one's own needed; the native job's
+    generated exemplar is the Python package's, frame for frame."""
+    made = _stylize(cli_path, inputs, inputs / "out", "--frames", "1-3", exemplar=False)
+    assert made.returncode == 0, made.stderr
+    folder = inputs / "out" / "exemplar_generated_circle"
+    assert (folder / rigid_tracks.TRACKS_NAME).is_file() and len(list((folder / "drawn").glob("*.png"))) == 60
+    assert rigid_tracks.read_tracks(folder)["objects"]["Generated"]["centre"][0] == [60.0, 60.0]
+    assert main(["rigid", "--cache", str(inputs / "cache"), "--out", str(inputs / "python"), "--frames", "1-3"]) == 0
+    _same_frames(inputs / "out" / "frames", inputs / "python", range(1, 4))
 
 
-def test_native_cli_names_where_rigid_runs(cli_path, inputs):
-    """The native CLI alone (no Python package in front) cannot run the
-    method: it says where it runs, with exit 2, before reading options."""
-    import subprocess
-
-    result = subprocess.run([str(cli_path), "stylize", "--method", "rigid", "--guides", str(inputs / "cache"),
-                             "--k", "2"], capture_output=True, text=True)
-    assert result.returncode == 2 and "python -m tempera stylize --method rigid" in result.stderr
+def test_stylize_method_rigid_bad_input_exits_2(cli_path, inputs):
+    out = inputs / "out"
+    for extra, words in ((["--frames", "20-40"], "frame 25 is outside the tracked frames 1-24"),
+                         (["--frames", "1-2", "--lambda-dir", "-1"], "lambda dir must be in [0,"),
+                         (["--frames", "1-2", "--shape", "star"], "unknown proxy shape 'star'"),
+                         (["--frames", "1-2", "--bogus", "1"], "unknown option '--bogus' for --method rigid"),
+                         (["--frames", "1-2", "--object", "Ball"], "has no object 'Ball' (it has Target)")):
+        result = _stylize(cli_path, inputs, out, *extra)
+        assert result.returncode == 2 and words in result.stderr, (extra, result.stderr)
+    no_guides = subprocess.run([str(cli_path), "stylize", "--method", "rigid", "--exemplar", str(inputs / "ex"),
+                                "--frames", "1-2", "--out", str(out)], capture_output=True, text=True, timeout=60)
+    assert no_guides.returncode == 2 and "--guides DIR" in no_guides.stderr
+    (inputs / "cache" / rigid_tracks.TRACKS_NAME).write_text('{"format": 1, "frame_start": 1,')
+    broken = _stylize(cli_path, inputs, out, "--frames", "1-2")
+    assert broken.returncode == 2 and "tracks.json: unreadable tracks (line 1 column 32" in broken.stderr
+    assert not list(out.rglob("frame_*.png"))
 
 
 # --------------------------------------------------------------------------- issue 31, items 2 and 5
@@ -284,10 +300,10 @@ def test_stylize_a_scene_renders_its_guides_and_tracks_first(tmp_path, cli_path)
     assert len(frames) == 12 and _native.read_image(str(frames[0]), None).shape == (64, 96, 4)
     assert max(_native.read_image(str(f), None)[:, :, 3].max() for f in frames) > 0.5  # the ball is drawn
     again = subprocess.run(command, capture_output=True, text=True, timeout=600, env=env)
-    assert again.returncode == 0 and "0 frames written, 12 kept" in again.stdout, again.stderr[-2000:]
+    assert again.returncode == 0 and "0 frame(s) stylized, 12 skipped" in again.stdout, again.stderr[-2000:]
     no_frames = subprocess.run(command[:-6] + ["--out", str(tmp_path / "o2")], capture_output=True, text=True,
                                timeout=120, env=env)
-    assert no_frames.returncode == 2 and "--frames is required with a scene" in no_frames.stderr
+    assert no_frames.returncode == 2 and "--frames is required" in no_frames.stderr
 
 
 def test_the_generated_exemplar_is_the_default(inputs, capsys):

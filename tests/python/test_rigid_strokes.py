@@ -4,6 +4,7 @@ stroke-position guide takes the exemplar's look and stays on the line; with
 the guide off the ink leaves the line (the test's own check that it is the
 guide doing it)."""
 import json
+import subprocess
 
 import numpy as np
 import pytest
@@ -11,7 +12,6 @@ import pytest
 from tempera import _native
 from tempera.engine import guides
 from tempera.methods.rigid import rigid, rigid_strokes, rigid_tracks
-from tempera.__main__ import main
 
 W, H = 240, 160
 BAND = 3.0  # px: ink this far from the drawn line still counts as on it
@@ -60,7 +60,7 @@ def test_stroke_guide_and_bad_exemplars():
         rigid_strokes.load_stroke_exemplar("nowhere.png")
 
 
-def test_cli_strokes_option(tmp_path, capsys):
+def test_cli_strokes_option(tmp_path, cli_path):
     track = _native.bouncing_ball((30, 40), (4.0, 0), 15, 1.2, 150, 0.6, 0.05, 30)
     ex = tmp_path / "ex"
     rigid_tracks.write_tracks(ex, {"Ball": track}, 1, (0, 1.2))
@@ -73,16 +73,16 @@ def test_cli_strokes_option(tmp_path, capsys):
     (cache / "manifest.json").write_text(json.dumps({"resolution": [W, H]}))
 
     def run(out, *extra):
-        return main(["stylize", "--method", "rigid", "--guides", str(cache), "--exemplar", str(ex), "--out",
-                     str(tmp_path / out), "--frames", "8-9", *extra])
+        return subprocess.run([str(cli_path), "stylize", "--method", "rigid", "--guides", str(cache), "--exemplar",
+                               str(ex), "--out", str(tmp_path / out), "--frames", "8-9", *extra],
+                              capture_output=True, text=True, timeout=300)
 
-    assert run("plain") == 0 and run("strokes", "--strokes", "generated") == 0
+    assert run("plain").returncode == 0 and run("strokes", "--strokes", "generated").returncode == 0
     for f in (8, 9):
         plain = _native.read_image(str(tmp_path / "plain" / "frames" / f"frame_{f:04d}.png"), None)
         made = _native.read_image(str(tmp_path / "strokes" / "frames" / f"frame_{f:04d}.png"), None)
         outside, mass, colour = _measure(plain, made)
         assert outside <= 0.03 and 0.5 <= mass <= 2.0
         assert np.abs(colour - rigid_strokes.STROKE_COLOUR).max() < 0.05
-    capsys.readouterr()
-    assert run("bad", "--strokes", str(tmp_path / "none.png")) == 1
-    assert "none.png' does not exist" in capsys.readouterr().err
+    bad = run("bad", "--strokes", str(tmp_path / "none.png"))
+    assert bad.returncode == 1 and "none.png' does not exist" in bad.stderr

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import _native
 from . import media_exemplars
 from .command import run_command
 
@@ -100,7 +101,7 @@ def with_default_exemplar(args, entry):
     ``default_exemplar``) and none is given; else the arguments as they are
     (the command then names what is missing)."""
     kind = entry["default_exemplar"]
-    if not kind or "--exemplar" in args or "--help" in args or "-h" in args:
+    if not kind or kind == _native.JOB_MADE_EXEMPLAR or "--exemplar" in args or "--help" in args or "-h" in args:
         return list(args)
     at = args.index("--out") if "--out" in args else len(args)
     if at + 1 >= len(args):

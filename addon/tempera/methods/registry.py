@@ -3,7 +3,6 @@ Python side: the panel's Method list, the `tempera` console script's
 dispatch and the farm planner read it, so a method is named once."""
 from __future__ import annotations
 
-import importlib
 import os
 from collections.abc import Mapping
 
@@ -11,7 +10,7 @@ from .. import _native
 from ..app.frame_job import MethodJob
 from ..app.segment_job import MethodSegmentJob
 
-# dicts: name, title, summary, paper, unit, light_path_guides, docs, python_command,
+# dicts: name, title, summary, paper, unit, light_path_guides, docs,
 # job (a job factory: make_job runs it), options_help, default_exemplar
 METHODS = tuple(_native.methods())
 
@@ -28,16 +27,6 @@ def find(name: str) -> dict:
 def panel_items() -> tuple:
     """The panel's Method EnumProperty items: (NAME, title, summary) in the registry's order."""
     return tuple((m["name"].upper(), m["title"], m["summary"]) for m in METHODS)
-
-
-def python_command(name: str):
-    """The function that runs `tempera stylize --method NAME ...` for a method
-    written in Python (rigid), or None for a method of the native command."""
-    entry = next((m for m in METHODS if m["name"] == name), None)
-    if entry is None or not entry["python_command"]:
-        return None
-    module, function = entry["python_command"].split(":")
-    return getattr(importlib.import_module(module), function)
 
 
 def _option_text(value) -> str:
@@ -63,8 +52,7 @@ def make_job(name: str, exemplar, guides, frames, out, *, format: str = "png", r
     ``_`` stands for ``-``), as ``tempera stylize --method NAME --help`` lists
     them. A flag given more than once (the coherent method's ``key``): a
     list of (flag, value) pairs instead of the dict. ValueError for an
-    unknown method, option or value, or a method without a job factory
-    (rigid runs in tempera.methods.rigid). StyLit and the coherent method
+    unknown method, option or value. StyLit and the coherent method
     take the exemplar render's guide cache as ``{"exemplar-guides": DIR}``."""
     config = dict(exemplar=os.fspath(exemplar), guides=os.fspath(guides), frames=[int(f) for f in frames],
                   out=os.fspath(out), format=str(format), resume=bool(resume))

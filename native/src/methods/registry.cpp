@@ -39,7 +39,7 @@ void register_method(MethodEntry entry) {
   for (const MethodEntry& m : registry())
     if (m.name == entry.name) throw ValueError(concat("the method '", entry.name, "' is registered already"));
   const bool segments = entry.unit == "segment";
-  if (entry.python_command.empty() && !(segments ? bool(entry.make_segment_job) : bool(entry.make_job)))
+  if (!(segments ? bool(entry.make_segment_job) : bool(entry.make_job)))
     throw ValueError(concat("the method '", entry.name, "' has no job (", segments ? "make_segment_job" : "make_job",
                             ") to run"));
   registry().push_back(std::move(entry));
@@ -88,9 +88,8 @@ namespace {
 
 // What a method without the asked kind of job runs by instead.
 ValueError no_job_factory(const MethodEntry& method, const char* kind) {
-  return ValueError(concat("--method ", method.name, " has no ", kind, " job factory: ",
-                           method.python_command.empty() ? concat("its unit is the ", method.unit, " (", method.docs, ")")
-                                                         : concat("it runs in Python (", method.python_command, ")")));
+  return ValueError(concat("--method ", method.name, " has no ", kind, " job factory: its unit is the ", method.unit,
+                           " (", method.docs, ")"));
 }
 
 }  // namespace

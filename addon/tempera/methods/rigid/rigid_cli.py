@@ -4,12 +4,10 @@ tracks, with no Blender.
     tempera rigid --cache CACHE [--exemplar EXEMPLAR|generated ...] --out OUT
                   [--object NAME] [--frames A-B] [--shape circle|box] [--paper]
                   [--strokes IMAGE|generated] [method options]
-    tempera stylize --method rigid --guides CACHE --exemplar EXEMPLAR ... (the same,
-                  in the form of the other methods: --guides names the cache, and the
-                  frames go to OUT/frames, as every method's)
-    tempera stylize SCENE.blend --method rigid --exemplar EXEMPLAR --frames A-B --out OUT
-                  [--samples N] ... (the scene's guides and tracks rendered first, into
-                  --guides, default OUT/guides, by the native tempera render-guides)
+
+`tempera stylize --method rigid` is the registry's native job of the method
+(native/src/methods/rigid/rigid_job.cpp): the same frames, byte for byte, in
+OUT/frames, with the core's records, progress and resume.
 
 CACHE holds tracks.json (tempera.methods.rigid.rigid_tracks) of the target simulation and
 its manifest (the frame size). Each EXEMPLAR folder holds the source
@@ -35,7 +33,7 @@ import numpy as np
 
 from ... import _native
 from . import rigid, rigid_strokes, rigid_tracks
-from ...app import record, scene_guides
+from ...app import record
 from ...app.command import run_command
 from ...app.frames import parse_frames
 
@@ -178,9 +176,8 @@ def _frame_indices(text, start, count):
     return [f - start for f in frames]
 
 
-def run(args, frames_folder=""):
-    """Draws the frames into OUT/`frames_folder` (with their records); the
-    generated exemplar goes to OUT."""
+def run(args):
+    """Draws the frames into OUT (with their records), the generated exemplar too."""
     tracks = rigid_tracks.read_tracks(args.cache)
     name, target = _one_object(tracks, args.object, f"guide cache {args.cache}")
     width, height = rigid_tracks.frame_size(args.cache)
@@ -191,7 +188,7 @@ def run(args, frames_folder=""):
     folders = [generated_exemplar_folder(args.out, args.shape) if d == rigid.GENERATED else d
                for d in (args.exemplar or [rigid.GENERATED])]
     exemplars = [_read_exemplar(d, args.shape, fit_values) for d in folders]
-    out = Path(args.out) / frames_folder
+    out = Path(args.out)
     settings = _settings_key(args, [d for _, d in exemplars], {**rigid_values, **fit_values})
     wanted = _frame_indices(args.frames, tracks["frame_start"], len(target["centre"]))
     frame_of = {i: tracks["frame_start"] + i for i in wanted}
@@ -224,35 +221,6 @@ def run(args, frames_folder=""):
     return 0
 
 
-def main(argv=None, prog="tempera rigid", frames_folder=""):
+def main(argv=None, prog="tempera rigid"):
     args = _parser(prog).parse_args(argv)
-    return run_command(prog, lambda: run(args, frames_folder), "cancelled; rerun the same command to resume")
-
-
-STYLIZE_PROG = "tempera stylize --method rigid"
-STYLIZE_FRAMES = "frames"  # the one output layout of `tempera stylize`: OUT/frames, as for every method
-
-
-def stylize_main(argv):
-    """`tempera stylize [SCENE.blend] --method rigid ...`: `tempera rigid` in
-    the form of the other methods (stylize's argv without "stylize"); the same
-    run, with the frames and their records in OUT/frames as every method's
-    (`tempera rigid --out OUT/frames` makes and keeps the same ones). With a
-    scene first, its guides (and tracks) are rendered into --guides (default
-    OUT/guides) first (tempera.app.scene_guides)."""
-    rest, skip = [], False
-    for a, b in zip(argv, argv[1:] + [""]):
-        if skip:
-            skip = False
-        elif a == "--method" and b == "rigid":
-            skip = True
-        elif a != "--method=rigid":
-            rest.append(a)
-    ready = {}
-
-    def render_guides():
-        ready["argv"] = scene_guides.with_scene_guides(rest, STYLIZE_PROG)
-        return 0
-
-    status = run_command(STYLIZE_PROG, render_guides, "cancelled while rendering the guides; rerun the same command")
-    return status or main(ready["argv"], STYLIZE_PROG, STYLIZE_FRAMES)
+    return run_command(prog, lambda: run(args), "cancelled; rerun the same command to resume")

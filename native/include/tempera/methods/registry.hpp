@@ -32,6 +32,9 @@ using MakeJob = std::function<std::unique_ptr<FrameJob>(const JobConfig&, const 
 // The same for a method whose unit is the segment (app/segment_job.hpp).
 using MakeSegmentJob = std::function<std::unique_ptr<SegmentJob>(const JobConfig&, const MethodOptions&)>;
 
+// A MethodEntry's default_exemplar when its job makes the exemplar itself.
+constexpr const char* kJobMadeExemplar = "generated";
+
 struct MethodEntry {
   std::string name;     // --method NAME; the panel's item is NAME in capitals
   std::string title;    // the panel's Method list
@@ -47,14 +50,11 @@ struct MethodEntry {
   // The others take their exemplar as it is (an image, a video, drawings).
   bool light_path_guides = false;
   std::string docs;  // its page under docs/
-  // Where it runs: "" for the native command; else the Python function that
-  // runs `tempera stylize --method NAME ...` ("module:function").
-  std::string python_command;
   // The job, which the registry's one command runs (cli/method_command.cpp:
   // flags, resume, progress, Ctrl-C, a .blend's guides, and for a
   // light-path method the exemplar scene, the video and the noise pass):
   // make_job for the units "frame" and "chained frame", make_segment_job for
-  // "segment"; neither for a method that runs in Python.
+  // "segment".
   MakeJob make_job;
   MakeSegmentJob make_segment_job;
   // Reads the method's options as its job factory does, touching no file:
@@ -68,8 +68,9 @@ struct MethodEntry {
   // The project's own exemplar that stands in when --exemplar is left out:
   // the kind `tempera exemplar KIND` writes ("smoke", "ink"), which the
   // Python package's `tempera stylize` generates into OUT once and passes
-  // on (tempera/app/exemplar_cli.py); "" when the method needs the artist's
-  // (StyLit's painting). The rigid-body method makes its own in Python.
+  // on (tempera/app/exemplar_cli.py); kJobMadeExemplar when the job makes its
+  // own from an empty --exemplar (the rigid-body method's drawn ball); ""
+  // when the method needs the artist's (StyLit's painting).
   std::string default_exemplar;
   // More of --help, after the summary: what the exemplar and the guides must
   // hold, where the outputs go, how resume decides; paragraphs ending in "\n".
@@ -82,8 +83,8 @@ const std::deque<MethodEntry>& method_registry();
 
 // Adds a method at run time (a plug-in, a test's example): registered before
 // a front end reads the registry, it is run like any other. ValueError when
-// the name is empty, taken or not a plain word, or when it has no job and
-// no command. Not thread-safe: register at start-up.
+// the name is empty, taken or not a plain word, or when it has no job
+// factory for its unit. Not thread-safe: register at start-up.
 void register_method(MethodEntry entry);
 
 // The ValueError of an option that the method `name` does not take,

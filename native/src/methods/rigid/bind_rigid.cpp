@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <optional>
 
+#include "bind_frame_job.hpp"
 #include "bind_method.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
@@ -16,6 +17,7 @@
 #include "tempera/methods/rigid/rigid.hpp"
 #include "tempera/methods/rigid/rigid_exemplar.hpp"
 #include "tempera/methods/rigid/rigid_frame.hpp"
+#include "tempera/methods/rigid/stroke_resynthesis.hpp"
 
 namespace py = pybind11;
 using namespace tempera;
@@ -95,6 +97,41 @@ QuadraticMap map_of(const py::array_t<double, py::array::c_style | py::array::fo
 const TrackFrame& frame_of(const Track& t, int f) {
   if (f < 0 || f >= int(t.frames.size())) throw ValueError(concat("frame ", f, " is outside the track's ", t.frames.size()));
   return t.frames[std::size_t(f)];
+}
+
+void bind_strokes(py::module_& m) {
+  m.def(
+      "stroke_guide",
+      [](const FloatArray& rgba, float d_max) {
+        const ImageView v = py_bridge::view_of(rgba, "drawing");
+        if (v.channels != 4) throw ValueError("the drawing must be an RGBA image");
+        return py_bridge::to_numpy(stroke_guide(v, d_max));
+      },
+      py::arg("rgba"), py::arg("d_max"), "G = 1 - distance to the ink / d_max (H, W, 1); use tempera.methods.rigid.rigid_strokes.");
+  m.def(
+      "resynthesize_strokes",
+      [](const FloatArray& drawing, const FloatArray& exemplar, float d_max, float weight, std::uint64_t seed,
+         const py::object& progress) {
+        const ImageView d = py_bridge::view_of(drawing, "drawing"), e = py_bridge::view_of(exemplar, "stroke exemplar");
+        const ProgressCallback report = py_bridge::python_progress(progress);
+        Image out;
+        {
+          py::gil_scoped_release release;
+          out = resynthesize_strokes(d, e, d_max, weight, seed, report);
+        }
+        return py_bridge::to_numpy(std::move(out));
+      },
+      py::arg("drawing"), py::arg("exemplar"), py::arg("d_max"), py::arg("weight"), py::arg("seed") = 1,
+      py::arg("progress") = py::none(), "The drawing's strokes re-made from the stroke exemplar (RGBA).");
+  m.def(
+      "generated_stroke_exemplar",
+      [](int size, float width, std::uint64_t seed) { return py_bridge::to_numpy(generated_stroke_exemplar(size, width, seed)); },
+      py::arg("size") = 160, py::arg("width") = 4.0f, py::arg("seed") = 0, "The project's brush-pen stroke exemplar (RGBA).");
+  m.def(
+      "load_stroke_exemplar", [](const std::string& spec) { return py_bridge::to_numpy(load_stroke_exemplar(spec)); },
+      py::arg("spec"), "The stroke exemplar 'generated' or an image file names (RGBA).");
+  m.attr("GENERATED_STROKE_COLOUR") =
+      py::make_tuple(kGeneratedStrokeColour[0], kGeneratedStrokeColour[1], kGeneratedStrokeColour[2]);
 }
 
 void bind_rigid(py::module_& m) {
@@ -259,6 +296,7 @@ void bind_rigid(py::module_& m) {
       py::arg("progress") = nullptr, py::arg("only") = py::none(),
       "Every target frame: [(RGBA, D_hat, contact shift)] (None for frames not in `only`); progress(frame) "
       "returning False cancels.");
+  bind_strokes(m);
 }
 
 // module.cpp runs it after the core's bindings (py_bridge::method_bindings).

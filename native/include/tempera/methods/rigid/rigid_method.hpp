@@ -1,6 +1,6 @@
 #pragma once
 // The rigid-body method's line of the method registry (methods/registry.hpp): its texts,
-// unit and guide needs; it runs through the Python package (python_command).
+// unit, options and its job (rigid_job.hpp).
 #include "tempera/methods/registry.hpp"
 
 namespace tempera {
