@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <climits>
+#include <cstdint>
+#include <map>
 #include <filesystem>
 
 #include "tempera/app/contact_sheet.hpp"
@@ -68,7 +71,24 @@ ExemplarFiles exemplar_files(const std::string& folder) {
   return files;
 }
 
+std::string names_text(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& n : names) out += concat(n.size(), ":", n, ";");  // any name, unambiguous
+  return out;
+}
+
 int shape_symmetry(ProxyShape shape) { return shape == ProxyShape::box ? 4 : 0; }
+
+// Straight-alpha `layer` over straight-alpha `below`, in place.
+void lay_over(Image& below, const Image& layer) {
+  for (std::size_t i = 0; i < below.pixel_count(); ++i) {
+    float* b = below.data() + 4 * i;
+    const float* l = layer.data() + 4 * i;
+    const float a = l[3], under = b[3] * (1.0f - a), alpha = a + under;
+    for (int c = 0; c < 3; ++c) b[c] = (l[c] * a + b[c] * under) / std::max(alpha, 1e-6f);
+    b[3] = alpha;
+  }
+}
 
 // Straight-alpha RGBA made opaque over the paper colour.
 void lay_on_paper(Image& rgba) {
@@ -116,8 +136,11 @@ void write_generated_rigid_exemplar(const std::string& folder, const std::string
 struct RigidJob::Solved {
   std::vector<RigidExemplar> exemplars;
   std::vector<std::vector<Image>> residuals;  // per exemplar and frame
-  std::vector<RigidFrame> deformations;       // per tracked target frame
-  std::vector<Vec2> shifts;
+  struct Target {
+    std::vector<RigidFrame> deformations;  // per tracked frame
+    std::vector<Vec2> shifts;
+  };
+  std::map<std::string, Target> targets;
 
   ImageView residual(int e, int f) const { return residuals[std::size_t(e)][std::size_t(f)].view(); }
 };
@@ -131,9 +154,16 @@ RigidJob::RigidJob(RigidJobConfig config) : config_(std::move(config)) {
   validate_fields(config_.options, rigid_option_table());
   validate_fields(config_.fit, quadratic_fit_option_table());
   tracks_ = read_tracks_file(config_.guides);
-  target_ = &tracks_.objects.at(one_object(tracks_, config_.object, concat("guide cache ", config_.guides)));
+  if (tracks_.objects.empty()) throw ValueError(concat("guide cache ", config_.guides, " tracks no object"));
+  for (const std::string& name : config_.objects) objects_.push_back(one_object(tracks_, name, concat("guide cache ", config_.guides)));
+  if (objects_.empty())
+    for (const auto& [name, track] : tracks_.objects) objects_.push_back(name);
+  std::sort(objects_.begin(), objects_.end());
+  objects_.erase(std::unique(objects_.begin(), objects_.end()), objects_.end());
   std::tie(width_, height_) = guide_cache_frame_size(config_.guides);
-  const int first = tracks_.frame_start, last = first + int(target_->frames.size()) - 1;
+  std::size_t tracked = SIZE_MAX;
+  for (const std::string& name : objects_) tracked = std::min(tracked, tracks_.objects.at(name).frames.size());
+  const int first = tracks_.frame_start, last = first + int(tracked) - 1;
   for (int f : config_.frames)
     if (f < first || f > last)
       throw ValueError(concat("frame ", f, " is outside the tracked frames ", first, "-", last));
@@ -168,7 +198,7 @@ RigidJob::RigidJob(RigidJobConfig config) : config_(std::move(config)) {
     for (const std::string& path : {output_path(f), record_path(f)}) inputs_.refuse_file(path);
   settings_ = concat(kRecordFormat, ";", settings_text(config_.options, rigid_option_table()),
                      settings_text(config_.fit, quadratic_fit_option_table()), "shape=", config_.shape,
-                     ";paper=", config_.paper, ";object=", one_object(tracks_, config_.object, ""), ";strokes=",
+                     ";paper=", config_.paper, ";objects=", names_text(objects_), ";strokes=",
                      config_.strokes.empty() || config_.strokes == kGeneratedStrokes ? config_.strokes
                                                                                        : file_stamp(config_.strokes),
                      ";size=", width_, "x", height_, ";format=", config_.format, ";", file_stamp(tracks_file), ";",
@@ -212,8 +242,12 @@ const RigidJob::Solved& RigidJob::solved() {
   }
   const Solved& view = *s;
   const ResidualSource source = [&view](int e, int f) { return view.residual(e, f); };
-  s->deformations = synthesize_deformations(s->exemplars, *target_, config_.options);
-  s->shifts = contact_shifts(s->exemplars, source, *target_, s->deformations, width_, height_, config_.options.contact_fade);
+  for (const std::string& name : objects_) {
+    const Track& target = tracks_.objects.at(name);
+    Solved::Target& t = s->targets[name];
+    t.deformations = synthesize_deformations(s->exemplars, target, config_.options);
+    t.shifts = contact_shifts(s->exemplars, source, target, t.deformations, width_, height_, config_.options.contact_fade);
+  }
   solved_ = std::move(s);
   return *solved_;
 }
@@ -227,21 +261,49 @@ FrameResult RigidJob::run_frame(std::size_t index, const ProgressCallback& progr
   if (config_.resume && record_current(record_path(f), kRecordFormat, frame_key(f), {result.path})) return result;
   const auto t0 = std::chrono::steady_clock::now();
   if (progress && !progress(0.0)) throw CancelledError("rigid-body stylization cancelled");
-  const Solved& s = solved();
-  const int i = f - tracks_.frame_start;
-  const ResidualSource source = [&s](int e, int k) { return s.residual(e, k); };
-  Image rgba = render_rigid_frame(s.exemplars, source, *target_, i, s.deformations[std::size_t(i)], width_, height_,
-                                  s.shifts[std::size_t(i)]);
-  if (!strokes_.empty())
-    rgba = resynthesize_strokes(rgba.view(), strokes_.view(), config_.options.stroke_d_max,
-                                config_.options.stroke_weight, 1, progress);
-  if (config_.paper) lay_on_paper(rgba);
+  solved();
+  Image rgba;
+  if (objects_.size() == 1) {
+    rgba = draw_object(objects_[0], f, progress);
+    if (config_.paper) lay_on_paper(rgba);
+  } else {
+    rgba = Image(width_, height_, 4);
+    if (config_.paper) lay_on_paper(rgba);
+    for (const std::string& name : far_to_near(f)) lay_over(rgba, draw_object(name, f, progress));
+  }
   create_output_folder((fs::path(config_.out) / kRecordsFolder).string());
   write_image(result.path, rgba.view());
   write_record(record_path(f), kRecordFormat, frame_key(f), {result.path});
   result.status = "stylized";
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;
+}
+
+// The targets far to near at `frame` (the tracks' camera depth; an object
+// without one counts as depth 0, and ties keep the name order).
+std::vector<std::string> RigidJob::far_to_near(int frame) const {
+  const std::size_t i = std::size_t(frame - tracks_.frame_start);
+  const auto key = [&](const std::string& name) {
+    const auto depth = tracks_.depths.find(name);
+    return depth == tracks_.depths.end() ? 0.0 : -depth->second[i];
+  };
+  std::vector<std::string> order = objects_;
+  std::stable_sort(order.begin(), order.end(), [&](const auto& a, const auto& b) { return key(a) < key(b); });
+  return order;
+}
+
+// One object's drawing at `frame` (RGBA, straight alpha), its lines re-drawn
+// from the stroke exemplar when there is one.
+Image RigidJob::draw_object(const std::string& name, int frame, const ProgressCallback& progress) const {
+  const Solved& s = *solved_;
+  const Solved::Target& t = s.targets.at(name);
+  const std::size_t i = std::size_t(frame - tracks_.frame_start);
+  const ResidualSource source = [&s](int e, int k) { return s.residual(e, k); };
+  Image rgba = render_rigid_frame(s.exemplars, source, tracks_.objects.at(name), int(i), t.deformations[i], width_,
+                                  height_, t.shifts[i]);
+  if (strokes_.empty()) return rgba;
+  return resynthesize_strokes(rgba.view(), strokes_.view(), config_.options.stroke_d_max,
+                              config_.options.stroke_weight, 1, progress);
 }
 
 void RigidJob::write_contact_sheet(const std::string& path, int columns) const {

@@ -25,7 +25,8 @@ const char* kDetails =
     "drawn frames; rerun the same command after an interruption. No file is ever deleted.\n";
 
 const char* kJobOptionsHelp =
-    "  --object NAME           the target object (needed when the cache tracks several)\n"
+    "  --object NAME           a target object (repeatable; default every tracked object, each drawn\n"
+    "                          on its own and laid over the others far to near by camera depth)\n"
     "  --shape MODE            the objects' proxy [circle, box] (default circle)\n"
     "  --paper [V]             opaque frames on paper instead of RGBA (default false)\n"
     "  --strokes IMAGE         re-draw the lines from this stroke exemplar (an RGBA image of strokes,\n"
@@ -46,7 +47,7 @@ RigidJobConfig job_config(const JobConfig& given, const MethodOptions& options) 
       if (text.empty()) throw ValueError(concat("--", flag, " needs a value"));
       return text;
     };
-    if (flag == "object") config.object = value();
+    if (flag == "object") config.objects.push_back(value());
     else if (flag == "shape") config.shape = enum_name(parse_enum<ProxyShape>(value(), "proxy shape"));
     else if (flag == "paper") config.paper = yes(flag, text);
     else if (flag == "strokes") config.strokes = value();

@@ -62,6 +62,17 @@ Track track_of(const Json& d) {
   return t;
 }
 
+std::vector<double> depths_of(const Json& depth, const Track& track) {
+  if (depth.type != Json::Type::Array || depth.items.size() != track.frames.size())
+    throw ValueError("a track's 'depth' needs one number per frame");
+  std::vector<double> out;
+  for (const Json& d : depth.items) {
+    out.push_back(number(d, "a depth"));
+    if (!std::isfinite(out.back())) throw ValueError(concat("depth ", out.back(), " at frame ", out.size() - 1, " is not finite"));
+  }
+  return out;
+}
+
 Json json_of(const Vec2& v) { return Json::array({Json::of(v.x), Json::of(v.y)}); }
 
 // The track as tempera.methods.rigid.rigid_tracks writes one.
@@ -122,6 +133,7 @@ TracksFile read_tracks_file(const std::string& folder) {
   for (const auto& [name, track] : objects->fields) {
     try {
       tracks.objects[name] = track_of(track);
+      if (const Json* depth = track.find("depth")) tracks.depths[name] = depths_of(*depth, tracks.objects[name]);
     } catch (const ValueError& e) {
       throw ValueError(concat(path.string(), ": object '", name, "': ", e.what()));
     }
@@ -131,7 +143,14 @@ TracksFile read_tracks_file(const std::string& folder) {
 
 void write_tracks_file(const std::string& folder, const TracksFile& tracks) {
   std::vector<std::pair<std::string, Json>> objects;
-  for (const auto& [name, track] : tracks.objects) objects.emplace_back(name, json_of(track));
+  for (const auto& [name, track] : tracks.objects) {
+    objects.emplace_back(name, json_of(track));
+    if (const auto depth = tracks.depths.find(name); depth != tracks.depths.end()) {
+      std::vector<Json> values;
+      for (double d : depth->second) values.push_back(Json::of(d));
+      objects.back().second.fields.emplace_back("depth", Json::array(values));
+    }
+  }
   const Json data = Json::object({{"format", Json::of(double(kTracksFormat))},
                                   {"frame_start", Json::of(double(tracks.frame_start))},
                                   {"gravity", json_of(tracks.gravity)},

@@ -1,8 +1,9 @@
 #pragma once
 // The rigid-body method (rigid.hpp) as a job of independent frames over a
 // guide cache's tracks.json: `tempera stylize --method rigid` and the
-// registry's make_job. The target is one tracked object (config.object, or
-// the cache's only one); the exemplar is a folder with a source
+// registry's make_job. The targets are the tracked objects (config.objects,
+// or every one), each drawn on its own and laid over the others far to near
+// by the tracks' camera depth (the name order without one); the exemplar is a folder with a source
 // simulation's tracks.json and its drawn frames drawn/NNNN.png (RGBA ink,
 // every frame drawn), a folder of such folders, or "generated": the
 // project's own drawn bouncing ball (a box with shape "box"), written once
@@ -25,7 +26,7 @@ namespace tempera {
 constexpr const char* kGeneratedRigidExemplar = "generated";
 
 struct RigidJobConfig : JobConfig {
-  std::string object;            // the target object; "" when the cache tracks one
+  std::vector<std::string> objects;  // the target objects; empty: every tracked one
   std::string shape = "circle";  // the objects' proxy: circle | box
   bool paper = false;            // opaque frames on paper instead of RGBA
   std::string strokes;           // a stroke exemplar to re-draw the lines with ("generated" or an image); "" none
@@ -61,10 +62,12 @@ class RigidJob : public FrameJob {
   struct Solved;  // the fitted exemplars and every frame's deformation, made once
   const Solved& solved();
   std::string frame_key(int frame) const;
+  std::vector<std::string> far_to_near(int frame) const;
+  Image draw_object(const std::string& name, int frame, const ProgressCallback& progress) const;
 
   RigidJobConfig config_;
   TracksFile tracks_;
-  const Track* target_ = nullptr;
+  std::vector<std::string> objects_;  // the targets, sorted
   int width_ = 0, height_ = 0;
   std::vector<std::string> exemplar_folders_;
   JobInputs inputs_;

@@ -18,6 +18,9 @@ struct TracksFile {
   int frame_start = 1;
   Vec2 gravity{0, 1};  // px per frame^2
   std::map<std::string, Track> objects;
+  // Each object's distance along the view axis per frame ("depth", which the
+  // Blender side writes): the order in which objects are laid over each other.
+  std::map<std::string, std::vector<double>> depths;
   int frame_count() const { return objects.empty() ? 0 : int(objects.begin()->second.frames.size()); }
 };
 
