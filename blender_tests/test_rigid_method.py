@@ -1,8 +1,8 @@
 """The rigid-body method from the panel (Method "Rigid Bodies (hand-drawn)")
 on a tiny baked scene: a ball dropped on a floor, drawn from the generated
 exemplar. Stylize Animation renders the guides (which write tracks.json),
-runs the method a step per object and chunk, composites and loads the
-result; Esc within a step writes nothing of it, and a rerun resumes."""
+runs the method's native job a frame per step and loads the result; Esc
+within a frame writes nothing of it, and a rerun resumes."""
 import math
 
 import bpy
@@ -111,12 +111,13 @@ def test_stylize_animation_draws_the_ball_and_resumes(rigid_scene, tmp_path):
         # floor at the bounce, never through it).
         assert len(xs) > 20 and abs(xs.mean() - cx) < 0.6 * r, f
         assert ys.min() < cy + r and ys.max() > cy - r and ys.max() < FLOOR_Y + 1.5, f
+    assert (tmp_path / "out" / "rigid" / "contact_sheet.png").is_file()
     image = bpy.data.images["Tempera frames"]  # loaded as today (Load Result: Image)
     assert image.source == "SEQUENCE" and bpy.path.abspath(image.filepath) == str(out / f"frame_{FRAMES[0]:04d}.png")
     again = StylizeRun.from_settings(rigid_scene, "ANIMATION")
     while not again.finished:
         again.step()
-    assert {r["status"] for r in again.step_results} == {"kept"}
+    assert {r["status"] for r in again.results} == {"skipped"}
     rigid_scene.tempera.rigid_output = "PAPER"
     paper = StylizeRun.from_settings(rigid_scene, "ANIMATION")
     while not paper.finished:
@@ -124,54 +125,64 @@ def test_stylize_animation_draws_the_ball_and_resumes(rigid_scene, tmp_path):
     assert tempera.read_image(str(out / f"frame_{FRAMES[0]:04d}.png"))[:, :, 3].min() == 1.0
 
 
-def test_esc_within_a_step_writes_nothing_then_resume(rigid_scene, tmp_path):
+def test_esc_within_a_frame_writes_nothing_then_resume(rigid_scene, tmp_path):
     from tempera.blender.stylize_operator import TEMPERA_OT_stylize, StylizeRun
 
     run = StylizeRun.from_settings(rigid_scene, "ANIMATION")
     while run.in_guide_phase:
         run.step()
-    run.step()  # the first chunk of the ball
-    held = run._rigid_job()
-    stylize = held._stylize
+    run.step()  # the first frame (the exemplar's fit, then its drawing)
+    run_frame = run.job.run_frame
 
     def hold(wrap):
-        held._stylize = lambda name, frames, paths, progress: stylize(name, frames, paths, wrap(progress))
+        run.job.run_frame = lambda index, progress=None: run_frame(index, wrap(progress))
 
     results, _log, reports, timers, _op = esc_within_next_step(TEMPERA_OT_stylize, rigid_scene, run, hold)
     assert results[-1] == {"CANCELLED"} and not timers and "Stopped" in reports[-1][1]
-    layers = tmp_path / "out" / "rigid" / "layers" / "Ball"
-    assert _frames(layers) == [f"frame_{f:04d}.png" for f in range(FRAMES[0], FRAMES[0] + 8)]  # the first chunk only
+    out = tmp_path / "out" / "rigid" / "frames"
+    assert _frames(out) == [f"frame_{FRAMES[0]:04d}.png"]  # the first frame only, nothing half-written
     rerun = StylizeRun.from_settings(rigid_scene, "ANIMATION")
     while not rerun.finished:
         rerun.step()
-    assert [r["status"] for r in rerun.step_results] == ["kept", "stylized", "composited", "composited"]
+    assert [r["status"] for r in rerun.results] == ["skipped"] + ["stylized"] * (FRAMES[1] - FRAMES[0])
 
 
-def test_panel_options_reach_the_job(rigid_scene):
+def test_panel_options_reach_the_job(rigid_scene, tmp_path):
     """K, augmentation, damping and the strokes of the panel are the job's
-    (names of the method's option table), and the panel shows them."""
+    options (the method's flags), the panel shows them, and the strokes are
+    the brush pen's."""
     from test_addon import _Recorder
+    from tempera import read_image
     from tempera.blender.methods import rigid
     from tempera.blender.stylize_operator import StylizeRun
+    from tempera.methods.rigid.rigid_strokes import STROKE_COLOUR
 
     settings = rigid_scene.tempera
     assert settings.rigid_k == rigid.OPTIONS["k"]["default"]
     settings.rigid_k, settings.rigid_augment, settings.rigid_damp = 1, False, False
     settings.rigid_strokes, settings.rigid_stroke_weight = "GENERATED", 2.5
+    settings.rigid_collection = bpy.data.collections.new("Targets")
+    settings.rigid_collection.objects.link(rigid_scene.objects["Ball"])
     calls = []
     bpy.types.TEMPERA_PT_output.draw(type("FakePanel", (), {"layout": _Recorder(calls)})(), bpy.context)
     props = [name for kind, name in calls if kind == "prop"]
     for name in ("rigid_k", "rigid_augment", "rigid_damp", "rigid_strokes", "rigid_stroke_weight"):
         assert name in props
     run = StylizeRun.from_settings(rigid_scene, "ANIMATION")
+    assert run.options == [("shape", "circle"), ("paper", False), ("k", 1), ("augment", False), ("damp", False),
+                           ("stroke-weight", 2.5), ("strokes", "generated"), ("object", "Ball")]
     while run.in_guide_phase:
         run.step()
-    job = run._rigid_job()
-    assert {k: job.values[k] for k in ("k", "augment", "damp", "stroke_weight")} == {
-        "k": 1, "augment": False, "damp": False, "stroke_weight": 2.5}
-    assert job.strokes == "generated" and job._stroke_exemplar is not None
+    run.step()
+    frame = read_image(run.results[0]["path"])
+    ink = frame[:, :, 3] > 0.5
+    assert ink.sum() > 20 and np.abs(frame[ink, :3].mean(0) - STROKE_COLOUR).max() < 0.05
+    bpy.data.collections.remove(settings.rigid_collection)
     settings.rigid_strokes, settings.rigid_stroke_image = "IMAGE", "/nowhere/strokes.png"
-    with pytest.raises(FileNotFoundError, match="strokes.png' does not exist"):
+    with pytest.raises(FileNotFoundError, match="strokes.png"):
+        StylizeRun.from_settings(rigid_scene, "ANIMATION")
+    settings.rigid_strokes, settings.rigid_examples = "NONE", str(tmp_path / "nowhere")
+    with pytest.raises(FileNotFoundError, match="nowhere' does not exist"):
         StylizeRun.from_settings(rigid_scene, "ANIMATION")
 
 
@@ -183,7 +194,7 @@ def test_empty_examples_use_the_projects_drawn_ball(rigid_scene, tmp_path):
     rigid_scene.tempera.rigid_examples = ""
     rigid_scene.tempera.guide_frame_start, rigid_scene.tempera.guide_frame_end = 9, 10
     assert bpy.ops.tempera.stylize(mode="ANIMATION") == {"FINISHED"}
-    generated = tmp_path / "out" / "rigid" / "generated_examples" / "exemplar_generated_circle"
+    generated = tmp_path / "out" / "rigid" / "exemplar_generated_circle"
     assert (generated / "tracks.json").is_file() and len(list((generated / "drawn").glob("*.png"))) == 60
     out = tmp_path / "out" / "rigid" / "frames"
     assert _frames(out) == ["frame_0009.png", "frame_0010.png"]

@@ -128,7 +128,7 @@ def test_a_hard_link_to_an_input_is_the_input(cli_path, tmp_path):
 def test_rigid_refuses_an_output_that_links_to_a_drawing(tmp_path, capsys):
     """The rigid-body method keeps the rule too, from the CLI and the panel's job."""
     from tempera.__main__ import main
-    from tempera.methods.rigid.rigid_job import RigidJob
+    from tempera.methods import registry
     from test_cli_rigid import _cache, _exemplar
 
     (tmp_path / "ex").mkdir()
@@ -145,5 +145,5 @@ def test_rigid_refuses_an_output_that_links_to_a_drawing(tmp_path, capsys):
     (tmp_path / "panel" / "frames").mkdir(parents=True)
     (tmp_path / "panel" / "frames" / "frame_0002.png").symlink_to(drawing)
     with pytest.raises(ValueError, match="would overwrite the drawn exemplar frame"):
-        RigidJob(tmp_path / "cache", tmp_path / "ex", tmp_path / "panel", [1, 2])
+        registry.make_job("rigid", tmp_path / "ex", tmp_path / "cache", [1, 2], tmp_path / "panel")
     assert drawing.read_bytes() == before

@@ -19,8 +19,9 @@ is present) and the result loaded back into Blender (Load Result).
 Every other method has a module of its own (tempera.blender.methods.NAME)
 and makes its run there (run(scene, frames, mode); None: per-frame StyLit,
 as the coherent method and the rigid bodies answer for Stylize Frame).
-StylizeRun is also the base of the coherent method's run, and RgbaRun
-below of the runs that make RGBA frames from a medium.
+StylizeRun is also the base of the coherent method's run and of MethodRun
+below (a registry method's job, a frame per step: the rigid bodies), and
+RgbaRun of the runs that make RGBA frames from a medium.
 """
 import os
 import time
@@ -217,44 +218,25 @@ EXEMPLAR_FRAMES_DIR = "exemplar_frames"  # decoded movies and linked sequences, 
 RENDER_DIR = "render"  # the render under an RGBA result (tempera.app.beauty), in the method's folder
 
 
-class RgbaRun(StylizeRun):
-    """Guides of every frame, then an RGBA method's job (its registry entry's
-    job factory, tempera.methods.registry.make_job) a frame per step: the
-    frames go over the render (tempera.app.beauty) in a composite scene."""
+class MethodRun(StylizeRun):
+    """Guides of every frame, then a method's job (its registry entry's job
+    factory, tempera.methods.registry.make_job) a frame per step, into
+    Output Folder/FOLDER/frames (its contact sheet and mp4 beside them)."""
 
     folder = None  # the method's registry name, and its folder in the Output Folder
     method_label = None  # the method's name in messages
-    seconds_per_mpix = None  # a frame's rough cost, for the confirmation of long runs
-    kinds = ("STILL", "SEQUENCE", "MOVIE")  # the exemplars the method takes
 
-    def __init__(self, scene, frames, mode="ANIMATION"):
-        from ..app.media_source import exemplar_source
-
-        settings = scene.tempera
+    def __init__(self, scene, frames, mode, exemplar, options, format):
+        """EXEMPLAR and OPTIONS (by command-line flag) as make_job takes them."""
         self.mode = mode
         self.frames = list(frames)
-        self.out = output_dir(settings)
+        self.out = output_dir(scene.tempera)
         self.method_out = self.result_dir = os.path.join(self.out, self.folder)
-        if settings.media_exemplar.strip():
-            label = next(n for k, n, _ in MEDIA_EXEMPLAR_KINDS if k == settings.media_exemplar_kind)
-            if settings.media_exemplar_kind not in self.kinds:
-                raise ValueError(f"The {self.method_label} method needs a video exemplar: set Exemplar to Image "
-                                 f"Sequence or Movie (not {label}).")
-            cache = os.path.join(self.out, EXEMPLAR_FRAMES_DIR)
-            self.exemplar = exemplar_source(settings.media_exemplar_kind,
-                                            resolve_path(settings.media_exemplar, f"exemplar {label}"), cache)
-        else:  # the project's own (its registry entry's default_exemplar), written once beside the frames
-            from ..app.exemplar_cli import generated_folder
-            from ..methods import registry
-
-            kind = registry.find(self.folder)["default_exemplar"]
-            self.exemplar = str(generated_folder(self.method_out, kind))
-        require_consecutive(self.frames, f"The {self.method_label} method")
+        self.exemplar = exemplar
         self.guides = GuideJob.from_settings(scene, self.frames)
-        self.config = {"out": os.path.join(self.method_out, FRAMES_DIR), "format": settings.output_format,
+        self.config = {"out": os.path.join(self.method_out, FRAMES_DIR), "format": format,
                        "quality": "final"}  # the one layout: make_job writes the frames to OUT/frames
-        # By command-line flag, as make_job takes them.
-        self.options = {"seed": int(settings.seed), **self.job_options(settings)}
+        self.options = options
         self.noise = None
         self.job = None  # the method's job, made once the guides exist
         self.index = 0
@@ -264,7 +246,7 @@ class RgbaRun(StylizeRun):
 
     @property
     def in_noise_phase(self):
-        return False  # no Temporal Noise after an RGBA method
+        return False  # no Temporal Noise after a method of the registry
 
     def _stylize(self, progress):
         if self.job is None:
@@ -290,6 +272,38 @@ class RgbaRun(StylizeRun):
 
         return registry.make_job(self.folder, self.exemplar, self.guides.folder, self.frames, self.method_out,
                                  format=self.config["format"], options=self.options)
+
+
+class RgbaRun(MethodRun):
+    """A method's run that makes RGBA frames from a medium: the frames go
+    over the render (tempera.app.beauty) in a composite scene."""
+
+    seconds_per_mpix = None  # a frame's rough cost, for the confirmation of long runs
+    kinds = ("STILL", "SEQUENCE", "MOVIE")  # the exemplars the method takes
+
+    def __init__(self, scene, frames, mode="ANIMATION"):
+        from ..app.media_source import exemplar_source
+
+        settings = scene.tempera
+        frames = list(frames)
+        method_out = os.path.join(output_dir(settings), self.folder)
+        if settings.media_exemplar.strip():
+            label = next(n for k, n, _ in MEDIA_EXEMPLAR_KINDS if k == settings.media_exemplar_kind)
+            if settings.media_exemplar_kind not in self.kinds:
+                raise ValueError(f"The {self.method_label} method needs a video exemplar: set Exemplar to Image "
+                                 f"Sequence or Movie (not {label}).")
+            cache = os.path.join(output_dir(settings), EXEMPLAR_FRAMES_DIR)
+            exemplar = exemplar_source(settings.media_exemplar_kind,
+                                       resolve_path(settings.media_exemplar, f"exemplar {label}"), cache)
+        else:  # the project's own (its registry entry's default_exemplar), written once beside the frames
+            from ..app.exemplar_cli import generated_folder
+            from ..methods import registry
+
+            kind = registry.find(self.folder)["default_exemplar"]
+            exemplar = str(generated_folder(method_out, kind))
+        require_consecutive(frames, f"The {self.method_label} method")
+        options = {"seed": int(settings.seed), **self.job_options(settings)}
+        super().__init__(scene, frames, mode, exemplar, options, settings.output_format)
 
     def estimate_seconds(self, scene):
         return (estimate_guide_seconds(scene, self.guides.params, len(self.frames))

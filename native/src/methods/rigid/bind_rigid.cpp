@@ -17,6 +17,7 @@
 #include "tempera/methods/rigid/rigid.hpp"
 #include "tempera/methods/rigid/rigid_exemplar.hpp"
 #include "tempera/methods/rigid/rigid_frame.hpp"
+#include "tempera/methods/rigid/rigid_job.hpp"
 #include "tempera/methods/rigid/stroke_resynthesis.hpp"
 
 namespace py = pybind11;
@@ -144,6 +145,9 @@ void bind_rigid(py::module_& m) {
       m, "ExemplarStyle", exemplar_style_table(),
       "The generated exemplar's style (native/include/tempera/methods/rigid/rigid_exemplar.hpp).");
 
+  m.def("rigid_exemplar_folders", &rigid_exemplar_folders, py::arg("examples"),
+        "The exemplar folders of EXAMPLES (itself, or its subfolders holding tracks.json, sorted); "
+        "FileNotFoundError or ValueError naming the folder.");
   m.def(
       "check_rigid_track", [](const py::dict& track) { track_of(track); }, py::arg("track"),
       "ValueError (or TypeError) naming what is wrong with a track dict (tracks.json is user input).");
