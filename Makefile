@@ -149,15 +149,16 @@ sanitize: deps build-asan/CMakeCache.txt
 	cd build-asan && ctest --output-on-failure
 
 # The fuzz harness for FUZZ_SECONDS each half (CI runs it before make test): the
-# native half under AddressSanitizer and UBSan, then the Python half (the
-# rigid-body method's tracks and options) on the normal build's module.
+# native half under AddressSanitizer and UBSan, then the command-level half (the
+# rigid-body method's whole command on mutated tracks and options) on the
+# normal build's CLI.
 FUZZ_SECONDS ?= 60
 fuzz: deps build-asan/CMakeCache.txt build
 	cmake --build build-asan -j $(JOBS) --target tempera_fuzz
 	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
 	LSAN_OPTIONS=suppressions=$(CURDIR)/tests/fuzz/lsan.supp \
 	    build-asan/tests/fuzz/tempera_fuzz --seconds $(FUZZ_SECONDS)
-	PYTHONPATH=addon $(PYTHON) tests/fuzz/fuzz_rigid.py --seconds $(FUZZ_SECONDS)
+	PYTHONPATH=addon $(PYTHON) tests/fuzz/fuzz_rigid.py --seconds $(FUZZ_SECONDS) --tempera $(BUILD)/bin/tempera
 
 clean:
 	rm -rf $(BUILD) build-asan dist addon/tempera/_native*.so

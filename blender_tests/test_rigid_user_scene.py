@@ -1,11 +1,11 @@
 """The rigid-body method on a scene made the way a new user makes one, only
 with Blender's own operators and their defaults (scenes/rigid_fractured_cube.py:
 a cube broken by Cell Fracture falling onto a plane). The method then
-runs from the panel (Stylize Animation) and from the CLI on the guide cache
-(`tempera rigid --object SHARD`, each shard on its own): every shard is
-drawn where it is, its first collision is on the floor, no drawing goes
-through the floor at a contact, no map folds, and the panel's frames are
-the CLI's shards laid far to near."""
+runs from the panel (Stylize Animation) and as the CLI's job on the guide
+cache (`tempera stylize --method rigid --object SHARD`, each shard on its
+own): every shard is drawn where it is, its first collision is on the
+floor, no drawing goes through the floor at a contact, no map folds, and
+the panel's frames are the shards laid far to near."""
 import math
 import sys
 from pathlib import Path
@@ -75,6 +75,16 @@ def _min_det(D):
     return float((jx[0] * jy[1] - jx[1] * jy[0]).min())
 
 
+def _fitted(folder):
+    """The exemplar FOLDER fitted (as the job fits it): its maps D, frame by frame."""
+    import tempera
+    from tempera.methods.rigid import rigid, rigid_tracks
+
+    track = rigid_tracks.read_tracks(folder)["objects"]["Box"]
+    drawn = [tempera.read_image(str(folder / "drawn" / f"{1 + i:04d}.png")) for i in range(len(track["centre"]))]
+    return rigid.fit_exemplar(track, drawn, shape="box")
+
+
 def _premultiplied(rgba):
     return np.concatenate([rgba[:, :, :3] * rgba[:, :, 3:], rgba[:, :, 3:]], axis=2)
 
@@ -91,8 +101,8 @@ def _laid_far_to_near(layers, depths):
 
 def test_fractured_cube_from_the_panel_and_the_cli(fractured_scene, tmp_path):
     import tempera
-    from tempera.methods.rigid import rigid, rigid_cli, rigid_tracks
-    from tempera.__main__ import main
+    from tempera.methods import registry
+    from tempera.methods.rigid import rigid, rigid_tracks
 
     scene, shards = fractured_scene
     assert len(shards) >= 4
@@ -101,12 +111,13 @@ def test_fractured_cube_from_the_panel_and_the_cli(fractured_scene, tmp_path):
     assert sorted(tracks["objects"]) == shards
     start = tracks["frame_start"]
     out = tmp_path / "out" / "rigid"
-    cli = tmp_path / "cli"  # each shard on its own, from the command line
+    cli = tmp_path / "cli"  # each shard on its own, as `tempera stylize --method rigid --object NAME` runs it
+    frames = list(range(FRAMES[0], FRAMES[1] + 1))
     for name in shards:
-        assert main(["rigid", "--cache", str(tmp_path / "guides"), "--exemplar", str(tmp_path / "examples" / "box"),
-                     "--object", name, "--shape", "box", "--frames", f"{FRAMES[0]}-{FRAMES[1]}",
-                     "--out", str(cli / name)]) == 0
-    exemplar = rigid_cli._read_exemplar(tmp_path / "examples" / "box", "box", {})[0]
+        job = registry.make_job("rigid", tmp_path / "examples" / "box", tmp_path / "guides", frames, cli / name,
+                                options=[("object", name), ("shape", "box")])
+        assert {job.run_frame(i)["status"] for i in range(len(frames))} == {"stylized"}
+    exemplar = _fitted(tmp_path / "examples" / "box")
     floor_events = 0
     for name in shards:
         track = tracks["objects"][name]
@@ -121,7 +132,7 @@ def test_fractured_cube_from_the_panel_and_the_cli(fractured_scene, tmp_path):
         floor_events += first["obstacle"] == "static"
         # Every shard drawn where it is, in every frame.
         for f in range(FRAMES[0], FRAMES[1] + 1):
-            layer = tempera.read_image(str(cli / name / f"frame_{f:04d}.png"))
+            layer = tempera.read_image(str(cli / name / "frames" / f"frame_{f:04d}.png"))
             ys, xs = np.nonzero(layer[:, :, 3] > 0.5)
             (cx, cy), r = track["centre"][f - start], track["radius"][f - start]
             assert len(xs) > 10, (name, f)
@@ -146,7 +157,7 @@ def test_fractured_cube_from_the_panel_and_the_cli(fractured_scene, tmp_path):
             near_y = min((o.matrix_world @ v.co).y for v in o.data.vertices)
             floor = world_to_camera_view(scene, scene.camera, Vector((o.matrix_world.translation.x, near_y, 0.0)))
             floor_row = (1 - floor.y) * SIZE[1]
-            layer = tempera.read_image(str(cli / name / f"frame_{f:04d}.png"))
+            layer = tempera.read_image(str(cli / name / "frames" / f"frame_{f:04d}.png"))
             rows = np.nonzero(layer[:, :, 3].max(axis=1) > 0.5)[0]
             r = tracks["objects"][name]["radius"][e["frame"]]
             ys, xs = np.nonzero(layer[:, :, 3] > 0.5)
@@ -158,7 +169,7 @@ def test_fractured_cube_from_the_panel_and_the_cli(fractured_scene, tmp_path):
             assert rows.max() <= floor_row + 0.25 * r, (name, f, rows.max(), floor_row)
     # The panel's frames are the shards laid far to near by camera depth.
     for f in (FRAMES[0], 14, FRAMES[1]):
-        layers = {n: tempera.read_image(str(cli / n / f"frame_{f:04d}.png")) for n in shards}
+        layers = {n: tempera.read_image(str(cli / n / "frames" / f"frame_{f:04d}.png")) for n in shards}
         depths = {n: tracks["objects"][n]["depth"][f - start] for n in shards}
         composite = tempera.read_image(str(out / "frames" / f"frame_{f:04d}.png"))
         assert np.abs(_premultiplied(composite) - _laid_far_to_near(layers, depths)).max() < 3 / 255, f

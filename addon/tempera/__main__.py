@@ -2,8 +2,7 @@
 `python -m tempera`.
 
 `tempera farm ...` and `tempera stylize --scheduler ADDRESS ...` run a shot on
-a Dask cluster (tempera.app.farm); `tempera rigid ...` runs the rigid-body
-method's own form (tempera.methods.rigid.rigid_cli); `tempera exemplar ...` writes one of the
+a Dask cluster (tempera.app.farm); `tempera exemplar ...` writes one of the
 project's own smoke/fire/ink exemplars (tempera.app.exemplar_cli), which `tempera stylize --method M`
 also uses when M has a default exemplar and --exemplar is left out; every other command is the
 native batch CLI
@@ -53,10 +52,6 @@ def main(argv=None):
         from .app.farm import main as farm_main
 
         return farm_main(argv[1:])
-    if argv[:1] == ["rigid"]:
-        from .methods.rigid.rigid_cli import main as rigid_main
-
-        return rigid_main(argv[1:])
     if argv[:1] == ["stylize"] and stylize_method(argv[1:]) is not None:
         from .app.exemplar_cli import with_default_exemplar
         from .methods import registry

@@ -30,6 +30,16 @@ const std::map<std::string, Command>& commands() {
   return table;
 }
 
+// Commands that became another, named when a script still calls them.
+const std::map<std::string, std::string>& moved_commands() {
+  static const std::map<std::string, std::string> table = {
+      {"rigid",
+       "'tempera rigid' is now 'tempera stylize --method rigid --guides CACHE --frames A-B --out OUT' "
+       "(--cache is --guides; the frames go to OUT/frames; see tempera stylize --method rigid --help)"},
+  };
+  return table;
+}
+
 void print_help() {
   std::cout << "usage: tempera [--help] [--version] <command> [options]\n\n"
                "Tempera stylizes 3D animations by example.\n\n";
@@ -51,6 +61,10 @@ int main(int argc, char** argv) {
   if (args[0] == "--version") {
     std::cout << "tempera " << TEMPERA_VERSION << "\n";
     return 0;
+  }
+  if (const auto moved = moved_commands().find(args[0]); moved != moved_commands().end()) {
+    std::cerr << "tempera: " << moved->second << "\n";
+    return 2;
   }
   auto it = commands().find(args[0]);
   if (it == commands().end()) {

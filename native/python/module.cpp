@@ -6,8 +6,6 @@
 #include "bind_method.hpp"
 #include "numpy_bridge.hpp"
 #include "tempera/app/image_io.hpp"
-#include "tempera/app/job_inputs.hpp"
-#include "tempera/app/record.hpp"
 #include "tempera/app/segments.hpp"
 
 namespace py = pybind11;
@@ -77,34 +75,6 @@ void bind_io(py::module_& m) {
       "Images declaring more pixels than this are refused (OSError) before their pixels are read; "
       "default 50 Mpix or $TEMPERA_MAX_IMAGE_PIXELS.");
   m.def("max_image_pixels", &max_image_pixels, "The current image size limit in pixels.");
-  m.def(
-      "refuse_writing_on_inputs",
-      [](const std::vector<std::string>& outputs, const std::vector<std::pair<std::string, std::string>>& inputs) {
-        JobInputs in;
-        for (const auto& [path, what] : inputs) in.add_file(path, what);
-        for (const auto& out : outputs) in.refuse_file(out);
-      },
-      py::arg("outputs"), py::arg("inputs"),
-      "The job core's rule for jobs written in Python (app/job_inputs.hpp): ValueError if writing any of `outputs` "
-      "would replace one of `inputs` ((path, what) pairs), also through a symbolic or hard link.");
-  m.def(
-      "write_record",
-      [](const std::string& record, const std::string& format, const std::string& key,
-         const std::vector<std::string>& files) {
-        py::gil_scoped_release release;  // checksums every file
-        write_record(record, format, key, files);
-      },
-      py::arg("record"), py::arg("format"), py::arg("key"), py::arg("files"),
-      "The job core's resume record (app/record.hpp): format, key, and each file's size and checksum; atomic.");
-  m.def(
-      "record_current",
-      [](const std::string& record, const std::string& format, const std::string& key,
-         const std::vector<std::string>& files) {
-        py::gil_scoped_release release;
-        return record_current(record, format, key, files);
-      },
-      py::arg("record"), py::arg("format"), py::arg("key"), py::arg("files"),
-      "True when the record has this format and key and every file is unchanged.");
   m.def(
       "key_segments",
       [](const std::vector<int>& frames, const std::vector<int>& key_frames) {

@@ -9,8 +9,9 @@
 // guide-cache EXR read by layer and as a GuideFrame), lpe (the light path
 // expression compiler), sidecar (the stylize resume record), options (the
 // option and frame-range parsing of every method's command: synth, stylize
-// with each --method, noisy, render-guides). The rigid-body method's tracks
-// reader and options are Python: tests/fuzz/fuzz_rigid.py. Every input must either work or be
+// with each --method, noisy, render-guides). tests/fuzz/fuzz_rigid.py runs the
+// rigid-body method's whole command on mutated tracks.json, manifests and
+// options. Every input must either work or be
 // refused with one of Tempera's error types; anything else is a finding and
 // the exit status is 1. Each finding's input is saved in the work folder.
 #include <fcntl.h>

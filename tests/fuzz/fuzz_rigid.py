@@ -1,34 +1,39 @@
-"""fuzz_rigid: the rigid-body method's inputs on random and mutated values
-(issue 31): the tracks reader (a guide cache's and an exemplar's tracks.json,
-and the cache's manifest.json) and the options of `tempera rigid`. That
-method's command is Python, so this is the Python half of the fuzz harness;
-tests/fuzz/fuzz_main.cpp is the native half. `make fuzz` runs both, and
-tests/python/test_fuzz_rigid.py runs this briefly in every `make test`.
+"""fuzz_rigid: the rigid-body method's command on random and mutated inputs
+(issue 31): its files (a guide cache's and an exemplar's tracks.json, and the
+cache's manifest.json) and its options, each input a whole run of the native
+`tempera stylize --method rigid` (read, check, fit, draw one frame, write).
+tests/fuzz/fuzz_main.cpp fuzzes the native entry points in-process; `make
+fuzz` runs both, and tests/python/test_fuzz_rigid.py runs this briefly in
+every `make test`.
 
     PYTHONPATH=addon python3 tests/fuzz/fuzz_rigid.py [--seconds S] [--seed N]
                                                      [--only tracks|options] [--work DIR]
+                                                     [--tempera PATH]
 
-Each input runs the whole command (read, check, fit, draw one frame, write).
-It must end with exit status 0, 1 (a file) or 2 (a bad value, named); any
-exception, another status, or a frame that does not read back is a finding.
-Each finding's input is saved in the work folder, and the exit status is 1.
+A run must end with exit status 0, 1 (a file) or 2 (a bad value), with a
+message when it is not 0; a signal (a crash), another status, or a frame
+that does not read back is a finding. Each finding's input is saved in the
+work folder, and the exit status is 1.
 """
 from __future__ import annotations
 
 import argparse
-import contextlib
-import io
 import json
 import math
+import os
 import random
+import re
 import shutil
+import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
 from tempera import _native
-from tempera.methods.rigid import rigid, rigid_cli, rigid_tracks
+from tempera.methods.rigid import rigid, rigid_tracks
+
+ROOT = Path(__file__).resolve().parents[2]
 
 W, H = 96, 64
 FRAMES = 12
@@ -119,25 +124,25 @@ def mutate_json_file(rng, text):
 # ------------------------------------------------------------------ running
 
 class Fuzz:
-    def __init__(self, work):
+    def __init__(self, work, tempera):
         self.work = work
+        self.tempera = tempera
         self.findings = 0
         self.statuses = {}
 
     def run(self, target, argv, saved_input):
-        """Runs `tempera rigid argv`; returns the status, counting a finding when it is not one of Tempera's."""
-        out = io.StringIO()
+        """Runs `tempera stylize --method rigid argv`; returns the status,
+        counting a finding when it is not one of Tempera's."""
         try:
-            with contextlib.redirect_stdout(out), contextlib.redirect_stderr(out):
-                status = rigid_cli.main(argv)
-        except SystemExit as e:  # argparse's usage errors
-            status = e.code
-        except Exception as e:  # noqa: BLE001 - every other exception is what the harness looks for
-            return self.finding(target, f"{type(e).__name__}: {e}", argv, saved_input)
+            done = subprocess.run([str(self.tempera), "stylize", "--method", "rigid", *argv], capture_output=True,
+                                  text=True, errors="replace", timeout=120)
+        except subprocess.TimeoutExpired:
+            return self.finding(target, "no end within 120 s", argv, saved_input)
+        status, said = done.returncode, done.stderr
         self.statuses[status] = self.statuses.get(status, 0) + 1
-        if status not in (0, 1, 2):
-            return self.finding(target, f"exit status {status}: {out.getvalue()[-300:]}", argv, saved_input)
-        if status in (1, 2) and not out.getvalue().strip():
+        if status not in (0, 1, 2):  # a signal (negative) or a status of no one's
+            return self.finding(target, f"exit status {status}: {said[-300:]}", argv, saved_input)
+        if status in (1, 2) and not said.strip():
             return self.finding(target, f"exit status {status} with no message", argv, saved_input)
         return status
 
@@ -177,17 +182,18 @@ def fuzz_tracks(fuzz, rng, more):
         which = rng.choices(list(originals), weights=[6, 3, 1])[0]
         data = mutate_json_file(rng, originals[which])
         (run / which).write_bytes(data)
-        argv = ["--cache", str(run / "cache"), "--exemplar", str(run / "ex"), "--out", str(run / "out"),
+        argv = ["--guides", str(run / "cache"), "--exemplar", str(run / "ex"), "--out", str(run / "out"),
                 "--frames", str(1 + rng.randrange(FRAMES))]
         if fuzz.run("tracks", argv, {which.replace("/", "_"): data}) == 0:
-            check_frames(fuzz, "tracks", run / "out", argv, {which.replace("/", "_"): data})
+            check_frames(fuzz, "tracks", run / "out" / "frames", argv, {which.replace("/", "_"): data})
 
 
-def option_flags():
-    """Every option of `tempera rigid`, from its parser (so a new one is fuzzed at once)."""
-    parser = rigid_cli._parser()
-    return [s for action in parser._actions for s in action.option_strings
-            if s.startswith("--") and s not in ("--help", "--cache", "--guides", "--exemplar", "--out")]
+def option_flags(tempera):
+    """Every option of the method, from its help (so a new one is fuzzed at once)."""
+    shown = subprocess.run([str(tempera), "stylize", "--method", "rigid", "--help"], capture_output=True, text=True,
+                           timeout=60).stdout
+    given = {"--help", "--guides", "--exemplar", "--out", "--method"}
+    return sorted({f for f in re.findall(r"^\s+(--[a-z][a-z0-9-]*)", shown, re.M) if f not in given})
 
 
 OPTION_VALUES = ["0", "1", "-1", "2", "0.5", "1e300", "-1e300", "nan", "inf", "-inf", "1,2", "1,nan", ",", "",
@@ -200,11 +206,11 @@ def fuzz_options(fuzz, rng, more):
     inputs = fuzz.work / "inputs"
     make_cache(inputs / "cache")
     make_exemplar(inputs / "ex")
-    flags = option_flags()
+    flags = option_flags(fuzz.tempera)
     out = fuzz.work / "options_out"
     while more():
         shutil.rmtree(out, ignore_errors=True)
-        argv = ["--cache", str(inputs / "cache"), "--exemplar", str(inputs / "ex"), "--out", str(out),
+        argv = ["--guides", str(inputs / "cache"), "--exemplar", str(inputs / "ex"), "--out", str(out),
                 "--frames", "3"]
         for _ in range(rng.randrange(8)):
             argv.append(rng.choice(flags))
@@ -212,7 +218,7 @@ def fuzz_options(fuzz, rng, more):
                 value = rng.choice(OPTION_VALUES)
                 argv.append(value if rng.random() < 0.9 else mutate_bytes(rng, value.encode()).decode("latin-1"))
         if fuzz.run("options", argv, {}) == 0:
-            check_frames(fuzz, "options", out, argv, {})
+            check_frames(fuzz, "options", out / "frames", argv, {})
 
 
 TARGETS = {"tracks": fuzz_tracks, "options": fuzz_options}
@@ -224,10 +230,12 @@ def main(argv=None):
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--only", choices=list(TARGETS))
     p.add_argument("--work", type=Path)
+    p.add_argument("--tempera", type=Path, default=Path(os.environ.get("TEMPERA_CLI", ROOT / "build" / "bin" / "tempera")),
+                   help="the native CLI (default $TEMPERA_CLI, else build/bin/tempera)")
     args = p.parse_args(argv)
     work = args.work or Path(tempfile.mkdtemp(prefix="tempera-fuzz-rigid-"))
     work.mkdir(parents=True, exist_ok=True)
-    fuzz = Fuzz(work)
+    fuzz = Fuzz(work, args.tempera)
     targets = [args.only] if args.only else list(TARGETS)
     each = args.seconds / len(targets)
     for name in targets:

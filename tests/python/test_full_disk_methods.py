@@ -8,7 +8,6 @@ fails ("is the disk full?"); every frame then in the output folder reads back wh
 the rerun makes B's frames byte for byte as a fresh run of B does."""
 import os
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -74,9 +73,9 @@ def rigid(p, cli):
     (p / "cache").mkdir()
     _exemplar(p / "ex")
     _cache(p / "cache")
-    base = [sys.executable, "-m", "tempera", "rigid", "--cache", str(p / "cache"), "--exemplar", str(p / "ex"),
+    base = [str(cli), "stylize", "--method", "rigid", "--guides", str(p / "cache"), "--exemplar", str(p / "ex"),
             "--frames", "1-10"]
-    return lambda out, b: base + ["--out", str(out), "--k", "1" if b else "2"], "."
+    return lambda out, b: base + ["--out", str(out), "--k", "1" if b else "2"], "frames"
 
 
 @pytest.mark.parametrize("method", [stylit, tcia, lazyfluids, fluidymation, noisy, rigid],

@@ -125,9 +125,8 @@ def test_a_hard_link_to_an_input_is_the_input(cli_path, tmp_path):
     assert (tmp_path / "paint.png").read_bytes() == before
 
 
-def test_rigid_refuses_an_output_that_links_to_a_drawing(tmp_path, capsys):
+def test_rigid_refuses_an_output_that_links_to_a_drawing(tmp_path, cli_path):
     """The rigid-body method keeps the rule too, from the CLI and the panel's job."""
-    from tempera.__main__ import main
     from tempera.methods import registry
     from test_cli_rigid import _cache, _exemplar
 
@@ -137,11 +136,12 @@ def test_rigid_refuses_an_output_that_links_to_a_drawing(tmp_path, capsys):
     _cache(tmp_path / "cache")
     drawing = tmp_path / "ex" / "drawn" / "0001.png"
     before = drawing.read_bytes()
-    (tmp_path / "out").mkdir()
-    (tmp_path / "out" / "frame_0001.png").symlink_to(drawing)
-    assert main(["rigid", "--cache", str(tmp_path / "cache"), "--exemplar", str(tmp_path / "ex"), "--out",
-                 str(tmp_path / "out"), "--frames", "1-2"]) == 2
-    assert "would overwrite the drawn exemplar frame" in capsys.readouterr().err
+    (tmp_path / "out" / "frames").mkdir(parents=True)
+    (tmp_path / "out" / "frames" / "frame_0001.png").symlink_to(drawing)
+    result = subprocess.run([str(cli_path), "stylize", "--method", "rigid", "--guides", str(tmp_path / "cache"),
+                             "--exemplar", str(tmp_path / "ex"), "--out", str(tmp_path / "out"), "--frames", "1-2"],
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == 2 and "would overwrite the drawn exemplar frame" in result.stderr, result.stderr
     (tmp_path / "panel" / "frames").mkdir(parents=True)
     (tmp_path / "panel" / "frames" / "frame_0002.png").symlink_to(drawing)
     with pytest.raises(ValueError, match="would overwrite the drawn exemplar frame"):

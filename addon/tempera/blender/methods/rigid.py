@@ -34,7 +34,7 @@ PROPERTIES = {
     "rigid_examples": StringProperty(
         name="Examples",
         description="The drawn examples: a folder with a source simulation's tracks.json and its drawn frames "
-        "drawn/NNNN.png (as `tempera rigid --exemplar` takes them), or a folder of such folders; "
+        "drawn/NNNN.png (as `tempera stylize --method rigid --exemplar` takes them), or a folder of such folders; "
         "'//' is relative to the .blend file. Empty: the project's own drawn bouncing ball",
         subtype="DIR_PATH", default=""),
     "rigid_collection": PointerProperty(

@@ -30,10 +30,6 @@ def _rgba(a, what):
     return a
 
 
-GENERATED = "generated"  # --exemplar generated: the project's own drawn exemplar
-GENERATED_SIZE = (640, 360)  # its drawings' canvas: the floor (y = 330) and the throw fit
-
-
 def generated_track(shape="circle"):
     """The project's own source motion: a ball thrown from the left that
     bounces on a floor (spinning more as a box, which tumbles as it goes)."""
