@@ -52,25 +52,6 @@ std::string drawn_path(const std::string& folder, int frame) {
   return (fs::path(folder) / "drawn" / frame_file("", frame, "png")).string();
 }
 
-// An exemplar folder's track and drawn frames, checked (every frame drawn).
-struct ExemplarFiles {
-  Track track;
-  std::vector<std::string> drawings;
-};
-
-ExemplarFiles exemplar_files(const std::string& folder) {
-  const TracksFile tracks = read_tracks_file(folder);
-  ExemplarFiles files{tracks.objects.at(one_object(tracks, "", concat("exemplar ", folder))), {}};
-  for (int i = 0; i < int(files.track.frames.size()); ++i) {
-    files.drawings.push_back(drawn_path(folder, tracks.frame_start + i));
-    std::error_code ec;
-    if (!fs::is_regular_file(files.drawings.back(), ec))
-      throw FileNotFoundError(
-          concat(files.drawings.back(), ": drawn frame missing (every frame of the exemplar must be drawn)"));
-  }
-  return files;
-}
-
 std::string names_text(const std::vector<std::string>& names) {
   std::string out;
   for (const std::string& n : names) out += concat(n.size(), ":", n, ";");  // any name, unambiguous
@@ -101,6 +82,19 @@ void lay_on_paper(Image& rgba) {
 }
 
 }  // namespace
+
+RigidExemplarFiles read_rigid_exemplar_files(const std::string& folder) {
+  const TracksFile tracks = read_tracks_file(folder);
+  RigidExemplarFiles files{tracks.objects.at(one_object(tracks, "", concat("exemplar ", folder))), {}};
+  for (int i = 0; i < int(files.track.frames.size()); ++i) {
+    files.drawings.push_back(drawn_path(folder, tracks.frame_start + i));
+    std::error_code ec;
+    if (!fs::is_regular_file(files.drawings.back(), ec))
+      throw FileNotFoundError(
+          concat(files.drawings.back(), ": drawn frame missing (every frame of the exemplar must be drawn)"));
+  }
+  return files;
+}
 
 std::vector<std::string> rigid_exemplar_folders(const std::string& examples) {
   std::error_code ec;
@@ -154,55 +148,79 @@ RigidJob::RigidJob(RigidJobConfig config) : config_(std::move(config)) {
   validate_fields(config_.options, rigid_option_table());
   validate_fields(config_.fit, quadratic_fit_option_table());
   tracks_ = read_tracks_file(config_.guides);
+  select_objects();
+  std::tie(width_, height_) = guide_cache_frame_size(config_.guides);
+  check_frames();
+  const std::string exemplar_stamps = take_exemplars();
+  take_strokes();
+  list_inputs();
+  settings_ = concat(kRecordFormat, ";", settings_text(config_.options, rigid_option_table()),
+                     settings_text(config_.fit, quadratic_fit_option_table()), "shape=", config_.shape,
+                     ";paper=", config_.paper, ";objects=", names_text(objects_), ";strokes=",
+                     config_.strokes.empty() || config_.strokes == kGeneratedStrokes ? config_.strokes
+                                                                                       : file_stamp(config_.strokes),
+                     ";size=", width_, "x", height_, ";format=", config_.format, ";",
+                     file_stamp((fs::path(config_.guides) / kTracksName).string()), ";", exemplar_stamps);
+}
+
+// The targets: config.objects (each tracked), or every tracked object; sorted.
+void RigidJob::select_objects() {
   if (tracks_.objects.empty()) throw ValueError(concat("guide cache ", config_.guides, " tracks no object"));
   for (const std::string& name : config_.objects) objects_.push_back(one_object(tracks_, name, concat("guide cache ", config_.guides)));
   if (objects_.empty())
     for (const auto& [name, track] : tracks_.objects) objects_.push_back(name);
   std::sort(objects_.begin(), objects_.end());
   objects_.erase(std::unique(objects_.begin(), objects_.end()), objects_.end());
-  std::tie(width_, height_) = guide_cache_frame_size(config_.guides);
+}
+
+// Every frame asked for must be tracked for every target.
+void RigidJob::check_frames() const {
   std::size_t tracked = SIZE_MAX;
   for (const std::string& name : objects_) tracked = std::min(tracked, tracks_.objects.at(name).frames.size());
   const int first = tracks_.frame_start, last = first + int(tracked) - 1;
   for (int f : config_.frames)
     if (f < first || f > last)
       throw ValueError(concat("frame ", f, " is outside the tracked frames ", first, "-", last));
-  std::string exemplar_stamps;
+}
+
+// The exemplar folders, and their files read and checked (the generated
+// exemplar's once written, by solved()); returns their part of the settings.
+std::string RigidJob::take_exemplars() {
   if (config_.exemplar == kGeneratedRigidExemplar) {
     // Beside the frames folder (OUT/frames: make_method_job), in OUT.
     const fs::path out = fs::path(config_.out).parent_path();
     exemplar_folders_ = {(out / concat("exemplar_generated_", config_.shape)).string()};
-    exemplar_stamps = concat("generated ", config_.shape);  // made the same every time
-  } else {
-    exemplar_folders_ = rigid_exemplar_folders(config_.exemplar);
-    inputs_.add_folder(config_.exemplar, "exemplar", "the drawn exemplar");
-    for (const std::string& folder : exemplar_folders_) {
-      const ExemplarFiles files = exemplar_files(folder);
-      inputs_.add_folder(folder, "exemplar", "the drawn exemplar");
-      inputs_.add_file((fs::path(folder) / kTracksName).string(), "exemplar tracks");
-      exemplar_stamps += file_stamp((fs::path(folder) / kTracksName).string()) + ";";
-      for (const std::string& drawing : files.drawings) {
-        inputs_.add_file(drawing, "drawn exemplar frame");
-        exemplar_stamps += file_stamp(drawing) + ";";
-      }
-    }
+    return concat("generated ", config_.shape);  // made the same every time
+  }
+  exemplar_folders_ = rigid_exemplar_folders(config_.exemplar);
+  std::string stamps;
+  for (const std::string& folder : exemplar_folders_) {
+    exemplar_files_.push_back(read_rigid_exemplar_files(folder));
+    stamps += file_stamp((fs::path(folder) / kTracksName).string()) + ";";
+    for (const std::string& drawing : exemplar_files_.back().drawings) stamps += file_stamp(drawing) + ";";
+  }
+  return stamps;
+}
+
+void RigidJob::take_strokes() {
+  if (!config_.strokes.empty()) strokes_ = load_stroke_exemplar(config_.strokes);
+}
+
+// What the job reads, which no output of it may replace (app/job_inputs.hpp).
+void RigidJob::list_inputs() {
+  if (config_.exemplar != kGeneratedRigidExemplar) inputs_.add_folder(config_.exemplar, "exemplar", "the drawn exemplar");
+  for (std::size_t e = 0; e < exemplar_files_.size(); ++e) {
+    inputs_.add_folder(exemplar_folders_[e], "exemplar", "the drawn exemplar");
+    inputs_.add_file((fs::path(exemplar_folders_[e]) / kTracksName).string(), "exemplar tracks");
+    for (const std::string& drawing : exemplar_files_[e].drawings) inputs_.add_file(drawing, "drawn exemplar frame");
   }
   if (!config_.strokes.empty() && config_.strokes != kGeneratedStrokes) inputs_.add_file(config_.strokes, "stroke exemplar");
-  if (!config_.strokes.empty()) strokes_ = load_stroke_exemplar(config_.strokes);
-  const std::string tracks_file = (fs::path(config_.guides) / kTracksName).string();
   inputs_.add_folder(config_.guides, "guide cache", "the guides");
-  inputs_.add_file(tracks_file, "target tracks");
+  inputs_.add_file((fs::path(config_.guides) / kTracksName).string(), "target tracks");
   inputs_.add_file((fs::path(config_.guides) / "manifest.json").string(), "manifest");
   inputs_.refuse_folder(config_.out);
   for (int f : config_.frames)
     for (const std::string& path : {output_path(f), record_path(f)}) inputs_.refuse_file(path);
-  settings_ = concat(kRecordFormat, ";", settings_text(config_.options, rigid_option_table()),
-                     settings_text(config_.fit, quadratic_fit_option_table()), "shape=", config_.shape,
-                     ";paper=", config_.paper, ";objects=", names_text(objects_), ";strokes=",
-                     config_.strokes.empty() || config_.strokes == kGeneratedStrokes ? config_.strokes
-                                                                                       : file_stamp(config_.strokes),
-                     ";size=", width_, "x", height_, ";format=", config_.format, ";", file_stamp(tracks_file), ";",
-                     exemplar_stamps);
 }
 
 std::string RigidJob::output_path(int frame) const {
@@ -221,10 +239,12 @@ std::string RigidJob::frame_key(int frame) const { return hash_hex(concat(settin
 const RigidJob::Solved& RigidJob::solved() {
   if (solved_) return *solved_;
   auto s = std::make_unique<Solved>();
-  if (config_.exemplar == kGeneratedRigidExemplar) write_generated_rigid_exemplar(exemplar_folders_[0], config_.shape);
+  if (exemplar_files_.empty()) {  // the generated exemplar
+    write_generated_rigid_exemplar(exemplar_folders_[0], config_.shape);
+    exemplar_files_.push_back(read_rigid_exemplar_files(exemplar_folders_[0]));
+  }
   const ProxyShape shape = parse_enum<ProxyShape>(config_.shape, "proxy shape");
-  for (const std::string& folder : exemplar_folders_) {
-    const ExemplarFiles files = exemplar_files(folder);
+  for (const RigidExemplarFiles& files : exemplar_files_) {
     RigidExemplar e{files.track, {}};
     std::vector<Image> residuals;
     for (std::size_t f = 0; f < files.drawings.size(); ++f) {
@@ -312,7 +332,8 @@ void RigidJob::write_contact_sheet(const std::string& path, int columns) const {
   std::error_code ec;
   for (int frame : config_.frames)
     if (fs::is_regular_file(output_path(frame), ec)) files.push_back(output_path(frame));
-  const ExemplarFiles first = exemplar_files(exemplar_folders_.front());
+  const RigidExemplarFiles first =
+      exemplar_files_.empty() ? read_rigid_exemplar_files(exemplar_folders_.front()) : exemplar_files_.front();
   const Image drawing = read_image(first.drawings[first.drawings.size() / 2]);
   write_frames_contact_sheet(path, drawing.view(), files, columns);
 }

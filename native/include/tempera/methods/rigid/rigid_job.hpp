@@ -35,6 +35,17 @@ struct RigidJobConfig : JobConfig {
   QuadraticFitOptions fit;
 };
 
+// An exemplar folder's source track and its drawn frames' paths (every
+// frame drawn: checked when read).
+struct RigidExemplarFiles {
+  Track track;
+  std::vector<std::string> drawings;
+};
+
+// The track and drawings of the exemplar folder `folder`; ValueError or
+// FileNotFoundError naming what is wrong.
+RigidExemplarFiles read_rigid_exemplar_files(const std::string& folder);
+
 // The exemplar folders `examples` names: itself when it holds tracks.json,
 // else its subfolders that do (sorted). ValueError when there is none.
 std::vector<std::string> rigid_exemplar_folders(const std::string& examples);
@@ -61,6 +72,11 @@ class RigidJob : public FrameJob {
  private:
   struct Solved;  // the fitted exemplars and every frame's deformation, made once
   const Solved& solved();
+  void select_objects();
+  void check_frames() const;
+  std::string take_exemplars();
+  void take_strokes();
+  void list_inputs();
   std::string frame_key(int frame) const;
   std::vector<std::string> far_to_near(int frame) const;
   Image draw_object(const std::string& name, int frame, const ProgressCallback& progress) const;
@@ -70,6 +86,7 @@ class RigidJob : public FrameJob {
   std::vector<std::string> objects_;  // the targets, sorted
   int width_ = 0, height_ = 0;
   std::vector<std::string> exemplar_folders_;
+  std::vector<RigidExemplarFiles> exemplar_files_;  // read once; the generated one when it is written
   JobInputs inputs_;
   Image strokes_;  // the stroke exemplar; empty for none
   std::string settings_;
