@@ -69,6 +69,9 @@ def rigid_scene(tmp_path):
     settings.load_result = "IMAGE"
     yield scene
     bpy.context.window.scene = shown
+    composite = bpy.data.scenes.get(SCENE + " Tempera Composite")
+    if composite is not None:
+        bpy.data.scenes.remove(composite)
     remove_scene(scene)
 
 
@@ -114,12 +117,22 @@ def test_stylize_animation_draws_the_ball_and_resumes(rigid_scene, tmp_path):
     assert (tmp_path / "out" / "rigid" / "contact_sheet.png").is_file()
     image = bpy.data.images["Tempera frames"]  # loaded as today (Load Result: Image)
     assert image.source == "SEQUENCE" and bpy.path.abspath(image.filepath) == str(out / f"frame_{FRAMES[0]:04d}.png")
+    # RGBA frames: also laid over the render (the guides' Combined pass) in a composite scene.
+    from tempera.blender import compat
+
+    composite = bpy.data.scenes[SCENE + " Tempera Composite"]
+    strips = sorted(compat.sequencer_strips(composite.sequence_editor), key=lambda s: s.channel)
+    assert [(s.name, s.channel, len(s.elements)) for s in strips] == [("Render", 1, 10), ("Tempera", 2, 10)]
+    assert strips[1].blend_type == "ALPHA_OVER"
+    render = tempera.read_image(str(tmp_path / "out" / "rigid" / "render" / f"frame_{FRAMES[0]:04d}.png"))
+    assert render.shape == (SIZE[1], SIZE[0], 3)  # black: the test scene has no light nor world
     again = StylizeRun.from_settings(rigid_scene, "ANIMATION")
     while not again.finished:
         again.step()
     assert {r["status"] for r in again.results} == {"skipped"}
     rigid_scene.tempera.rigid_output = "PAPER"
     paper = StylizeRun.from_settings(rigid_scene, "ANIMATION")
+    assert not paper.over_render  # opaque frames are the picture themselves
     while not paper.finished:
         paper.step()
     assert tempera.read_image(str(out / f"frame_{FRAMES[0]:04d}.png"))[:, :, 3].min() == 1.0

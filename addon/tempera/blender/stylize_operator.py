@@ -21,7 +21,9 @@ and makes its run there (run(scene, frames, mode); None: per-frame StyLit,
 as the coherent method and the rigid bodies answer for Stylize Frame).
 StylizeRun is also the base of the coherent method's run and of MethodRun
 below (a registry method's job, a frame per step: the rigid bodies), and
-RgbaRun of the runs that make RGBA frames from a medium.
+RgbaRun of the runs that make RGBA frames from a medium. A run whose
+over_render is true (RGBA frames) is also shown over the render, in a
+composite scene.
 """
 import os
 import time
@@ -225,6 +227,7 @@ class MethodRun(StylizeRun):
 
     folder = None  # the method's registry name, and its folder in the Output Folder
     method_label = None  # the method's name in messages
+    over_render = False  # RGBA frames, shown over the render in a composite scene
 
     def __init__(self, scene, frames, mode, exemplar, options, format):
         """EXEMPLAR and OPTIONS (by command-line flag) as make_job takes them."""
@@ -273,6 +276,12 @@ class MethodRun(StylizeRun):
         return registry.make_job(self.folder, self.exemplar, self.guides.folder, self.frames, self.method_out,
                                  format=self.config["format"], options=self.options)
 
+    def render_paths(self):
+        """The render frames under an RGBA result (made from the guide cache when stale)."""
+        from ..app.beauty import write_render_frames
+
+        return write_render_frames(self.guides.folder, self.frames, os.path.join(self.method_out, RENDER_DIR))
+
 
 class RgbaRun(MethodRun):
     """A method's run that makes RGBA frames from a medium: the frames go
@@ -280,6 +289,7 @@ class RgbaRun(MethodRun):
 
     seconds_per_mpix = None  # a frame's rough cost, for the confirmation of long runs
     kinds = ("STILL", "SEQUENCE", "MOVIE")  # the exemplars the method takes
+    over_render = True
 
     def __init__(self, scene, frames, mode="ANIMATION"):
         from ..app.media_source import exemplar_source
@@ -308,12 +318,6 @@ class RgbaRun(MethodRun):
     def estimate_seconds(self, scene):
         return (estimate_guide_seconds(scene, self.guides.params, len(self.frames))
                 + megapixels(scene) * self.seconds_per_mpix * len(self.frames))
-
-    def render_paths(self):
-        """The render frames under the result (made from the guide cache when stale)."""
-        from ..app.beauty import write_render_frames
-
-        return write_render_frames(self.guides.folder, self.frames, os.path.join(self.method_out, RENDER_DIR))
 
 
 def flicker_text(flicker):
@@ -375,7 +379,7 @@ class TEMPERA_OT_stylize(JobOperator, Operator):
                 if video:
                     shown.append(f"video {video}")
         how = settings.load_result if job.mode == "ANIMATION" else "IMAGE"
-        if isinstance(job, RgbaRun) and paths and how != "NONE":  # over the render, whatever is shown
+        if getattr(job, "over_render", False) and paths and how != "NONE":  # over the render, whatever is shown
             composite = results.load_composite_scene(scene, job.render_paths(), paths, job.frames)
             loaded = composite if how == "SEQUENCER" else results.load(scene, paths, job.frames, how)
         else:

@@ -129,6 +129,7 @@ class RigidRun(MethodRun):
             if not objects:
                 raise ValueError(f"The collection '{settings.rigid_collection.name}' holds no active rigid body.")
         self.objects = objects
+        self.over_render = settings.rigid_output == "RGBA"  # on paper: opaque frames, shown alone
         super().__init__(scene, frames, mode, exemplar, rigid_options(settings, objects), "png")
 
     def estimate_seconds(self, scene):
