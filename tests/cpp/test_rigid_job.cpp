@@ -8,6 +8,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
 
 #include "tempera/app/file_keys.hpp"
 #include "tempera/app/image_io.hpp"
@@ -30,6 +33,11 @@ struct Folder {
 };
 
 void write_text(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
 
 // A guide cache of a ball thrown to the left: tracks.json and manifest.json.
 std::string make_cache(const fs::path& root) {
@@ -156,6 +164,24 @@ TEST(RigidJob, CancelWritesNothingAndBadInputIsNamed) {
   RigidJob job(config_for(f.root));
   EXPECT_THROW(job.run_frame(0, [](double) { return false; }), CancelledError);
   EXPECT_FALSE(fs::exists(job.output_path(3)));
+  // Esc while the exemplar is fitted (the first frame's long part): the fit
+  // hears it between drawings; nothing is written, and the frame made
+  // afterwards is an uninterrupted run's.
+  std::vector<double> heard;
+  EXPECT_THROW(job.run_frame(0, [&](double fraction) {
+    heard.push_back(fraction);
+    return heard.size() < 3;
+  }), CancelledError);
+  ASSERT_EQ(heard.size(), 3u);
+  EXPECT_GT(heard[2], heard[1]);
+  EXPECT_LT(heard[2], 0.9);  // within the fit, not after it
+  EXPECT_FALSE(fs::exists(job.output_path(3)));
+  EXPECT_EQ(job.run_frame(0).status, "stylized");
+  RigidJobConfig whole = config_for(f.root);
+  whole.out = (f.root / "whole").string();
+  RigidJob uninterrupted(whole);
+  uninterrupted.run_frame(0);
+  EXPECT_EQ(read_file(job.output_path(3)), read_file(uninterrupted.output_path(3)));
   RigidJobConfig outside = config_for(f.root);
   outside.frames = {24, 25};
   try {

@@ -127,23 +127,24 @@ def test_strokes_are_resynthesized_cancellable_and_part_of_the_settings(examples
     are re-made writes nothing of the frame; plain and stroked runs are
     different settings (each redoes the other's files)."""
     out = tmp_path / "out"
-    assert _run(_job(cache, examples, out, [6], ("object", "Near"))) == ["stylized"]
+    assert _run(_job(cache, examples, out, [5, 6], ("object", "Near"))) == ["stylized"] * 2
     plain = (out / "frames" / "frame_0006.png").read_bytes()
+    stroked = _job(cache, examples, out, [5, 6], ("object", "Near"), ("strokes", rigid_strokes.GENERATED))
+    assert stroked.run_frame(0)["status"] == "stylized"  # the exemplar fitted, frame 5 drawn
     calls = []
 
     def esc_in_the_strokes(fraction):  # the first call starts the frame, the next are the strokes'
         calls.append(fraction)
         return len(calls) <= 1
 
-    stroked = _job(cache, examples, out, [6], ("object", "Near"), ("strokes", rigid_strokes.GENERATED))
     with pytest.raises(tempera.Cancelled):
-        stroked.run_frame(0, esc_in_the_strokes)
+        stroked.run_frame(1, esc_in_the_strokes)
     assert len(calls) == 2 and (out / "frames" / "frame_0006.png").read_bytes() == plain
-    assert _run(stroked) == ["stylized"]
+    assert _run(stroked) == ["skipped", "stylized"]
     frame = _frame(out, 6)
     ink = frame[:, :, 3] > 0.5
     assert ink.sum() > 20 and np.abs(frame[ink, :3].mean(0) - rigid_strokes.STROKE_COLOUR).max() < 0.05
-    assert _run(_job(cache, examples, out, [6], ("object", "Near"))) == ["stylized"]
+    assert _run(_job(cache, examples, out, [5, 6], ("object", "Near"))) == ["stylized"] * 2
 
 
 def test_bad_input_is_named(examples, cache, tmp_path):

@@ -236,7 +236,9 @@ std::string RigidJob::frame_key(int frame) const { return hash_hex(concat(settin
 // The exemplars fitted (D per drawn frame, and the residuals) and every
 // tracked frame's deformation and contact fix: a frame needs them all
 // (sub-sequences span events), so they are made once, by the first frame made.
-const RigidJob::Solved& RigidJob::solved() {
+// The fit is most of that frame's time (tens of seconds for the generated
+// exemplar): `progress` hears of each drawing fitted and may cancel.
+const RigidJob::Solved& RigidJob::solved(const ProgressCallback& progress) {
   if (solved_) return *solved_;
   auto s = std::make_unique<Solved>();
   if (exemplar_files_.empty()) {  // the generated exemplar
@@ -244,6 +246,8 @@ const RigidJob::Solved& RigidJob::solved() {
     exemplar_files_.push_back(read_rigid_exemplar_files(exemplar_folders_[0]));
   }
   const ProxyShape shape = parse_enum<ProxyShape>(config_.shape, "proxy shape");
+  std::size_t drawings = 0, fitted = 0;
+  for (const RigidExemplarFiles& files : exemplar_files_) drawings += files.drawings.size();
   for (const RigidExemplarFiles& files : exemplar_files_) {
     RigidExemplar e{files.track, {}};
     std::vector<Image> residuals;
@@ -256,6 +260,8 @@ const RigidJob::Solved& RigidJob::solved() {
       const Image ink = extract_channels(drawing.view(), 3, 1);
       e.maps.push_back(fit_quadratic_map(mask.view(), ink.view(), object, config_.fit));
       residuals.push_back(extract_residual(drawing.view(), e.maps.back(), object));
+      if (progress && !progress(0.9 * double(++fitted) / double(drawings)))
+        throw CancelledError("rigid-body stylization cancelled");
     }
     s->exemplars.push_back(std::move(e));
     s->residuals.push_back(std::move(residuals));
@@ -281,7 +287,7 @@ FrameResult RigidJob::run_frame(std::size_t index, const ProgressCallback& progr
   if (config_.resume && record_current(record_path(f), kRecordFormat, frame_key(f), {result.path})) return result;
   const auto t0 = std::chrono::steady_clock::now();
   if (progress && !progress(0.0)) throw CancelledError("rigid-body stylization cancelled");
-  solved();
+  solved(progress);
   Image rgba;
   if (objects_.size() == 1) {
     rgba = draw_object(objects_[0], f, progress);

@@ -71,7 +71,7 @@ class RigidJob : public FrameJob {
 
  private:
   struct Solved;  // the fitted exemplars and every frame's deformation, made once
-  const Solved& solved();
+  const Solved& solved(const ProgressCallback& progress);
   void select_objects();
   void check_frames() const;
   std::string take_exemplars();
