@@ -96,9 +96,10 @@ def test_stylits_options_come_from_its_one_table(cli_path, caches):
     from tempera.app import settings
     from tempera.methods.stylit import stylize as stylit
 
-    table = {row["name"]: row for row in tempera._native.stylit_option_table()}
+    table = {row["name"]: row for row in tempera._native.StylitOptions.table()}
     assert (table["temporal_weight"]["flag"], table["quality"]["choices"]) == ("temporal", ["final", "preview"])
-    assert tempera._native.stylit_defaults() == {"temporal_weight": 0.0, "quality": "final"}
+    defaults = tempera._native.StylitOptions()
+    assert (defaults.temporal_weight, defaults.quality) == (0.0, "final")
     assert settings.STYLIT_OPTIONS == table and settings.DEFAULT_QUALITY == "final"
     help_text = stylize(cli_path, "--help").stdout
     assert table["quality"]["help"] in help_text and table["temporal_weight"]["help"] in help_text

@@ -54,9 +54,10 @@ def test_every_per_frame_job_returns_the_one_result(tmp_path):
 
 def native_constructors():
     from tempera import _native
+    from tempera.methods.stylit import stylize
     from tempera.methods.tcia import tcia
 
-    return {"StylizeJob": lambda c: _native.StylizeJob(c),
+    return {"StylizeJob": lambda c: _native.StylizeJob(c, stylize.options()),
             "FluidJob": lambda c: _native.LazyFluidsJob(c, lazyfluids.options()),
             "MediaJob": lambda c: _native.FluidymationJob(c, fluidymation.options()),
             "NoisySequence": lambda c: _native.NoisySequence(c, noisy.options()),

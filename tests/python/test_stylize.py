@@ -9,6 +9,7 @@ import tempera
 from tempera import _native
 from tempera.app import guide_cache
 from tempera.methods.stylit.stylize import tonemap
+from tempera.methods.stylit import stylize
 from tempera.methods.stylit.stylize import StylizeJob, stylize_frame
 
 from conftest import assert_releases_gil
@@ -63,10 +64,12 @@ def test_changed_settings_redo_the_frames(inputs):
 
 def test_unknown_config_keys_are_named():
     with pytest.raises(ValueError, match="'colour'.*'speed'|'speed'.*'colour'"):
-        _native.StylizeJob(dict(exemplar="a", exemplar_guides="b", guides="c", frames=[1], out="d", colour=1, speed=2))
+        _native.StylizeJob(dict(exemplar="a", exemplar_guides="b", guides="c", frames=[1], out="d", colour=1, speed=2),
+                           stylize.options())
     with pytest.raises(ValueError, match="unknown guide 'DIFFUSE'"):
-        _native.StylizeJob(dict(exemplar="a", exemplar_guides="b", guides="c", frames=[1], out="d",
-                                weights={"DIFFUSE": 1.0}))
+        stylize.options(weights={"DIFFUSE": 1.0})
+    with pytest.raises(TypeError, match="unknown stylit option 'colour'"):
+        StylizeJob("a", "b", "c", [1], "d", colour=1)
 
 
 def test_missing_files_and_guides_are_named(inputs):
@@ -158,3 +161,20 @@ def test_one_guide_table_everywhere():
     assert lpe.STYLIT_EXPRESSIONS["LDDE"] == "L.*DDE" and set(lpe.STYLIT_EXPRESSIONS) == set(names)
     assert all(guide_cache.GUIDES[n] == "RGB" for n in names)
     assert settings.SEED_DEFAULT == tempera.SynthesisOptions().seed == 1
+
+
+def test_stylit_options_are_a_typed_class():
+    """Issue 41, step 6: StyLit's options cross the binding as a bound class,
+    with the guide weights as a dict in matching order and the engine's options."""
+    opts = stylize.options(weights={"LDE": 3.0, "LDDE": 0}, temporal_weight=0.25, quality="preview", seed=7)
+    assert list(opts.weights) == list(stylize.GUIDES)
+    assert opts.weights == dict(stylize.DEFAULT_WEIGHTS, LDE=3.0, LDDE=0.0)
+    assert (opts.temporal_weight, opts.quality, opts.synthesis.seed) == (0.25, "preview", 7)
+    assert "temporal_weight=0.25" in repr(opts)
+    opts.weights = {"FULL": 0}  # the named guide; the others keep theirs
+    assert (opts.weights["FULL"], opts.weights["LDE"]) == (0.0, 3.0)
+    opts.weights = {"LDE": 0, "LSE": 0, "LDDE": 0, "LD12E": 0}
+    with pytest.raises(ValueError, match="guide"):  # every guide left out
+        opts.validate()
+    with pytest.raises(ValueError, match="temporal"):
+        stylize.options(temporal_weight=-1)

@@ -35,7 +35,7 @@ DEFAULT_GUIDE_WEIGHTS = {g["name"]: g["weight"] for g in LIGHT_PATH_GUIDES}
 # panel starts artists at 0.5, measured on the demo: flicker 0.030 -> 0.011
 # with the stroke detail kept (docs/user_guide.md).
 # StyLit's option table (stylit.hpp): name -> row (flag, help, default, min, max, choices).
-STYLIT_OPTIONS = {row["name"]: row for row in _native.stylit_option_table()}
+STYLIT_OPTIONS = {row["name"]: row for row in _native.StylitOptions.table()}
 DEFAULT_TEMPORAL_WEIGHT = STYLIT_OPTIONS["temporal_weight"]["default"]
 PANEL_TEMPORAL_WEIGHT = 0.5
 # The panel's Guided Noise checkbox sets noise_guides to this (docs/noisy.md:

@@ -16,6 +16,7 @@ from ... import _native
 from ...app.frame_job import ProgressFn, SheetFrameJob
 from ...app.settings import DEFAULT_GUIDE_WEIGHTS as DEFAULT_WEIGHTS
 from ...app.settings import LIGHT_PATH_GUIDES
+from ...engine.synthesis import method_options
 
 GUIDES = tuple(g["name"] for g in LIGHT_PATH_GUIDES)
 
@@ -29,17 +30,17 @@ def tonemap(linear):
     return _native.tonemap_guide(np.ascontiguousarray(flat)).reshape(a.shape)
 
 
-def _stylit_options(weights, temporal_weight, quality, engine):
-    """The native options dict: StyLit's keys plus engine options (names of
-    tempera.SynthesisOptions; the native side rejects unknown ones)."""
-    options = dict(engine)
-    if temporal_weight is not None:
-        options["temporal_weight"] = float(temporal_weight)
-    if quality is not None:
-        options["quality"] = str(quality)
+def options(weights: Optional[Mapping[str, float]] = None, **values) -> "_native.StylitOptions":
+    """StylitOptions from keywords: ``weights`` ({guide: weight} overriding
+    DEFAULT_WEIGHTS), StyLit's own (temporal_weight, quality) and engine
+    options (SynthesisOptions names). None keeps a default; unknown names
+    are TypeErrors, bad values ValueErrors naming them."""
+    values = {k: v for k, v in values.items() if v is not None}
+    opts = method_options(_native.StylitOptions, _native.SynthesisOptions(), values, "stylit")
     if weights is not None:
-        options["weights"] = {str(k): float(v) for k, v in dict(weights).items()}
-    return options
+        opts.weights = {str(k): v for k, v in dict(weights).items()}
+    opts.validate()
+    return opts
 
 
 class StylizeJob(SheetFrameJob):
@@ -71,9 +72,9 @@ class StylizeJob(SheetFrameJob):
         config = dict(exemplar=os.fspath(style), exemplar_guides=os.fspath(exemplar_guides),
                       guides=os.fspath(guides), frames=[int(f) for f in frames], out=os.fspath(out),
                       exemplar_frame=None if exemplar_frame is None else int(exemplar_frame),
-                      format=str(format), prefix=str(prefix), resume=bool(resume),
-                      **_stylit_options(weights, temporal_weight, quality, engine))
-        self._job = _native.StylizeJob(config)
+                      format=str(format), prefix=str(prefix), resume=bool(resume))
+        self._job = _native.StylizeJob(config, options(weights, temporal_weight=temporal_weight, quality=quality,
+                                                       **engine))
 
     @property
     def report_path(self) -> str:
@@ -96,9 +97,9 @@ def stylize_frame(style, exemplar: Mapping, target: Mapping, *, previous=None, v
             raise ValueError("previous needs velocity_backward and occlusion_backward")
         temporal = dict(previous=_float(previous), velocity_backward=_float(velocity_backward),
                         occlusion_backward=_float(occlusion_backward))
-    options = _stylit_options(weights, temporal_weight, quality, engine)
+    opts = options(weights, temporal_weight=temporal_weight, quality=quality, **engine)
     return _native.stylize_frame(_float(style), {k: _float(v) for k, v in exemplar.items()},
-                                 {k: _float(v) for k, v in target.items()}, options, temporal, progress)
+                                 {k: _float(v) for k, v in target.items()}, opts, temporal, progress)
 
 
 def encode_video(pattern, first_frame: int, out, fps: float = 24.0) -> bool:

@@ -1,7 +1,8 @@
-// Python binding of StyLit per frame and of the sequence driver (StylizeJob),
-// plus the contact sheet, flicker and video helpers they use. Configuration
-// comes as dicts whose unknown keys are errors; tempera.methods.stylit.stylize wraps these
-// with keyword arguments. The GIL is released while native code runs.
+// Python binding of StyLit's options (StylitOptions), per frame and of the
+// sequence driver (StylizeJob), plus the contact sheet, flicker and video
+// helpers they use. A job's paths and frames come as a dict whose unknown keys
+// are errors; tempera.methods.stylit.stylize wraps these with keyword
+// arguments. The GIL is released while native code runs.
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
@@ -26,37 +27,19 @@ using py_bridge::get;
 
 namespace {
 
-// StyLit's keys: weights, its option table's and the engine's (SynthesisOptions).
-std::set<std::string> stylit_keys() {
-  std::set<std::string> keys = {"weights"};
-  for_each_field(stylit_option_table(), [&](const auto& f) { keys.insert(f.name); });
-  for_each_field(synthesis_option_table(), [&](const auto& f) { keys.insert(f.name); });
-  return keys;
-}
-
-// The entries of `d` whose keys are fields of `table`.
-template <class Tuple>
-py::dict table_keys(const py::dict& d, const Tuple& table) {
-  py::dict out;
-  for_each_field(table, [&](const auto& f) {
-    if (d.contains(f.name)) out[f.name] = d[f.name];
-  });
-  return out;
-}
 const std::set<std::string> kJobKeys = {"exemplar", "exemplar_guides", "exemplar_frame", "guides", "frames",
                                         "out", "format", "prefix", "resume"};
 
-void reject_unknown(const py::dict& d, const std::set<std::string>& a, const std::set<std::string>& b,
-                    const char* what) {
+void reject_unknown(const py::dict& d, const std::set<std::string>& known, const char* what) {
   std::string unknown;
   for (const auto& [key, value] : d) {
     const std::string k = py::str(key);
-    if (!a.count(k) && !b.count(k)) unknown += (unknown.empty() ? "'" : ", '") + k + "'";
+    if (!known.count(k)) unknown += (unknown.empty() ? "'" : ", '") + k + "'";
   }
   if (!unknown.empty()) throw ValueError(concat("unknown ", what, " key(s) ", unknown));
 }
 
-// Named weights replace the defaults of those guides; the others keep theirs.
+// Named weights replace those guides' weights; the others keep theirs.
 void set_weights(StylitOptions& opt, const py::dict& weights) {
   for (const auto& [key, value] : weights) {
     const std::string name = py::str(key);
@@ -71,28 +54,29 @@ void set_weights(StylitOptions& opt, const py::dict& weights) {
   }
 }
 
-StylitOptions parse_stylit(const py::dict& d) {
-  StylitOptions opt;
-  const std::string what = "option";
-  if (d.contains("weights")) set_weights(opt, get<py::dict>(d, "weights", what));
-  py_bridge::set_from_dict(opt, stylit_option_table(), table_keys(d, stylit_option_table()), what.c_str());
-  py_bridge::set_from_dict(opt.synthesis, synthesis_option_table(), table_keys(d, synthesis_option_table()),
-                           "engine option");
+py::dict weights_of(const StylitOptions& opt) {
+  py::dict out;
+  for (const auto& [name, weight] : opt.weights) out[py::str(name)] = weight;
+  return out;
+}
+
+// The options' errors now, not in the middle of a run.
+const StylitOptions& checked(const StylitOptions& opt) {
   validate(opt.synthesis);
-  active_guides(opt);  // errors now, not in the middle of a run
+  active_guides(opt);
   return opt;
 }
 
-StylizeJobConfig parse_job_config(const py::dict& d) {
+StylizeJobConfig parse_job_config(const py::dict& d, const StylitOptions& options) {
   const std::string what = "StylizeJob config";
-  reject_unknown(d, kJobKeys, stylit_keys(), what.c_str());
+  reject_unknown(d, kJobKeys, what.c_str());
   StylizeJobConfig c;
   py_bridge::read_job_config(d, c, what);
   c.guides = get<std::string>(d, "guides", what);  // required here
   c.exemplar_guides = get<std::string>(d, "exemplar_guides", what);
   if (py_bridge::given(d, "exemplar_frame")) c.exemplar_frame = get<int>(d, "exemplar_frame", what);
   if (d.contains("prefix")) c.prefix = get<std::string>(d, "prefix", what);
-  c.stylit = parse_stylit(d);
+  c.stylit = checked(options);
   return c;
 }
 
@@ -109,16 +93,15 @@ GuideFrame guide_frame(const py::dict& arrays, const char* what, std::vector<Flo
 }
 
 py::tuple stylize_frame_py(const FloatArray& style, const py::dict& exemplar, const py::dict& target,
-                           const py::dict& options, const py::object& temporal, const py::object& progress) {
-  reject_unknown(options, stylit_keys(), {}, "stylize_frame option");
-  const StylitOptions opt = parse_stylit(options);
+                           const StylitOptions& options, const py::object& temporal, const py::object& progress) {
+  const StylitOptions& opt = checked(options);
   std::vector<FloatArray> keep;
   const GuideFrame ex = guide_frame(exemplar, "exemplar", keep), tg = guide_frame(target, "target", keep);
   TemporalInput t;
   const bool has_temporal = !temporal.is_none();
   if (has_temporal) {
     const py::dict d = temporal.cast<py::dict>();
-    reject_unknown(d, {"previous", "velocity_backward", "occlusion_backward"}, {}, "temporal");
+    reject_unknown(d, {"previous", "velocity_backward", "occlusion_backward"}, "temporal");
     for (const char* key : {"previous", "velocity_backward", "occlusion_backward"}) {
       if (!d.contains(key)) throw ValueError(concat("temporal needs '", key, "'"));
       keep.push_back(d[key].cast<FloatArray>());
@@ -143,16 +126,29 @@ py::tuple stylize_frame_py(const FloatArray& style, const py::dict& exemplar, co
 
 void bind_job(py::module_& m) {
   py::class_<StylizeJob, FrameJob>(m, "StylizeJob", "Stylization of a frame sequence; use tempera.methods.stylit.stylize.StylizeJob.")
-      .def(py::init([](const py::dict& config) {
-             StylizeJobConfig c = parse_job_config(config);
+      .def(py::init([](const py::dict& config, const StylitOptions& options) {
+             StylizeJobConfig c = parse_job_config(config, options);
              py::gil_scoped_release release;  // reads the painting and checks every cache frame
              return std::make_unique<StylizeJob>(std::move(c));
            }),
-           py::arg("config"))
+           py::arg("config"), py::arg("options"))
       .def_property_readonly("report_path", &StylizeJob::report_path);
 }
 
+void bind_options(py::module_& m) {
+  py_bridge::bind_options_class<StylitOptions>(m, "StylitOptions", stylit_option_table(),
+                                               "Options of StyLit (native/include/tempera/methods/stylit/stylit.hpp).")
+      .def_property("weights", &weights_of, &set_weights,
+                    "{guide: weight} in matching order (<= 0 leaves a guide out); setting names some guides, "
+                    "the others keep their weights")
+      .def_readwrite("synthesis", &StylitOptions::synthesis, "engine options (the quality preset sets the iterations)")
+      .def(
+          "validate", [](const StylitOptions& o) { checked(o); },
+          "ValueError naming the first bad value (engine ranges, guide weights, temporal weight).");
+}
+
 void bind_stylit(py::module_& m) {
+  bind_options(m);
   bind_job(m);
   m.def("stylize_frame", &stylize_frame_py, py::arg("style"), py::arg("exemplar"), py::arg("target"),
         py::arg("options"), py::arg("temporal") = py::none(), py::arg("progress") = py::none(),
@@ -167,18 +163,6 @@ void bind_stylit(py::module_& m) {
       },
       py::arg("previous"), py::arg("current"), py::arg("velocity_backward"), py::arg("visible"),
       "Mean absolute colour change along valid motion; use tempera.engine.temporal.flicker.");
-  m.def(
-      "stylit_defaults",
-      [] {
-        py::dict d;
-        for (const py::handle& f : py_bridge::table_as_list<StylitOptions>(stylit_option_table()))
-          d[f["name"]] = f["default"];
-        return d;
-      },
-      "StyLit's own defaults (the engine's are SynthesisOptions.table()).");
-  m.def(
-      "stylit_option_table", [] { return py_bridge::table_as_list<StylitOptions>(stylit_option_table()); },
-      "StyLit's option table (stylit.hpp): name, flag, help, default, min, max, choices; the panel's tooltips.");
   m.def(
       "box_blur",
       [](const FloatArray& image, float width) {
