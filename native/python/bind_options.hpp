@@ -6,8 +6,10 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <optional>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include "tempera/engine/option_table.hpp"
 
@@ -19,6 +21,24 @@ template <class T>
 py::object to_python(const T& v) {
   if constexpr (std::is_enum_v<T>) return py::str(enum_name(v));
   else return py::cast(v);
+}
+
+template <class T>
+struct is_optional : std::false_type {};
+template <class T>
+struct is_optional<std::optional<T>> : std::true_type {};
+
+// What a value of type T is, as messages say it.
+template <class T>
+std::string kind_name() {
+  if constexpr (std::is_same_v<T, std::string>) return "a string or path";
+  else if constexpr (std::is_same_v<T, bool>) return "True or False";
+  else if constexpr (std::is_enum_v<T>) return "one of " + enum_choices<T>();
+  else if constexpr (std::is_integral_v<T>) return "a whole number";
+  else if constexpr (std::is_floating_point_v<T>) return "a number";
+  else if constexpr (std::is_same_v<T, std::vector<int>>) return "a list of whole numbers";
+  else if constexpr (is_optional<T>::value) return kind_name<typename T::value_type>() + " or None";
+  else return py::type_id<T>();
 }
 
 template <class T>
@@ -40,7 +60,7 @@ T from_python(const py::handle& value, const char* name) {
       return py::cast<T>(value);
     }
   } catch (const py::cast_error&) {
-    throw ValueError(concat(name, " expects ", py::type_id<T>(), ", got ", std::string(py::str(value.get_type()))));
+    throw ValueError(concat(name, " expects ", kind_name<T>(), ", got ", std::string(py::repr(value)).substr(0, 80)));
   }
 }
 

@@ -1,5 +1,5 @@
 // Python binding of the method registry (methods/registry.hpp) and of the
-// job core's units of work: the registry's entries as dicts, FrameJob
+// job core: JobConfig, the registry's entries as dicts, FrameJob
 // (app/frame_job.hpp) and SegmentJob (app/segment_job.hpp) as the base
 // classes of every method's job (each method's job class derives from one
 // in Python too), and method_job / method_segment_job, the job of any method
@@ -94,30 +94,32 @@ void bind_segment_job_class(py::module_& m) {
           "The exemplar followed by the frames written so far, as one image (atomic).");
 }
 
-// The job of `name` from the core's config (a dict: exemplar, guides, frames,
-// out, format, resume; the frames go to OUT/frames) and the method's options as the command line takes
-// them ((flag without "--", text) pairs; "" for a switch alone).
-std::unique_ptr<FrameJob> method_job(const std::string& name, const py::dict& config, const MethodOptions& options) {
+void bind_job_config_class(py::module_& m) {
+  py_bridge::ConfigClass<JobConfig> c(m, "JobConfig", "What every job's config has (app/job_config.hpp).");
+  py_bridge::job_config_fields(c);
+}
+
+// The job of `name` from the core's config (the frames go to OUT/frames) and
+// the method's options as the command line takes them ((flag without "--",
+// text) pairs; "" for a switch alone).
+std::unique_ptr<FrameJob> method_job(const std::string& name, const JobConfig& config, const MethodOptions& options) {
   const MethodEntry& method = find_method(name);
-  JobConfig c;
-  py_bridge::read_job_config(config, c, concat("the ", name, " job's config"));
   py::gil_scoped_release release;  // the job reads its inputs' headers
-  return make_method_job(method, c, options);
+  return make_method_job(method, config, options);
 }
 
 // The same for a method whose unit is the segment.
-std::unique_ptr<SegmentJob> method_segment_job(const std::string& name, const py::dict& config,
+std::unique_ptr<SegmentJob> method_segment_job(const std::string& name, const JobConfig& config,
                                                const MethodOptions& options) {
   const MethodEntry& method = find_method(name);
-  JobConfig c;
-  py_bridge::read_job_config(config, c, concat("the ", name, " job's config"));
   py::gil_scoped_release release;  // the job reads its inputs' headers
-  return make_method_segment_job(method, c, options);
+  return make_method_segment_job(method, config, options);
 }
 
 }  // namespace
 
 void bind_registry(py::module_& m) {
+  bind_job_config_class(m);
   bind_frame_job_class(m);
   bind_segment_job_class(m);
   m.attr("JOB_MADE_EXEMPLAR") = kJobMadeExemplar;

@@ -57,18 +57,39 @@ def native_constructors():
     from tempera.methods.stylit import stylize
     from tempera.methods.tcia import tcia
 
-    return {"StylizeJob": lambda c: _native.StylizeJob(c, stylize.options()),
-            "FluidJob": lambda c: _native.LazyFluidsJob(c, lazyfluids.options()),
-            "MediaJob": lambda c: _native.FluidymationJob(c, fluidymation.options()),
-            "NoisySequence": lambda c: _native.NoisySequence(c, noisy.options()),
-            "ShotJob": lambda c: _native.TciaJob(c, tcia.options())}
+    return {"StylizeJob": lambda **c: _native.StylizeJob(c, stylize.options()),
+            "FluidJob": lambda **c: _native.LazyFluidsJob(_native.JobConfig(**c), lazyfluids.options()),
+            "MediaJob": lambda **c: _native.FluidymationJob(c, fluidymation.options()),
+            "NoisySequence": lambda **c: _native.NoisySequence(c, noisy.options()),
+            "ShotJob": lambda **c: _native.TciaJob(c, tcia.options())}
 
 
 @pytest.mark.parametrize("name", ["StylizeJob", "FluidJob", "MediaJob", "NoisySequence", "ShotJob"])
 def test_every_job_binding_reads_the_job_config_one_way(name):
-    """One dict convention for the core's JobConfig fields (bind_job_config.hpp)."""
+    """The core's JobConfig fields are read one way by every job's binding (bind_job_config.hpp)."""
     make = native_constructors()[name]
     with pytest.raises(ValueError, match=f"{name} config needs 'exemplar'"):
-        make({"frames": [1], "out": "o"})
-    with pytest.raises(ValueError, match=f"{name} config 'frames' must be a list of whole numbers"):
-        make({"exemplar": "e", "frames": "1-3", "out": "o"})
+        make(frames=[1], out="o")
+    with pytest.raises(ValueError, match=f"{name} config 'frames' must be a list of whole numbers|"
+                                         "frames expects a list of whole numbers, got '1-3'"):
+        make(exemplar="e", frames="1-3", out="o")
+
+
+def test_a_job_config_is_a_typed_class(tmp_path):
+    """Issue 41, step 6: a config crosses the binding as a class, field by
+    field: paths as str or os.PathLike, every unknown keyword named, each bad
+    value named with what its field expects."""
+    from tempera import _native
+
+    config = _native.JobConfig(exemplar=tmp_path / "paint.png", frames=range(3, 5), out=str(tmp_path))
+    assert (config.exemplar, config.frames, config.out) == (str(tmp_path / "paint.png"), [3, 4], str(tmp_path))
+    assert (config.guides, config.format, config.resume) == ("", "png", True)
+    assert repr(config).startswith(f"JobConfig(exemplar={str(tmp_path / 'paint.png')!r}, guides='', frames=[3, 4]")
+    config.resume = False
+    assert config.resume is False
+    with pytest.raises(ValueError, match="unknown JobConfig field\\(s\\) 'colour', 'speed' \\(known: exemplar, guides"):
+        _native.JobConfig(colour=1, speed=2)
+    for field, value, kind in (("frames", [1, "x"], "a list of whole numbers"), ("format", 5, "a string or path"),
+                               ("resume", "yes", "True or False")):
+        with pytest.raises(ValueError, match=f"{field} expects {kind}"):
+            setattr(config, field, value)

@@ -3,7 +3,6 @@ Python side: the panel's Method list, the `tempera` console script's
 dispatch and the farm planner read it, so a method is named once."""
 from __future__ import annotations
 
-import os
 from collections.abc import Mapping
 
 from .. import _native
@@ -54,8 +53,8 @@ def make_job(name: str, exemplar, guides, frames, out, *, format: str = "png", r
     list of (flag, value) pairs instead of the dict. ValueError for an
     unknown method, option or value. StyLit and the coherent method
     take the exemplar render's guide cache as ``{"exemplar-guides": DIR}``."""
-    config = dict(exemplar=os.fspath(exemplar), guides=os.fspath(guides), frames=[int(f) for f in frames],
-                  out=os.fspath(out), format=str(format), resume=bool(resume))
+    config = _native.JobConfig(exemplar=exemplar, guides=guides, frames=[int(f) for f in frames], out=out, format=format,
+                               resume=resume)
     pairs = options.items() if isinstance(options, Mapping) else (options or ())
     flags = [(str(flag).replace("_", "-"), _option_text(value)) for flag, value in pairs]
     if find(name)["unit"] == "segment":

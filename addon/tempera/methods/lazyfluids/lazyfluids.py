@@ -11,7 +11,6 @@ with a warning), one resumable frame at a time.
 """
 from __future__ import annotations
 
-import os
 
 import numpy as np
 
@@ -82,6 +81,6 @@ class FluidJob(SheetFrameJob):
     """
 
     def __init__(self, exemplar, guides, frames, out, *, format="png", resume=True, **values):
-        config = dict(exemplar=os.fspath(exemplar), guides=os.fspath(guides), frames=[int(f) for f in frames],
-                      out=os.fspath(out), format=str(format), resume=bool(resume))
+        config = _native.JobConfig(exemplar=exemplar, guides=guides, frames=[int(f) for f in frames], out=out, format=format,
+                                   resume=resume)
         self._job = _native.LazyFluidsJob(config, options(**values))

@@ -57,9 +57,10 @@ void bind_lazyfluids(py::module_& m) {
       },
       py::arg("target_alpha"), py::arg("advected"), py::arg("lam"), "λ_q of eq. 5.6.");
   py::class_<LazyFluidsJob, FrameJob>(m, "LazyFluidsJob", "LazyFluids over a guide cache; use tempera.methods.lazyfluids.lazyfluids.FluidJob.")
-      .def(py::init([](const py::dict& config, const LazyFluidsOptions& options) {
+      .def(py::init([](const JobConfig& config, const LazyFluidsOptions& options) {
+             py_bridge::require_job_config(config, "FluidJob config");
              LazyFluidsJobConfig c;
-             py_bridge::read_job_config(config, c, "FluidJob config");
+             static_cast<JobConfig&>(c) = config;
              c.options = options;
              py::gil_scoped_release release;  // reads the exemplar and cache headers
              return std::make_unique<LazyFluidsJob>(std::move(c));
