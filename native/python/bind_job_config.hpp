@@ -19,6 +19,7 @@
 
 #include "bind_options.hpp"
 #include "tempera/app/job_config.hpp"
+#include "tempera/app/light_path_shot.hpp"
 #include "tempera/engine/error.hpp"
 
 namespace tempera::py_bridge {
@@ -113,6 +114,14 @@ ConfigClass<S>& job_config_fields(ConfigClass<S>& c) {
       .field("out", &JobConfig::out, "output folder")
       .field("format", &JobConfig::format, "png | exr")
       .field("resume", &JobConfig::resume, "skip what is current; False makes everything again");
+}
+
+// The exemplar render's fields of the light-path methods' configs (app/light_path_shot.hpp).
+template <class S>
+ConfigClass<S>& light_path_shot_fields(ConfigClass<S>& c) {
+  return c.field("exemplar_guides", &LightPathShotConfig::exemplar_guides, "guide cache folder of the exemplar render")
+      .field("exemplar_frame", &LightPathShotConfig::exemplar_frame, "frame of exemplar_guides (None: its only frame)")
+      .field("prefix", &LightPathShotConfig::prefix, "the frames' file names: PREFIX0001.png");
 }
 
 // ValueError "`what` needs 'NAME'" for each of exemplar, frames and out that is empty.

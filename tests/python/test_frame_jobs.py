@@ -57,10 +57,11 @@ def native_constructors():
     from tempera.methods.stylit import stylize
     from tempera.methods.tcia import tcia
 
-    return {"StylizeJob": lambda **c: _native.StylizeJob(c, stylize.options()),
+    return {"StylizeJob": lambda **c: _native.StylizeJob(_native.StylizeJobConfig(**c), stylize.options()),
             "FluidJob": lambda **c: _native.LazyFluidsJob(_native.JobConfig(**c), lazyfluids.options()),
-            "MediaJob": lambda **c: _native.FluidymationJob(c, fluidymation.options()),
-            "NoisySequence": lambda **c: _native.NoisySequence(c, noisy.options()),
+            "MediaJob": lambda **c: _native.FluidymationJob(_native.FluidymationJobConfig(**c),
+                                                            fluidymation.options()),
+            "NoisySequence": lambda **c: _native.NoisySequence(_native.NoisySequenceConfig(**c), noisy.options()),
             "ShotJob": lambda **c: _native.TciaJob(c, tcia.options())}
 
 

@@ -497,8 +497,8 @@ def test_conversion_errors_name_the_option(caches):
     config = {"exemplar": str(caches / "paint.png"), "exemplar_guides": str(caches / "exemplar"),
               "guides": str(caches / "cache"), "frames": [1], "out": str(caches / "out")}
     for key, value, kind in (("frames", "1-3", "list of whole numbers"), ("format", 5, "string")):
-        with pytest.raises(ValueError, match=f"'{key}' must be a {kind}"):
-            _native.StylizeJob(dict(config, **{key: value}), stylize.options())
+        with pytest.raises(ValueError, match=f"{key} expects a {kind}"):
+            _native.StylizeJobConfig(**dict(config, **{key: value}))
     for key, value in (("patch_size", "five"), ("temporal_weight", "high")):
         with pytest.raises(ValueError, match=f"{key} expects"):
             stylize.options(**{key: value})

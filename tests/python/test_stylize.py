@@ -64,8 +64,8 @@ def test_changed_settings_redo_the_frames(inputs):
 
 def test_unknown_config_keys_are_named():
     with pytest.raises(ValueError, match="'colour'.*'speed'|'speed'.*'colour'"):
-        _native.StylizeJob(dict(exemplar="a", exemplar_guides="b", guides="c", frames=[1], out="d", colour=1, speed=2),
-                           stylize.options())
+        _native.StylizeJobConfig(exemplar="a", exemplar_guides="b", guides="c", frames=[1], out="d", colour=1,
+                                 speed=2)
     with pytest.raises(ValueError, match="unknown guide 'DIFFUSE'"):
         stylize.options(weights={"DIFFUSE": 1.0})
     with pytest.raises(TypeError, match="unknown stylit option 'colour'"):

@@ -8,8 +8,6 @@ from the previous frame's matches, resumable per frame.
 """
 from __future__ import annotations
 
-import os
-
 import numpy as np
 
 from ... import _native
@@ -101,9 +99,9 @@ class MediaJob(SheetFrameJob):
                  format="png", resume=True, **values):
         if flow is not None and flow not in FLOW_SOURCES:
             raise ValueError(f"flow must be None or one of {', '.join(FLOW_SOURCES)}, got {flow!r}")
-        config = dict(exemplar=os.fspath(exemplar), guides=os.fspath(guides), frames=[int(f) for f in frames],
-                      out=os.fspath(out), exemplar_masks=None if exemplar_masks is None else os.fspath(exemplar_masks),
-                      target_mask=str(target_mask), flow=flow, format=str(format), resume=bool(resume))
+        config = _native.FluidymationJobConfig(exemplar=exemplar, guides=guides, frames=[int(f) for f in frames],
+                                               out=out, exemplar_masks=exemplar_masks or "", target_mask=target_mask,
+                                               flow=flow or "auto", format=format, resume=resume)
         self._job = _native.FluidymationJob(config, options(**values))
 
     @property

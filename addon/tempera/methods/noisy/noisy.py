@@ -82,20 +82,12 @@ class NoisySequence(FrameJob):
 
     def __init__(self, exemplar, reference, frames, out, *, noise_map=None, guides=None, prefix="frame_",
                  resume=True, exemplar_guides=None, exemplar_frame=None, guide_weights=None, **values):
-        import os
-
-        config = dict(exemplar=os.fspath(exemplar), reference=os.fspath(reference), frames=[int(f) for f in frames],
-                      out=os.fspath(out), prefix=str(prefix), resume=bool(resume))
-        if noise_map:
-            config["noise_map"] = os.fspath(noise_map)
-        if guides:
-            config["guides"] = os.fspath(guides)
-        if exemplar_guides:
-            config["exemplar_guides"] = os.fspath(exemplar_guides)
-        if exemplar_frame is not None:
-            config["exemplar_frame"] = int(exemplar_frame)
+        config = _native.NoisySequenceConfig(exemplar=exemplar, reference=reference, frames=[int(f) for f in frames],
+                                             out=out, prefix=prefix, resume=resume, noise_map=noise_map or "",
+                                             guides=guides or "", exemplar_guides=exemplar_guides or "",
+                                             exemplar_frame=exemplar_frame)
         if guide_weights is not None:
-            config["guide_weights"] = [(str(k), float(v)) for k, v in dict(guide_weights).items()]
+            config.guide_weights = [(str(k), float(v)) for k, v in dict(guide_weights).items()]
         self._job = _native.NoisySequence(config, options(**values))
 
 

@@ -69,10 +69,9 @@ class StylizeJob(SheetFrameJob):
     def __init__(self, style, exemplar_guides, guides, frames: Iterable[int], out, *, exemplar_frame=None,
                  format="png", prefix="frame_", weights: Optional[Mapping[str, float]] = None,
                  temporal_weight=None, quality=None, resume=True, **engine):
-        config = dict(exemplar=os.fspath(style), exemplar_guides=os.fspath(exemplar_guides),
-                      guides=os.fspath(guides), frames=[int(f) for f in frames], out=os.fspath(out),
-                      exemplar_frame=None if exemplar_frame is None else int(exemplar_frame),
-                      format=str(format), prefix=str(prefix), resume=bool(resume))
+        config = _native.StylizeJobConfig(exemplar=style, exemplar_guides=exemplar_guides, guides=guides,
+                                          frames=[int(f) for f in frames], out=out, exemplar_frame=exemplar_frame,
+                                          format=format, prefix=prefix, resume=resume)
         self._job = _native.StylizeJob(config, options(weights, temporal_weight=temporal_weight, quality=quality,
                                                        **engine))
 

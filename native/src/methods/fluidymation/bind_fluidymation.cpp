@@ -35,16 +35,6 @@ py::list to_list(std::vector<Image>&& images) {
   return out;
 }
 
-FluidymationJobConfig job_config(const py::dict& d, const FluidymationOptions& options) {
-  FluidymationJobConfig c;
-  py_bridge::read_job_config(d, c, "MediaJob config");
-  if (!d["exemplar_masks"].is_none()) c.exemplar_masks = d["exemplar_masks"].cast<std::string>();
-  c.target_mask = d["target_mask"].cast<std::string>();
-  if (!d["flow"].is_none()) c.flow = parse_enum<FlowSource>(d["flow"].cast<std::string>(), "flow");
-  c.options = options;
-  return c;
-}
-
 void bind_fluidymation(py::module_& m) {
   py_bridge::bind_options_class<FluidymationOptions>(m, "FluidymationOptions", fluidymation_option_table(),
                                                      "Options of Fluidymation (native/include/tempera/methods/fluidymation/fluidymation.hpp).")
@@ -108,9 +98,19 @@ void bind_fluidymation(py::module_& m) {
       },
       py::arg("exemplar"), py::arg("exemplar_masks"), py::arg("target_masks"), py::arg("target_flows"),
       py::arg("options"), py::arg("progress") = nullptr, "Use tempera.methods.fluidymation.fluidymation.stylize_sequence.");
+  py_bridge::ConfigClass<FluidymationJobConfig> config(
+      m, "FluidymationJobConfig", "Fluidymation over a guide cache (fluidymation_job.hpp); its options are FluidymationOptions.");
+  py_bridge::job_config_fields(config)
+      .field("exemplar_masks", &FluidymationJobConfig::exemplar_masks,
+             "folder of the exemplar's mask frames (first channel); '' the exemplar's alpha")
+      .field("target_mask", &FluidymationJobConfig::target_mask, "alpha | mask.OB_<name> | mask.CO_<name>")
+      .field("flow", &FluidymationJobConfig::flow,
+             "auto: the cache's fluid_velocity, else velocity_forward, else the masks");
   py::class_<FluidymationJob, FrameJob>(m, "FluidymationJob", "Fluidymation over a guide cache; use tempera.methods.fluidymation.fluidymation.MediaJob.")
-      .def(py::init([](const py::dict& config, const FluidymationOptions& options) {
-             FluidymationJobConfig c = job_config(config, options);
+      .def(py::init([](const FluidymationJobConfig& config, const FluidymationOptions& options) {
+             py_bridge::require_job_config(config, "MediaJob config");
+             FluidymationJobConfig c = config;
+             c.options = options;
              py::gil_scoped_release release;  // reads the exemplar and the target's masks
              return std::make_unique<FluidymationJob>(std::move(c));
            }),

@@ -16,24 +16,23 @@ using py_bridge::FloatArray;
 
 namespace {
 
-// The paths and frames of a NoisySequenceConfig; the options come set.
-NoisySequenceConfig sequence_config(const py::dict& d, const NoisyOptions& options) {
-  NoisySequenceConfig c;
-  py_bridge::read_job_config(d, c, "NoisySequence config");
-  c.reference = d["reference"].cast<std::string>();
-  if (d.contains("prefix")) c.prefix = d["prefix"].cast<std::string>();
-  if (d.contains("noise_map")) c.noise_map = d["noise_map"].cast<std::string>();
-  if (d.contains("exemplar_guides")) c.exemplar_guides = d["exemplar_guides"].cast<std::string>();
-  if (d.contains("exemplar_frame")) c.exemplar_frame = d["exemplar_frame"].cast<int>();
-  if (d.contains("guide_weights")) c.guide_weights = d["guide_weights"].cast<std::vector<std::pair<std::string, float>>>();
-  c.options = options;
-  return c;
-}
-
 void bind_sequence(py::module_& m) {
+  py_bridge::ConfigClass<NoisySequenceConfig> config(
+      m, "NoisySequenceConfig", "Color Me Noisy over a folder of frames (noisy_sequence.hpp); its options are NoisyOptions.");
+  py_bridge::job_config_fields(config)
+      .field("reference", &NoisySequenceConfig::reference, "folder of the coherent frames R: PREFIX0001.png ...")
+      .field("prefix", &NoisySequenceConfig::prefix, "of the reference and the output frames")
+      .field("noise_map", &NoisySequenceConfig::noise_map,
+             "local noise map (an image file, or a guide of `guides`); '' the same noise everywhere")
+      .field("exemplar_guides", &NoisySequenceConfig::exemplar_guides, "guided noise: the exemplar render's guide cache")
+      .field("exemplar_frame", &NoisySequenceConfig::exemplar_frame, "frame of exemplar_guides (None: its only frame)")
+      .field("guide_weights", &NoisySequenceConfig::guide_weights, "guided noise: [(light-path guide, weight)]");
   py::class_<NoisySequence, FrameJob>(m, "NoisySequence", "Color Me Noisy over a folder of frames; use tempera.methods.noisy.noisy.NoisySequence.")
-      .def(py::init([](const py::dict& config, const NoisyOptions& options) {
-             NoisySequenceConfig c = sequence_config(config, options);
+      .def(py::init([](const NoisySequenceConfig& config, const NoisyOptions& options) {
+             py_bridge::require_job_config(config, "NoisySequence config");
+             if (config.reference.empty()) throw ValueError("NoisySequence config needs 'reference'");
+             NoisySequenceConfig c = config;
+             c.options = options;
              py::gil_scoped_release release;  // reads the medium, checks every frame
              return std::make_unique<NoisySequence>(std::move(c));
            }),

@@ -1,8 +1,8 @@
 // Python binding of StyLit's options (StylitOptions), per frame and of the
 // sequence driver (StylizeJob), plus the contact sheet, flicker and video
-// helpers they use. A job's paths and frames come as a dict whose unknown keys
-// are errors; tempera.methods.stylit.stylize wraps these with keyword
-// arguments. The GIL is released while native code runs.
+// helpers they use; the job's config is StylizeJobConfig, bound field by
+// field. tempera.methods.stylit.stylize wraps these with keyword arguments.
+// The GIL is released while native code runs.
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
@@ -23,12 +23,8 @@
 namespace py = pybind11;
 using namespace tempera;
 using py_bridge::FloatArray;
-using py_bridge::get;
 
 namespace {
-
-const std::set<std::string> kJobKeys = {"exemplar", "exemplar_guides", "exemplar_frame", "guides", "frames",
-                                        "out", "format", "prefix", "resume"};
 
 void reject_unknown(const py::dict& d, const std::set<std::string>& known, const char* what) {
   std::string unknown;
@@ -67,15 +63,12 @@ const StylitOptions& checked(const StylitOptions& opt) {
   return opt;
 }
 
-StylizeJobConfig parse_job_config(const py::dict& d, const StylitOptions& options) {
+StylizeJobConfig job_config(const StylizeJobConfig& config, const StylitOptions& options) {
   const std::string what = "StylizeJob config";
-  reject_unknown(d, kJobKeys, what.c_str());
-  StylizeJobConfig c;
-  py_bridge::read_job_config(d, c, what);
-  c.guides = get<std::string>(d, "guides", what);  // required here
-  c.exemplar_guides = get<std::string>(d, "exemplar_guides", what);
-  if (py_bridge::given(d, "exemplar_frame")) c.exemplar_frame = get<int>(d, "exemplar_frame", what);
-  if (d.contains("prefix")) c.prefix = get<std::string>(d, "prefix", what);
+  py_bridge::require_job_config(config, what);
+  if (config.guides.empty()) throw ValueError(what + " needs 'guides'");
+  if (config.exemplar_guides.empty()) throw ValueError(what + " needs 'exemplar_guides'");
+  StylizeJobConfig c = config;
   c.stylit = checked(options);
   return c;
 }
@@ -125,9 +118,12 @@ py::tuple stylize_frame_py(const FloatArray& style, const py::dict& exemplar, co
 }
 
 void bind_job(py::module_& m) {
+  py_bridge::ConfigClass<StylizeJobConfig> config(m, "StylizeJobConfig",
+                                                  "StyLit's job (stylize_job.hpp); its options are StylitOptions.");
+  py_bridge::light_path_shot_fields(py_bridge::job_config_fields(config));
   py::class_<StylizeJob, FrameJob>(m, "StylizeJob", "Stylization of a frame sequence; use tempera.methods.stylit.stylize.StylizeJob.")
-      .def(py::init([](const py::dict& config, const StylitOptions& options) {
-             StylizeJobConfig c = parse_job_config(config, options);
+      .def(py::init([](const StylizeJobConfig& config, const StylitOptions& options) {
+             StylizeJobConfig c = job_config(config, options);
              py::gil_scoped_release release;  // reads the painting and checks every cache frame
              return std::make_unique<StylizeJob>(std::move(c));
            }),
