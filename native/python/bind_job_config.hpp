@@ -19,6 +19,7 @@
 
 #include "bind_options.hpp"
 #include "tempera/app/job_config.hpp"
+#include "tempera/app/light_path_guides.hpp"
 #include "tempera/app/light_path_shot.hpp"
 #include "tempera/engine/error.hpp"
 
@@ -48,6 +49,19 @@ T field_value(const py::handle& value, const char* name) {
   }
   throw ValueError(concat(name, " expects ", kind_name<T>(), ", got ", std::string(py::repr(value)).substr(0, 80)));
 }
+
+template <class T>
+struct is_container : std::false_type {};
+template <class T>
+struct is_container<std::vector<T>> : std::true_type {};
+template <class A, class B>
+struct is_container<std::pair<A, B>> : std::true_type {};
+
+// A struct bound as its own Python class (an options class), not a value
+// that pybind11 converts (a string, list, tuple or optional).
+template <class T>
+constexpr bool is_struct_field =
+    std::is_class_v<T> && !std::is_same_v<T, std::string> && !is_optional<T>::value && !is_container<T>::value;
 
 template <class T>
 py::object field_python(const T& v) {
@@ -83,10 +97,22 @@ class ConfigClass {
   template <class T, class C>
   ConfigClass& field(const char* name, T C::*member, const char* help) {
     static_assert(std::is_base_of_v<C, S>);
-    setters_->emplace_back(name, [member, name](S& s, const py::handle& v) { s.*member = field_value<T>(v, name); });
-    cls_.def_property(
-        name, [member](const S& s) { return field_python(s.*member); },
-        [member, name](S& s, const py::object& v) { s.*member = field_value<T>(v, name); }, help);
+    const auto set = [member, name](S& s, const py::handle& v) { s.*member = field_value<T>(v, name); };
+    if constexpr (is_struct_field<T>) {
+      // Its attributes set in place: config.lines.weight = 2.
+      return field_with(name, py::cpp_function([member](S& s) -> T& { return s.*member; },
+                                               py::return_value_policy::reference_internal),
+                        set, help);
+    } else {
+      return field_with(name, py::cpp_function([member](const S& s) { return field_python(s.*member); }), set, help);
+    }
+  }
+
+  // A field read and set by `get` (a cpp_function taking S) and `set(S&, value)`.
+  template <class Set>
+  ConfigClass& field_with(const char* name, const py::cpp_function& get, Set set, const char* help) {
+    setters_->emplace_back(name, set);
+    cls_.def_property(name, get, [set](S& s, const py::object& v) { set(s, v); }, help);
     return *this;
   }
 
@@ -124,56 +150,31 @@ ConfigClass<S>& light_path_shot_fields(ConfigClass<S>& c) {
       .field("prefix", &LightPathShotConfig::prefix, "the frames' file names: PREFIX0001.png");
 }
 
+// Light-path guide weights as a dict {guide: weight} in matching order.
+inline py::dict guide_weights_dict(const GuideWeights& weights) {
+  py::dict out;
+  for (const auto& [name, weight] : weights) out[py::str(name)] = weight;
+  return out;
+}
+
+// Sets the named guides' weights from a dict; the others keep theirs.
+inline void set_guide_weights(GuideWeights& weights, const py::handle& values) {
+  if (!py::isinstance<py::dict>(values))
+    throw ValueError(concat("weights expects a dict {guide: weight}, got ", std::string(py::repr(values)).substr(0, 80)));
+  for (const auto& [key, value] : py::reinterpret_borrow<py::dict>(values)) {
+    const std::string name = py::str(key);
+    auto it = std::find_if(weights.begin(), weights.end(), [&](auto& w) { return w.first == name; });
+    if (it == weights.end())
+      throw ValueError(concat("unknown guide '", name, "' in weights (StyLit guides: ", light_path_guide_names(), ")"));
+    it->second = field_value<float>(value, concat("weight of '", name, "'").c_str());
+  }
+}
+
 // ValueError "`what` needs 'NAME'" for each of exemplar, frames and out that is empty.
 inline void require_job_config(const JobConfig& c, const std::string& what) {
   if (c.exemplar.empty()) throw ValueError(concat(what, " needs 'exemplar'"));
   if (c.frames.empty()) throw ValueError(concat(what, " needs 'frames'"));
   if (c.out.empty()) throw ValueError(concat(what, " needs 'out'"));
-}
-
-// The former dict path (a config as a dict keyed by field names), until the
-// last job takes its config class.
-template <typename T>
-constexpr const char* dict_kind_name() {
-  if constexpr (std::is_same_v<T, std::string>) return "a string";
-  else if constexpr (std::is_same_v<T, bool>) return "True or False";
-  else if constexpr (std::is_integral_v<T>) return "a whole number";
-  else if constexpr (std::is_floating_point_v<T>) return "a number";
-  else if constexpr (std::is_same_v<T, std::vector<int>>) return "a list of whole numbers";
-  else if constexpr (std::is_same_v<T, pybind11::dict>) return "a dict";
-  else return "another type";
-}
-
-// d[key] as T, or a ValueError naming `what` and the key.
-template <typename T>
-T get(const pybind11::dict& d, const char* key, const std::string& what) {
-  namespace py = pybind11;
-  if (!d.contains(key)) throw ValueError(concat(what, " needs '", key, "'"));
-  const py::object value = d[key];
-  try {
-    if constexpr (std::is_same_v<T, std::string>) {
-      if (!py::isinstance<py::str>(value)) throw py::cast_error("");
-    }
-    return value.cast<T>();
-  } catch (const py::cast_error&) {
-  } catch (const py::error_already_set&) {  // e.g. an int too large for C++
-  }
-  throw ValueError(concat(what, " '", key, "' must be ", dict_kind_name<T>(), ", got ",
-                          std::string(py::repr(value)).substr(0, 80)));
-}
-
-// True when d has `key` with a value other than None.
-inline bool given(const pybind11::dict& d, const char* key) { return d.contains(key) && !d[key].is_none(); }
-
-// exemplar, frames and out are required; guides, format and resume keep
-// their defaults when absent or None.
-inline void read_job_config(const pybind11::dict& d, JobConfig& c, const std::string& what) {
-  c.exemplar = get<std::string>(d, "exemplar", what);
-  c.frames = get<std::vector<int>>(d, "frames", what);
-  c.out = get<std::string>(d, "out", what);
-  if (given(d, "guides")) c.guides = get<std::string>(d, "guides", what);
-  if (given(d, "format")) c.format = get<std::string>(d, "format", what);
-  if (given(d, "resume")) c.resume = get<bool>(d, "resume", what);
 }
 
 }  // namespace tempera::py_bridge

@@ -12,8 +12,6 @@ key to key, each resumable (docs/cli.md).
 """
 from __future__ import annotations
 
-import os
-
 import numpy as np
 
 from ... import _native
@@ -102,6 +100,11 @@ def segments(frames, key_frames=()):
     return [(first, last) for first, last, _ in _native.key_segments(frames, [int(k) for k in key_frames])]
 
 
+def _key(key):
+    """A TciaKey of (frame, painting path[, mask path or None])."""
+    return _native.TciaKey(frame=int(key[0]), painting=key[1], mask=(key[2] or "") if len(key) > 2 else "")
+
+
 class ShotJob(SegmentJob):
     """The coherent method over a guide cache, segment by segment.
 
@@ -126,19 +129,13 @@ class ShotJob(SegmentJob):
     def __init__(self, style, exemplar_guides, guides, frames, out, *, exemplar_frame=None, keys=(), segment=None,
                  weights=None, format="png", resume=True, lines=None, layers=(), layer_order="depth", orientation=False,
                  **values):
-        config = dict(exemplar=os.fspath(style), exemplar_guides=os.fspath(exemplar_guides), guides=os.fspath(guides),
-                      frames=[int(f) for f in frames], out=os.fspath(out), format=str(format), resume=bool(resume),
-                      exemplar_frame=None if exemplar_frame is None else int(exemplar_frame),
-                      weights={str(k): float(v) for k, v in dict(weights or {}).items()},
-                      keys=[(int(k[0]), os.fspath(k[1]), None if len(k) < 3 or not k[2] else os.fspath(k[2]))
-                            for k in keys],
-                      segment=None if segment is None else (int(segment[0]), int(segment[1])),
-                      lines=dict(lines or {}),
-                      layers=[(str(l[0]), str(l[1]), None if len(l) < 3 or not l[2] else os.fspath(l[2]),
-                               [(int(k[0]), os.fspath(k[1]), None if len(k) < 3 or not k[2] else os.fspath(k[2]))
-                                for k in (l[3] if len(l) > 3 else ())])
-                              for l in layers],
-                      layer_order=str(layer_order), orientation={"from_cache": bool(orientation)})
+        config = _native.TciaJobConfig(
+            exemplar=style, exemplar_guides=exemplar_guides, guides=guides, frames=[int(f) for f in frames], out=out,
+            format=format, resume=resume, exemplar_frame=exemplar_frame, weights=dict(weights or {}),
+            keys=[_key(k) for k in keys], segment=None if segment is None else (int(segment[0]), int(segment[1])), lines=_native.TciaLineOptions(**dict(lines or {})),
+            layers=[_native.TciaLayer(name=l[0], mask=l[1], painting=(l[2] or "") if len(l) > 2 else "",
+                                      keys=[_key(k) for k in (l[3] if len(l) > 3 else ())]) for l in layers],
+            layer_order=layer_order, orientation=_native.TciaOrientationOptions(from_cache=bool(orientation)))
         self._job = _native.TciaJob(config, options(**values))
 
     def output_path(self, frame: int) -> str:

@@ -35,27 +35,6 @@ void reject_unknown(const py::dict& d, const std::set<std::string>& known, const
   if (!unknown.empty()) throw ValueError(concat("unknown ", what, " key(s) ", unknown));
 }
 
-// Named weights replace those guides' weights; the others keep theirs.
-void set_weights(StylitOptions& opt, const py::dict& weights) {
-  for (const auto& [key, value] : weights) {
-    const std::string name = py::str(key);
-    auto it = std::find_if(opt.weights.begin(), opt.weights.end(), [&](auto& w) { return w.first == name; });
-    if (it == opt.weights.end())
-      throw ValueError(concat("unknown guide '", name, "' in weights (StyLit guides: ", light_path_guide_names(), ")"));
-    try {
-      it->second = value.cast<float>();
-    } catch (const py::cast_error&) {
-      throw ValueError(concat("weight of '", name, "' must be a number, got ", std::string(py::repr(value)).substr(0, 80)));
-    }
-  }
-}
-
-py::dict weights_of(const StylitOptions& opt) {
-  py::dict out;
-  for (const auto& [name, weight] : opt.weights) out[py::str(name)] = weight;
-  return out;
-}
-
 // The options' errors now, not in the middle of a run.
 const StylitOptions& checked(const StylitOptions& opt) {
   validate(opt.synthesis);
@@ -134,7 +113,9 @@ void bind_job(py::module_& m) {
 void bind_options(py::module_& m) {
   py_bridge::bind_options_class<StylitOptions>(m, "StylitOptions", stylit_option_table(),
                                                "Options of StyLit (native/include/tempera/methods/stylit/stylit.hpp).")
-      .def_property("weights", &weights_of, &set_weights,
+      .def_property(
+          "weights", [](const StylitOptions& o) { return py_bridge::guide_weights_dict(o.weights); },
+          [](StylitOptions& o, const py::object& w) { py_bridge::set_guide_weights(o.weights, w); },
                     "{guide: weight} in matching order (<= 0 leaves a guide out); setting names some guides, "
                     "the others keep their weights")
       .def_readwrite("synthesis", &StylitOptions::synthesis, "engine options (the quality preset sets the iterations)")

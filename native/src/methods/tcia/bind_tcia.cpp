@@ -24,38 +24,34 @@ ImageView keep_view(const py::handle& array, const std::string& what, std::vecto
   return py_bridge::view_of(keep.back(), what);
 }
 
-// The job's configuration from tempera.methods.tcia.tcia.ShotJob's keywords (checked there).
-TciaJobConfig job_config(const py::dict& d, const TciaOptions& options) {
-  TciaJobConfig c;
-  py_bridge::read_job_config(d, c, "ShotJob config");
-  c.exemplar_guides = d["exemplar_guides"].cast<std::string>();
-  if (!d["exemplar_frame"].is_none()) c.exemplar_frame = d["exemplar_frame"].cast<int>();
-  std::string weights;
-  for (const auto& [name, weight] : d["weights"].cast<py::dict>())
-    weights += concat(weights.empty() ? "" : ",", std::string(py::str(name)), "=", py::str(weight).cast<std::string>());
-  parse_guide_weights(weights, c.weights);
-  active_guides(c.weights);
-  for (const auto& key : d["keys"].cast<py::list>()) {
-    const auto t = key.cast<py::tuple>();
-    c.keys.push_back({t[0].cast<int>(), t[1].cast<std::string>(), t[2].is_none() ? "" : t[2].cast<std::string>()});
-  }
-  for (const auto& layer : d["layers"].cast<py::list>()) {
-    const auto t = layer.cast<py::tuple>();
-    c.layers.push_back({t[0].cast<std::string>(), t[1].cast<std::string>(), t[2].is_none() ? "" : t[2].cast<std::string>(), {}});
-    if (t.size() > 3)  // the layer's own keys
-      for (const auto& key : t[3].cast<py::list>()) {
-        const auto k = key.cast<py::tuple>();
-        c.layers.back().keys.push_back(
-            {k[0].cast<int>(), k[1].cast<std::string>(), k[2].is_none() ? "" : k[2].cast<std::string>()});
-      }
-  }
-  c.layer_order = d["layer_order"].cast<std::string>();
-  if (!d["segment"].is_none()) c.segment = d["segment"].cast<std::pair<int, int>>();
-  c.tcia = options;
-  py_bridge::set_from_dict(c.lines, tcia_line_option_table(), d["lines"].cast<py::dict>(), "line option");
-  py_bridge::set_from_dict(c.orientation, tcia_orientation_option_table(), d["orientation"].cast<py::dict>(),
-                           "orientation option");
-  return c;
+// The job's config and its parts, field by field.
+void bind_config(py::module_& m) {
+  py_bridge::bind_options_class<TciaLineOptions>(m, "TciaLineOptions", tcia_line_option_table(),
+                                                 "The line term of eq. 9 (tcia_job.hpp).");
+  py_bridge::bind_options_class<TciaOrientationOptions>(m, "TciaOrientationOptions", tcia_orientation_option_table(),
+                                                        "Patches turned by the guide cache's orientation (tcia_job.hpp).");
+  py_bridge::ConfigClass<KeyFile> key(m, "TciaKey", "A painted keyframe (tcia_job.hpp KeyFile; the CLI's --key).");
+  key.field("frame", &KeyFile::frame, "the frame it paints")
+      .field("painting", &KeyFile::painting, "the painting's file")
+      .field("mask", &KeyFile::mask, "where the painting counts (an image file); '' everywhere");
+  py_bridge::ConfigClass<LayerFile> layer(m, "TciaLayer", "A layer solved on its own (tcia_job.hpp LayerFile; --layer).");
+  layer.field("name", &LayerFile::name, "its folder's name: OUT/layers/NAME/")
+      .field("mask", &LayerFile::mask, "its mask guide: mask.OB_<object> or mask.CO_<collection>")
+      .field("painting", &LayerFile::painting, "its own painting; '' the shot's")
+      .field("keys", &LayerFile::keys, "its own keys (TciaKey), in place of the shot's at their frames");
+  py_bridge::ConfigClass<TciaJobConfig> config(
+      m, "TciaJobConfig", "The coherent method over a guide cache (tcia_job.hpp); its options are TciaOptions.");
+  py_bridge::light_path_shot_fields(py_bridge::job_config_fields(config))
+      .field_with(
+          "weights", py::cpp_function([](const TciaJobConfig& c) { return py_bridge::guide_weights_dict(c.weights); }),
+          [](TciaJobConfig& c, const py::handle& w) { py_bridge::set_guide_weights(c.weights, w); },
+          "{guide: weight} in matching order; setting names some guides, the others keep theirs")
+      .field("keys", &TciaJobConfig::keys, "the painted keyframes (TciaKey)")
+      .field("segment", &TciaJobConfig::segment, "(first, last): only that segment (a farm task); None: the shot")
+      .field("lines", &TciaJobConfig::lines, "the line term (TciaLineOptions)")
+      .field("layers", &TciaJobConfig::layers, "layers solved separately and composited (TciaLayer)")
+      .field("layer_order", &TciaJobConfig::layer_order, "depth (per frame, the cache's depth) | given (first at the back)")
+      .field("orientation", &TciaJobConfig::orientation, "patches turned by the cache's orientation (TciaOrientationOptions)");
 }
 
 // The Shot of tempera.methods.tcia.tcia.stylize_shot's arguments; its views point into `keep`.
@@ -97,10 +93,15 @@ Shot shot_from(const FloatArray& style, const py::list& guides, const py::list& 
 }
 
 void bind_tcia(py::module_& m) {
+  bind_config(m);
   py::class_<TciaJob, SegmentJob>(m, "TciaJob",
                                   "The coherent method over a guide cache; use tempera.methods.tcia.tcia.ShotJob.")
-      .def(py::init([](const py::dict& config, const TciaOptions& options) {
-             TciaJobConfig c = job_config(config, options);
+      .def(py::init([](const TciaJobConfig& config, const TciaOptions& options) {
+             py_bridge::require_job_config(config, "ShotJob config");
+             if (config.exemplar_guides.empty()) throw ValueError("ShotJob config needs 'exemplar_guides'");
+             TciaJobConfig c = config;
+             active_guides(c.weights);
+             c.tcia = options;
              py::gil_scoped_release release;  // reads the painting, keys and cache headers
              return std::make_unique<TciaJob>(std::move(c));
            }),
