@@ -7,9 +7,10 @@ A method is a folder of native/src/methods. Its own folders are
 native/src/methods/M, native/include/tempera/methods/M, addon/tempera/methods/M
 and addon/tempera/blender/methods/M(.py). The rest of native/, addon/, tools/,
 farm/, the Makefile and CMakeLists.txt is searched, case-insensitively, in
-code only: comments and docstrings name papers and methods as references, not
-as coupling, so they do not count; string literals do (a name in a string is
-how dispatch by name spreads).
+code only. Comments, docstrings and prose in strings (a string with a space:
+messages and help, which cite the papers) name a method as a reference, not
+as coupling, so they do not count; a string without a space does (a name in a
+key or a path is how dispatch by name spreads).
 
     /usr/bin/python3 tools/method_name_spread.py [--files]
 """
@@ -23,6 +24,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 SEARCHED = ("native", "addon", "tools", "farm", "Makefile", "CMakeLists.txt")
+PROSE = re.compile(r"\s")  # a string with a space is prose
+C_STRING = re.compile(r'"(?:[^"\\\n]|\\.)*"')
 HASH_COMMENTS = {".py", ".txt", ".cmake", ""}  # Python is tokenized; CMake and Makefiles drop '#' comments
 
 
@@ -44,8 +47,8 @@ def python_code(text):
         tokens = list(tokenize.generate_tokens(io.StringIO(text).readline))
     except (SyntaxError, tokenize.TokenError):
         return text
-    return " ".join(t.string for t in tokens
-                    if t.type != tokenize.COMMENT and not (t.type == tokenize.STRING and t.start in docstrings))
+    return " ".join(t.string for t in tokens if t.type != tokenize.COMMENT
+                    and not (t.type == tokenize.STRING and (t.start in docstrings or PROSE.search(t.string))))
 
 
 def code_text(path):
@@ -55,7 +58,8 @@ def code_text(path):
         return python_code(text)
     if path.suffix in (".cpp", ".hpp", ".h", ".js"):
         text = re.sub(r"/\*.*?\*/", "", text, flags=re.S)
-        return "\n".join(line.split("//")[0] for line in text.splitlines())
+        text = "\n".join(line.split("//")[0] for line in text.splitlines())
+        return C_STRING.sub(lambda m: "" if PROSE.search(m.group()) else m.group(), text)
     if path.suffix in HASH_COMMENTS or path.name == "Makefile":
         return "\n".join(line.split("#")[0] for line in text.splitlines())
     return None  # not code (data, images, markdown)
