@@ -79,6 +79,8 @@ def require_consecutive(frames, method):
 class StylizeRun:
     """The steps of one Stylize run: guides of every frame, then StyLit per frame."""
 
+    over_render = False  # True: RGBA frames, shown over the render in a composite scene
+
     def __init__(self, scene, frames, mode="ANIMATION"):
         settings = scene.tempera
         self.mode = mode
@@ -227,7 +229,6 @@ class MethodRun(StylizeRun):
 
     folder = None  # the method's registry name, and its folder in the Output Folder
     method_label = None  # the method's name in messages
-    over_render = False  # RGBA frames, shown over the render in a composite scene
 
     def __init__(self, scene, frames, mode, exemplar, options, format):
         """EXEMPLAR and OPTIONS (by command-line flag) as make_job takes them."""
@@ -296,13 +297,13 @@ class RgbaRun(MethodRun):
 
         settings = scene.tempera
         frames = list(frames)
-        method_out = os.path.join(output_dir(settings), self.folder)
+        out = output_dir(settings)
         if settings.media_exemplar.strip():
             label = next(n for k, n, _ in MEDIA_EXEMPLAR_KINDS if k == settings.media_exemplar_kind)
             if settings.media_exemplar_kind not in self.kinds:
                 raise ValueError(f"The {self.method_label} method needs a video exemplar: set Exemplar to Image "
                                  f"Sequence or Movie (not {label}).")
-            cache = os.path.join(output_dir(settings), EXEMPLAR_FRAMES_DIR)
+            cache = os.path.join(out, EXEMPLAR_FRAMES_DIR)
             exemplar = exemplar_source(settings.media_exemplar_kind,
                                        resolve_path(settings.media_exemplar, f"exemplar {label}"), cache)
         else:  # the project's own (its registry entry's default_exemplar), written once beside the frames
@@ -310,7 +311,7 @@ class RgbaRun(MethodRun):
             from ..methods import registry
 
             kind = registry.find(self.folder)["default_exemplar"]
-            exemplar = str(generated_folder(method_out, kind))
+            exemplar = str(generated_folder(os.path.join(out, self.folder), kind))
         require_consecutive(frames, f"The {self.method_label} method")
         options = {"seed": int(settings.seed), **self.job_options(settings)}
         super().__init__(scene, frames, mode, exemplar, options, settings.output_format)
@@ -379,7 +380,7 @@ class TEMPERA_OT_stylize(JobOperator, Operator):
                 if video:
                     shown.append(f"video {video}")
         how = settings.load_result if job.mode == "ANIMATION" else "IMAGE"
-        if getattr(job, "over_render", False) and paths and how != "NONE":  # over the render, whatever is shown
+        if job.over_render and paths and how != "NONE":  # over the render, whatever is shown
             composite = results.load_composite_scene(scene, job.render_paths(), paths, job.frames)
             loaded = composite if how == "SEQUENCER" else results.load(scene, paths, job.frames, how)
         else:
