@@ -163,7 +163,7 @@ def test_exemplar_thumbnail_and_image_only_picker(scene, tmp_path):
     assert len(icons) == 1, calls  # the bundled kit's painting (icon ids are 0 in background mode)
     assert ("label", "style.png") in calls
     from tempera.blender.kit_operators import painting_preview
-    from tempera.methods.stylit.kit import kit_exemplar
+    from tempera.app.exemplar_kit import kit_exemplar
 
     assert tuple(painting_preview(str(kit_exemplar()[0])).image_size)[0] > 0  # the thumbnail was decoded
     picker = bpy.ops.tempera.choose_painting.get_rna_type().properties
@@ -194,7 +194,7 @@ def test_painting_template_and_photo_registration_from_blender(scene, tmp_path):
     settings = scene.tempera
     assert settings.exemplar_source == "CUSTOM"
     assert settings.exemplar_style == str(kit / "painting.png")
-    from tempera.methods.stylit.kit import kit_exemplar
+    from tempera.app.exemplar_kit import kit_exemplar
 
     guides = kit_exemplar()[1]
     assert os.path.samefile(settings.exemplar_guide_dir, guides)

@@ -83,7 +83,7 @@ def _paint_keys(guides, folder):
 
 def test_coherent_method_on_a_users_scene_from_the_panel_and_the_cli(user_scene, tmp_path):
     import tempera
-    from tempera.methods.stylit import kit
+    from tempera.app import exemplar_kit as kit
     from tempera.blender.properties import WEIGHT_PROPERTIES
 
     scene, settings = user_scene, user_scene.tempera

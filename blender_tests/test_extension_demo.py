@@ -46,7 +46,7 @@ def test_demo_finishes_with_every_frame(demo):
     frames = demo["out"] / "frames"
     names = sorted(p.name for p in frames.glob("frame_*.png"))
     assert names == [f"frame_{f:04d}.png" for f in FRAMES]
-    from tempera.methods.stylit import kit
+    from tempera.app import exemplar_kit as kit
 
     style, _ = kit.kit_exemplar()
     palette = tempera.read_image(str(style))[:, :, :3].reshape(-1, 3).mean(0)
@@ -67,7 +67,7 @@ def test_demo_loads_the_result_into_a_sequencer_scene(demo):
 
 
 def test_the_kit_comes_from_the_extension_folder():
-    from tempera.methods.stylit import kit
+    from tempera.app import exemplar_kit as kit
 
     style, guides = kit.kit_exemplar()
     installed = Path(os.environ["TEMPERA_TEST_SCRIPTS_DIR"])

@@ -67,7 +67,7 @@ def _energy(frames, guides):
 def test_temporal_noise_from_the_panel_and_the_cli(user_scene, tmp_path):
     from tempera.methods.noisy import noisy
     from tempera.engine import temporal
-    from tempera.methods.stylit.kit import kit_exemplar
+    from tempera.app.exemplar_kit import kit_exemplar
 
     settings = user_scene.tempera
     settings.noise_level = HIGH

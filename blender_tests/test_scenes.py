@@ -123,7 +123,7 @@ def test_exemplar_kit_outputs(tmp_path):
     assert 0 < x0 < x1 < page.shape[1] and 0 < y0 < y1 < page.shape[0]
     assert (folder / "template.pdf").read_bytes().startswith(b"%PDF")
     # Ready to stylize with: the painting and the guide cache, at the kit's resolution.
-    from tempera.methods.stylit import kit as bundled
+    from tempera.app import exemplar_kit as bundled
 
     style, guides = bundled.kit_exemplar(folder.name, kit_dir=folder.parent)
     assert tempera.read_image(str(style)).shape[:2] == (36, 48)

@@ -131,7 +131,7 @@ def in_blender(argv):
         settings = scene.tempera
         if kind == "custom":
             settings.exemplar_source = "CUSTOM"
-            from tempera.methods.stylit.kit import kit_exemplar
+            from tempera.app.exemplar_kit import kit_exemplar
 
             style, guides = kit_exemplar()
             settings.exemplar_style, settings.exemplar_guide_dir = str(style), str(guides)

@@ -121,7 +121,7 @@ def comparison_sheet(out, scene):
     import numpy as np
     import tempera
     from tempera.app import guide_cache
-    from tempera.methods.stylit import kit
+    from tempera.app import exemplar_kit as kit
     from tempera.methods.stylit.stylize import tonemap
 
     style_path, exemplar_guides = kit.kit_exemplar()

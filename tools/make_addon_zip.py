@@ -6,7 +6,7 @@ the manifest stays out of this zip, so 4.2+ does not take it for one.
 
 With --kit DIR (a folder written by scenes/exemplar_kit.py), the kit's
 painting, render and guide cache go into the zip as tempera/kit/<variant>/,
-the add-on's bundled exemplar (tempera.methods.stylit.kit)."""
+the add-on's bundled exemplar (tempera.app.exemplar_kit)."""
 import argparse
 import sys
 import zipfile

@@ -13,7 +13,7 @@ from pathlib import Path
 
 def register():
     import tempera
-    from tempera.methods.stylit import kit
+    from tempera.app import exemplar_kit as kit
 
     kit.KIT_DIR = Path(__file__).resolve().parent / "kit"
     tempera.register(addon_id=__name__)

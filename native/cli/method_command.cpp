@@ -30,6 +30,9 @@ std::string method_default_exemplar(const MethodEntry& m) {
   if (m.default_exemplar == kJobMadeExemplar)
     return " (left out, or 'generated': the project's own,\n"
            "                          which the job writes into OUT/exemplar_generated_...)";
+  if (m.default_exemplar == kKitExemplar)
+    return " (left out with the exemplar's guides and scene:\n"
+           "                          the Python package's tempera uses the bundled exemplar kit)";
   return concat(" (left out: the Python package's tempera generates\n"
                 "                          the project's own ", m.default_exemplar, " into OUT/exemplar_generated_",
                 m.default_exemplar, ")");
@@ -80,6 +83,10 @@ struct Request {
 void check_required(const MethodEntry& method, const Request& q) {
   const JobConfig& config = q.config;
   const bool job_makes_one = method.default_exemplar == kJobMadeExemplar;
+  if (config.exemplar.empty() && method.default_exemplar == kKitExemplar)
+    throw ValueError("--exemplar is required here; the Python package's 'tempera stylize' uses the bundled "
+                     "exemplar kit (a painted sphere on a table) when --exemplar, --exemplar-guides and "
+                     "--exemplar-scene are left out");
   if (config.exemplar.empty() && !method.default_exemplar.empty() && !job_makes_one)
     throw ValueError(concat("--exemplar is required here; the Python package's 'tempera stylize' uses the project's "
                             "own ", method.default_exemplar, " exemplar when it is left out (or write it with "

@@ -123,6 +123,7 @@ void bind_registry(py::module_& m) {
   bind_frame_job_class(m);
   bind_segment_job_class(m);
   m.attr("JOB_MADE_EXEMPLAR") = kJobMadeExemplar;
+  m.attr("KIT_EXEMPLAR") = kKitExemplar;
   m.def(
       "methods",
       [] {

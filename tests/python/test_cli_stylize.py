@@ -221,6 +221,43 @@ def test_fluid_methods_default_to_the_projects_own_exemplar(cli_path, tmp_path):
         assert (exemplar / "frame_0001.png").stat().st_mtime_ns == written  # made once
 
 
+def test_light_path_methods_default_to_the_bundled_kit(cli_path, caches):
+    """Step 5 of issue 41: with no painting of one's own, the Python package's
+    `tempera stylize` gives StyLit (and the coherent method) the bundled
+    exemplar kit's painting and guides; the frames are those of the kit given
+    by hand. The native CLI alone names the way to one; a missing kit is named."""
+    from tempera.app import guide_cache
+
+    kit = caches / "kits" / "sphere_on_table"
+    kit.mkdir(parents=True)
+    shutil.copy(caches / "paint.png", kit / "style.png")
+    shutil.copytree(caches / "exemplar", kit / "guides")
+    guide_cache.write_manifest(kit / "guides", {"frames": {}})  # a kit's guides are a whole cache
+    for method in ("stylit", "tcia"):
+        assert tempera._native.find_method(method)["default_exemplar"] == tempera._native.KIT_EXEMPLAR == "kit"
+    args = ["stylize", "--method", "stylit", "--guides", str(caches / "cache"), "--frames", "1-2", "--threads", "2",
+            "--levels", "2"]
+    native = subprocess.run([str(cli_path), *args, "--out", str(caches / "native")], capture_output=True, text=True,
+                            timeout=300)
+    assert native.returncode == 2 and "uses the bundled exemplar kit" in native.stderr, native.stderr
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "addon"), TEMPERA_CLI=str(cli_path),
+               TEMPERA_KIT_DIR=str(caches / "kits"))
+    run = subprocess.run([sys.executable, "-m", "tempera", *args, "--out", str(caches / "kit_run")],
+                         capture_output=True, text=True, timeout=300, env=env)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert "using the bundled exemplar kit" in run.stderr
+    by_hand = stylize(cli_path, *args[1:], "--exemplar", kit / "style.png", "--exemplar-guides", kit / "guides",
+                      "--out", caches / "by_hand")
+    assert by_hand.returncode == 0, by_hand.stderr
+    for f in (1, 2):
+        name = f"frames/frame_{f:04d}.png"
+        assert (caches / "kit_run" / name).read_bytes() == (caches / "by_hand" / name).read_bytes()
+    missing = subprocess.run([sys.executable, "-m", "tempera", *args, "--out", str(caches / "no_kit")],
+                             capture_output=True, text=True, timeout=300,
+                             env=dict(env, TEMPERA_KIT_DIR=str(caches / "nowhere")))
+    assert missing.returncode == 1 and "exemplar kit 'sphere_on_table' is not in this build" in missing.stderr
+
+
 @pytest.mark.skipif(shutil.which(BLENDER) is None, reason="Blender not installed")
 def test_fluid_methods_render_a_scenes_guides_first(cli_path, tmp_path):
     """Step 5 of issue 41: `stylize SCENE.blend` for the methods that read a guide cache

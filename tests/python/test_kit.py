@@ -1,7 +1,7 @@
-"""tempera.methods.stylit.kit: finding the bundled exemplar kit (no Blender)."""
+"""tempera.app.exemplar_kit: finding the bundled exemplar kit (no Blender)."""
 import pytest
 
-from tempera.methods.stylit import kit
+from tempera.app import exemplar_kit as kit
 
 
 def make_kit(folder, variant):
@@ -30,3 +30,14 @@ def test_incomplete_kit_is_missing(tmp_path):
     (tmp_path / "sphere_on_table" / "guides" / "manifest.json").unlink()
     with pytest.raises(FileNotFoundError):
         kit.kit_exemplar(kit_dir=tmp_path)
+
+
+def test_the_kit_is_the_packages_kit_folder():
+    """make_addon_zip packs the kit as tempera/kit; the extension points KIT_DIR beside itself."""
+    import os
+    from pathlib import Path
+
+    import tempera
+
+    if not os.environ.get("TEMPERA_KIT_DIR"):
+        assert kit.KIT_DIR == Path(tempera.__file__).resolve().parent / "kit"

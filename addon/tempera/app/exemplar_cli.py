@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import _native
-from . import media_exemplars
+from . import exemplar_kit, media_exemplars
 from .command import run_command
 
 DEFAULT_SIZE = (256, 256)
@@ -103,6 +103,8 @@ def with_default_exemplar(args, entry):
     kind = entry["default_exemplar"]
     if not kind or kind == _native.JOB_MADE_EXEMPLAR or "--exemplar" in args or "--help" in args or "-h" in args:
         return list(args)
+    if kind == _native.KIT_EXEMPLAR:
+        return with_kit_exemplar(args)
     at = args.index("--out") if "--out" in args else len(args)
     if at + 1 >= len(args):
         return list(args)
@@ -110,6 +112,19 @@ def with_default_exemplar(args, entry):
     print(f"tempera stylize: no --exemplar given: using the project's own {kind} exemplar, {folder}",
           file=sys.stderr, flush=True)
     return [*args, "--exemplar", str(folder)]
+
+
+def with_kit_exemplar(args):
+    """The arguments with the bundled kit's painting and guide cache as the
+    exemplar (a light-path method's), unless the exemplar's guides or scene
+    are given (the command then names what is missing). FileNotFoundError
+    naming the kit when this install has none."""
+    if "--exemplar-guides" in args or "--exemplar-scene" in args:
+        return list(args)
+    style, guides = exemplar_kit.kit_exemplar()
+    print(f"tempera stylize: no --exemplar given: using the bundled exemplar kit, {style}", file=sys.stderr,
+          flush=True)
+    return [*args, "--exemplar", str(style), "--exemplar-guides", str(guides)]
 
 
 def main(argv=None):

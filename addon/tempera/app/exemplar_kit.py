@@ -1,4 +1,5 @@
-"""The exemplar kit bundled with the add-on (no bpy).
+"""The exemplar kit bundled with the add-on (no bpy): the light-path
+methods' exemplar when an artist has painted none.
 
 `make addon-zip` renders StyLit's "sphere on a table" exemplar
 (scenes/exemplar_kit.py), paints it with tempera.methods.stylit.exemplar_paint and packs
@@ -10,12 +11,14 @@ it into the add-on as
 
 so that an artist can stylize a scene before painting an exemplar of their own.
 """
+import os
 from pathlib import Path
 
 # The legacy add-on zip carries the kit inside the package; the extension
 # carries it beside its own __init__.py, which points KIT_DIR there.
-# Either way the kit folder is tempera/kit, two packages above this file.
-KIT_DIR = Path(__file__).resolve().parents[2] / "kit"
+# Either way the kit folder is tempera/kit, the package above this file;
+# $TEMPERA_KIT_DIR points elsewhere (a studio's own kits, laid out the same).
+KIT_DIR = Path(os.environ.get("TEMPERA_KIT_DIR") or Path(__file__).resolve().parents[1] / "kit")
 DEFAULT_VARIANT = "sphere_on_table"
 STYLE_NAME = "style.png"
 GUIDES_NAME = "guides"

@@ -5,7 +5,7 @@ import os
 
 import bpy
 
-from ..methods.stylit import kit
+from ..app import exemplar_kit as kit
 
 FRAMES_DIR = "frames"  # the stylized frames, in the Output Folder (or a method's folder in it)
 

@@ -34,6 +34,10 @@ using MakeSegmentJob = std::function<std::unique_ptr<SegmentJob>(const JobConfig
 
 // A MethodEntry's default_exemplar when its job makes the exemplar itself.
 constexpr const char* kJobMadeExemplar = "generated";
+// A MethodEntry's default_exemplar when it is the bundled exemplar kit: a
+// painting and its exemplar render's guide cache (tempera/app/exemplar_kit.py),
+// the light-path methods' stand-in for the artist's painting.
+constexpr const char* kKitExemplar = "kit";
 
 struct MethodEntry {
   std::string name;     // --method NAME; the panel's item is NAME in capitals
@@ -69,8 +73,9 @@ struct MethodEntry {
   // the kind `tempera exemplar KIND` writes ("smoke", "ink"), which the
   // Python package's `tempera stylize` generates into OUT once and passes
   // on (tempera/app/exemplar_cli.py); kJobMadeExemplar when the job makes its
-  // own from an empty --exemplar (the rigid-body method's drawn ball); ""
-  // when the method needs the artist's (StyLit's painting).
+  // own from an empty --exemplar (the rigid-body method's drawn ball);
+  // kKitExemplar when the Python package passes the bundled kit's painting
+  // and guides (the light-path methods); "" when the method needs the artist's.
   std::string default_exemplar;
   // More of --help, after the summary: what the exemplar and the guides must
   // hold, where the outputs go, how resume decides; paragraphs ending in "\n".

@@ -73,6 +73,7 @@ MethodEntry stylit_method() {
   m.paper = "Fišer et al. 2016";
   m.unit = "frame";
   m.light_path_guides = true;
+  m.default_exemplar = kKitExemplar;  // the painted sphere on a table
   m.docs = "docs/user_guide.md";
   m.make_job = [](const JobConfig& config, const MethodOptions& options) {
     return std::make_unique<StylizeJob>(job_config(config, options));

@@ -86,6 +86,7 @@ MethodEntry tcia_method() {
   m.paper = "Bénard et al. 2013";
   m.unit = "segment";
   m.light_path_guides = true;
+  m.default_exemplar = kKitExemplar;  // the painted sphere on a table
   m.docs = "docs/coherent.md";
   m.make_segment_job = [](const JobConfig& config, const MethodOptions& options) {
     return std::make_unique<TciaJob>(job_config(config, options));
