@@ -24,7 +24,7 @@ import time
 import numpy as np
 
 import tempera
-from tempera.tracer.lpe import STYLIT_EXPRESSIONS
+from tempera.tracer.lpe import LIGHT_PATH_EXPRESSIONS
 
 
 def sphere(center, radius, rings, segments):
@@ -95,7 +95,7 @@ def make_scene(size):
 
 def trace(scene, samples, threads, seed=0):
     start_wall, start_cpu = time.perf_counter(), time.process_time()
-    images, alpha = tempera.trace_lpe(scene, list(STYLIT_EXPRESSIONS.values()), samples=samples, threads=threads,
+    images, alpha = tempera.trace_lpe(scene, list(LIGHT_PATH_EXPRESSIONS.values()), samples=samples, threads=threads,
                                       seed=seed)
     return images, alpha, time.perf_counter() - start_wall, time.process_time() - start_cpu
 
@@ -110,7 +110,7 @@ def noise_table(size, threads, reference_samples, sample_counts):
         # RMS error over the RMS of the reference: fair to sparse guides (LSE
         # highlights) where the mean is tiny.
         errors = {name: float(np.sqrt(np.mean((img - ref) ** 2) / max(float(np.mean(ref * ref)), 1e-24)))
-                  for name, img, ref in zip(STYLIT_EXPRESSIONS, images, reference)}
+                  for name, img, ref in zip(LIGHT_PATH_EXPRESSIONS, images, reference)}
         rows["rel_rmse"][n] = errors
         print(n, f"{seconds:.1f} s", {k: round(v, 4) for k, v in errors.items()}, flush=True)
     return rows
@@ -139,16 +139,16 @@ def main():
             "size": args.size,
             "samples": args.samples,
             "triangles": int(len(scene["triangles"])),
-            "expressions": STYLIT_EXPRESSIONS,
+            "expressions": LIGHT_PATH_EXPRESSIONS,
             "wall_seconds": wall,
             "cpu_seconds": cpu,
             "seconds_per_sample_per_pixel": wall / (args.samples * pixels),
             "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
-            "guide_means": {name: float(img.mean()) for name, img in zip(STYLIT_EXPRESSIONS, images)},
+            "guide_means": {name: float(img.mean()) for name, img in zip(LIGHT_PATH_EXPRESSIONS, images)},
             "alpha_mean": float(alpha.mean()),
         }
         if args.save:
-            np.savez(args.save, alpha=alpha, **dict(zip(STYLIT_EXPRESSIONS, images)))
+            np.savez(args.save, alpha=alpha, **dict(zip(LIGHT_PATH_EXPRESSIONS, images)))
     result["machine"] = {"cpu": platform.processor() or platform.machine(), "python": platform.python_version()}
     print(json.dumps(result, indent=1))
     if args.json:

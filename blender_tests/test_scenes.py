@@ -76,7 +76,7 @@ def test_render_settings(exemplar_scene):
 
 def test_exemplar_renders_to_guides(exemplar_scene, tmp_path):
     from tempera.app.passes import read_pass
-    from tempera.methods.stylit.stylize import tonemap
+    from tempera.engine.guides import tonemap
 
     path = exemplar_kit.render_exemplar(exemplar_scene, tmp_path / "exemplar" / "guides.exr", (48, 36), 2)
     assert path == tmp_path / "exemplar" / "guides.exr" and path.is_file()

@@ -29,7 +29,7 @@ def exemplar(tmp_path_factory):
     import tempera
     from tempera.app import guide_cache
     from tempera.blender.guide_render import render_guides
-    from tempera.methods.stylit.stylize import tonemap
+    from tempera.engine.guides import tonemap
 
     folder = tmp_path_factory.mktemp("exemplar")
     scene = build_scene("Stylize exemplar")

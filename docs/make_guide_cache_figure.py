@@ -27,7 +27,7 @@ import tempera  # noqa: E402
 from tempera.app import guide_cache
 from tempera.engine import guides  # noqa: E402
 from tempera.blender.guide_render import render_guides  # noqa: E402
-from tempera.methods.stylit.stylize import tonemap  # noqa: E402
+from tempera.engine.guides import tonemap  # noqa: E402
 
 OUT = ROOT / "docs" / "images" / "guide_cache_frame.png"
 FRAME = 4

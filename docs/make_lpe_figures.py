@@ -6,7 +6,7 @@ above the same paths from Tempera's tracer, for one small scene
     PYTHONPATH=addon blender -b --factory-startup --python docs/make_lpe_figures.py
 
 Both come from one render_guides run (tempera.blender.guide_render), 256
-samples each. Tiles, tone-mapped with tempera.methods.stylit.stylize.tonemap:
+samples each. Tiles, tone-mapped with tempera.engine.guides.tonemap:
 row 1 (Cycles)  FULL, DiffDir x DiffCol, GlossDir x GlossCol, DiffInd x DiffCol
                 (caustics off), and an empty tile: Cycles cannot isolate caustics;
 row 2 (tracer)  L.*E, LDE, LSE, L.*DDE, LS+DE (caustics, x 4 to be visible).
@@ -25,7 +25,7 @@ import lpe_scene  # noqa: E402
 import tempera  # noqa: E402
 from tempera.app import guide_cache  # noqa: E402
 from tempera.blender.guide_render import render_guides  # noqa: E402
-from tempera.methods.stylit.stylize import tonemap  # noqa: E402
+from tempera.engine.guides import tonemap  # noqa: E402
 
 OUT = ROOT / "docs" / "images" / "lpe_side_by_side.png"
 SIZE = (192, 144)

@@ -47,7 +47,7 @@ def row(images, gap=6):
 def make(work):
     import tempera
     from tempera.app import guide_cache
-    from tempera.methods.stylit.stylize import tonemap
+    from tempera.engine.guides import tonemap
 
     scene = bpy.context.scene
     for o in list(scene.objects):

@@ -15,7 +15,7 @@ import numpy as np
 
 import tempera
 from tempera.app import guide_cache
-from tempera.methods.stylit.stylize import tonemap
+from tempera.engine.guides import tonemap
 from tempera.methods.stylit.stylize import StylizeJob
 
 IMAGES = Path(__file__).resolve().parent / "images"

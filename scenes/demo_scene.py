@@ -122,7 +122,7 @@ def comparison_sheet(out, scene):
     import tempera
     from tempera.app import guide_cache
     from tempera.app import exemplar_kit as kit
-    from tempera.methods.stylit.stylize import tonemap
+    from tempera.engine.guides import tonemap
 
     style_path, exemplar_guides = kit.kit_exemplar()
     exemplar_render = tempera.read_image(str(style_path.parent / "render.png"))[:, :, :3]

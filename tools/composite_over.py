@@ -20,7 +20,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "addon"))
 from tempera import contact_sheet, read_image, write_image  # noqa: E402
 from tempera.app.frames import parse_frames  # noqa: E402
-from tempera.methods.stylit.stylize import encode_video  # noqa: E402
+from tempera.app.video import encode_video  # noqa: E402
 
 FRAME = "frame_{:04d}.png"
 SHEET_STEP = 3

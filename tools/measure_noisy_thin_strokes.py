@@ -24,7 +24,7 @@ import tempera
 from tempera.app import guide_cache
 from tempera.methods.noisy import noisy
 from tempera.app.settings import DEFAULT_GUIDE_WEIGHTS
-from tempera.methods.stylit.stylize import tonemap
+from tempera.engine.guides import tonemap
 
 ROOT = Path(__file__).resolve().parent.parent
 PAINTING = ROOT / "build" / "kit" / "sphere_on_table" / "style.png"

@@ -57,7 +57,7 @@ void bind_guides(py::module_& m) {
         }
         return py_bridge::to_numpy(std::move(out));
       },
-      py::arg("linear"), "Linear radiance -> guide values in [0, 1): x/(1+x), then sRGB (use tempera.methods.stylit.stylize.tonemap).");
+      py::arg("linear"), "Linear radiance -> guide values in [0, 1): x/(1+x), then sRGB (use tempera.engine.guides.tonemap).");
   m.def(
       "cache_guides",
       [] {

@@ -12,6 +12,7 @@
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
 #include "tempera/engine/patch_usage.hpp"
+#include "tempera/engine/pyramid.hpp"
 #include "tempera/engine/synthesis.hpp"
 
 namespace py = pybind11;
@@ -179,6 +180,18 @@ void add_item_access(C& cls) {
 }  // namespace
 
 void bind_synthesis(py::module_& m) {
+  m.def(
+      "box_blur",
+      [](const FloatArray& image, float width) {
+        const ImageView v = py_bridge::view_of(image, "image");
+        Image out;
+        {
+          py::gil_scoped_release release;
+          out = box_blur(v, width);
+        }
+        return py_bridge::to_numpy(std::move(out));
+      },
+      py::arg("image"), py::arg("width"), "Box low-pass of `width` pixels (pyramid.hpp), clamped at the borders.");
   py_bridge::bind_options_class<SynthesisOptions>(m, "SynthesisOptions", synthesis_option_table(),
                                                   "Options of the synthesis engine (native/include/tempera/engine/synthesis_options.hpp).")
       .def("validate", [](const SynthesisOptions& o) { validate(o); }, "ValueError naming the first bad option.");

@@ -5,7 +5,9 @@
 
 #include "bind_method.hpp"
 #include "numpy_bridge.hpp"
+#include "tempera/app/contact_sheet.hpp"
 #include "tempera/app/image_io.hpp"
+#include "tempera/app/process.hpp"
 #include "tempera/app/segments.hpp"
 
 namespace py = pybind11;
@@ -75,6 +77,29 @@ void bind_io(py::module_& m) {
       "Images declaring more pixels than this are refused (OSError) before their pixels are read; "
       "default 50 Mpix or $TEMPERA_MAX_IMAGE_PIXELS.");
   m.def("max_image_pixels", &max_image_pixels, "The current image size limit in pixels.");
+  m.def(
+      "contact_sheet",
+      [](const std::vector<FloatArray>& images, int columns, int gap, int margin, std::vector<float> background) {
+        std::vector<ImageView> views;
+        for (std::size_t i = 0; i < images.size(); ++i)
+          views.push_back(py_bridge::view_of(images[i], concat("contact_sheet: image ", i)));
+        Image sheet;
+        {
+          py::gil_scoped_release release;
+          sheet = contact_sheet(views, ContactSheetLayout{columns, gap, margin, std::move(background)});
+        }
+        return py_bridge::to_numpy(std::move(sheet));
+      },
+      py::arg("images"), py::arg("columns"), py::arg("gap"), py::arg("margin"), py::arg("background"),
+      "Grid of images; use tempera.app.contact_sheet.contact_sheet.");
+  m.def(
+      "encode_video",
+      [](const std::string& pattern, int first_frame, double fps, const std::string& out) {
+        py::gil_scoped_release release;
+        return encode_video(pattern, first_frame, fps, out);
+      },
+      py::arg("pattern"), py::arg("first_frame"), py::arg("fps"), py::arg("out"),
+      "H.264 MP4 of numbered frames with ffmpeg, atomically; False (no file) without ffmpeg; use tempera.app.video.");
   m.def(
       "key_segments",
       [](const std::vector<int>& frames, const std::vector<int>& key_frames) {

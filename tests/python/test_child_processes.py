@@ -17,7 +17,7 @@ import pytest
 
 import tempera
 from tempera.app import media_source
-from tempera.methods.stylit.stylize import encode_video
+from tempera.app.video import encode_video
 
 FFMPEG = shutil.which("ffmpeg")
 needs_ffmpeg = pytest.mark.skipif(FFMPEG is None, reason="ffmpeg is not on PATH")

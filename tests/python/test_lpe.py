@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import tempera
-from tempera.tracer.lpe import STYLIT_EXPRESSIONS, lpe_matches
+from tempera.tracer.lpe import LIGHT_PATH_EXPRESSIONS, lpe_matches
 
 from conftest import assert_releases_gil
 
@@ -67,7 +67,7 @@ def test_same_result_for_any_thread_count():
 
 
 def test_check_lpe_names_the_position():
-    for expression in STYLIT_EXPRESSIONS.values():
+    for expression in LIGHT_PATH_EXPRESSIONS.values():
         tempera.check_lpe(expression)
     with pytest.raises(ValueError, match=r"position 4: expected '\)'"):
         tempera.check_lpe("L(DE")

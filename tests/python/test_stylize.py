@@ -8,7 +8,7 @@ import pytest
 import tempera
 from tempera import _native
 from tempera.app import guide_cache
-from tempera.methods.stylit.stylize import tonemap
+from tempera.engine.guides import tonemap
 from tempera.methods.stylit import stylize
 from tempera.methods.stylit.stylize import StylizeJob, stylize_frame
 
@@ -158,7 +158,7 @@ def test_one_guide_table_everywhere():
     names = [g["name"] for g in table]
     assert list(stylize.GUIDES) == names and names == ["FULL", "LDE", "LSE", "LDDE", "LD12E"]
     assert stylize.DEFAULT_WEIGHTS == settings.DEFAULT_GUIDE_WEIGHTS == {g["name"]: g["weight"] for g in table}
-    assert lpe.STYLIT_EXPRESSIONS["LDDE"] == "L.*DDE" and set(lpe.STYLIT_EXPRESSIONS) == set(names)
+    assert lpe.LIGHT_PATH_EXPRESSIONS["LDDE"] == "L.*DDE" and set(lpe.LIGHT_PATH_EXPRESSIONS) == set(names)
     assert all(guide_cache.GUIDES[n] == "RGB" for n in names)
     assert settings.SEED_DEFAULT == tempera.SynthesisOptions().seed == 1
 

@@ -9,7 +9,7 @@ Layout of a cache folder (documented in docs/guide_cache.md):
 Channel names are "<guide>.<component>" (GUIDES below); masks are
 "mask.<OB_|CO_><name>.V"; light path expression guides are "lpe_<name>.R/G/B"
 (lpe_guide below). All values are float32 and linear (light-path
-guides are radiance, not tone-mapped: apply tempera.methods.stylit.stylize.tonemap).
+guides are radiance, not tone-mapped: apply tempera.engine.guides.tonemap).
 Images are rows top-down; x runs right and y down, velocities are in pixels
 with the conventions of tempera.engine.guides.
 

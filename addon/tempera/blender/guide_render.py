@@ -32,7 +32,7 @@ from .. import image_info, read_image
 from . import compat, fluid_velocity, rigid_tracks
 from ..app.frames import MAX_FRAME, check_frame
 from ..tracer.lpe import check_lpe, trace_lpe
-from ..methods.stylit.stylize import tonemap
+from ..engine.guides import tonemap
 from .scene_export import SceneExportError, evaluated_depsgraph, export_scene, path_settings
 
 

@@ -99,7 +99,7 @@ class TEMPERA_OT_painting_template(Operator):
     def execute(self, context):
         from ..app import guide_cache
         from ..methods.stylit.painting_template import make_template, write_kit_json, write_pdf
-        from ..methods.stylit.stylize import tonemap
+        from ..engine.guides import tonemap
 
         settings = context.scene.tempera
         try:

@@ -132,11 +132,12 @@ def draw_synthesis(box, settings):
     if side is not None:  # the method's own module (tempera.blender.methods)
         side.draw(box, settings)
     else:
-        draw_stylit(box, settings)
+        draw_light_path_settings(box, settings)
 
 
-def draw_stylit(box, settings):
-    """StyLit's settings and the Temporal Noise pass after it."""
+def draw_light_path_settings(box, settings):
+    """The light-path methods' settings (StyLit's, which the coherent method shares) and the Temporal
+    Noise pass after them."""
     col = box.column()
     col.prop(settings, "quality")
     col.prop(settings, "usage")

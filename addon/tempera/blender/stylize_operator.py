@@ -395,7 +395,7 @@ class TEMPERA_OT_stylize(JobOperator, Operator):
 
     def _encode_video(self, scene, job):
         """Encodes the mp4; its path, or None (reported why)."""
-        from ..methods.stylit.stylize import encode_video
+        from ..app.video import encode_video
 
         if job.config["format"] != "png":
             self.report({"INFO"}, "No mp4: the video is made from PNG frames (Format is OpenEXR)")

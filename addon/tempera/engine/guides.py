@@ -7,7 +7,8 @@ Bénard et al. 2013, "Stylizing Animation by Example", on numpy arrays:
   backward advection of the previous frame;
 * orientation (§3.1): structure tensor of the grayscale image, and the
   angle / coherence it defines;
-* lines (§3.2): bounded distance to line pixels, D(I).
+* lines (§3.2): bounded distance to line pixels, D(I);
+* light-path guides (StyLit): radiance tone-mapped to the values matched.
 
 Conventions: images are (H, W) or (H, W, C); x runs to the right and y down
 (image rows). Velocities are (H, W, 2) arrays (x, y) in pixels:
@@ -31,6 +32,7 @@ __all__ = [
     "occlusion_forward",
     "orientation",
     "structure_tensor",
+    "tonemap",
     "warp_backward",
 ]
 
@@ -159,3 +161,13 @@ def line_distance(mask, d_max: float = 10.0) -> np.ndarray:
     if m.shape[2] != 1:
         raise ValueError(f"line mask must be an (H, W) or (H, W, 1) array, got shape {np.shape(mask)}")
     return _native.line_distance(m, _positive(d_max, "d_max"))[:, :, 0]
+
+
+def tonemap(linear):
+    """Linear radiance -> guide values in [0, 1) as StyLit matches them:
+    NaN and negatives to 0, Reinhard x / (1 + x), then the sRGB encoding.
+    Per pixel, with no image-dependent normalization, so equal lighting gives
+    equal guides in the exemplar and in every frame."""
+    a = np.asarray(linear, dtype=np.float32)
+    flat = a.reshape(a.shape[0], -1) if a.ndim == 1 else a
+    return _native.tonemap_guide(np.ascontiguousarray(flat)).reshape(a.shape)

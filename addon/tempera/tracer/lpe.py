@@ -17,7 +17,7 @@ import numpy as np
 from .. import _native
 
 # The guides of the StyLit paper (thesis fig. 8.4), by name (native guide table).
-STYLIT_EXPRESSIONS = {g["name"]: g["expression"] for g in _native.light_path_guides()}
+LIGHT_PATH_EXPRESSIONS = {g["name"]: g["expression"] for g in _native.light_path_guides()}
 
 
 class _Reader:

@@ -13,7 +13,7 @@ method, so that nothing outside it names the method:
     CLASSES         optional: its property groups, lists and operators, to register
 
 StyLit, the method without a module here, is the default: panels.py draws
-its settings (draw_stylit) and stylize_operator.StylizeRun runs it."""
+its settings (draw_light_path_settings) and stylize_operator.StylizeRun runs it."""
 import functools
 import importlib
 

@@ -7,7 +7,6 @@ native/src/methods/stylit/stylize_job.cpp); see docs/cli.md for the job's files 
 """
 from __future__ import annotations
 
-import os
 from typing import Iterable, Mapping, Optional
 
 import numpy as np
@@ -19,15 +18,6 @@ from ...app.settings import LIGHT_PATH_GUIDES
 from ...engine.synthesis import method_options
 
 GUIDES = tuple(g["name"] for g in LIGHT_PATH_GUIDES)
-
-def tonemap(linear):
-    """Linear radiance -> guide values in [0, 1) as StyLit matches them:
-    NaN and negatives to 0, Reinhard x / (1 + x), then the sRGB encoding.
-    Per pixel, with no image-dependent normalization, so equal lighting gives
-    equal guides in the exemplar and in every frame."""
-    a = np.asarray(linear, dtype=np.float32)
-    flat = a.reshape(a.shape[0], -1) if a.ndim == 1 else a
-    return _native.tonemap_guide(np.ascontiguousarray(flat)).reshape(a.shape)
 
 
 def options(weights: Optional[Mapping[str, float]] = None, **values) -> "_native.StylitOptions":
@@ -99,12 +89,6 @@ def stylize_frame(style, exemplar: Mapping, target: Mapping, *, previous=None, v
     opts = options(weights, temporal_weight=temporal_weight, quality=quality, **engine)
     return _native.stylize_frame(_float(style), {k: _float(v) for k, v in exemplar.items()},
                                  {k: _float(v) for k, v in target.items()}, opts, temporal, progress)
-
-
-def encode_video(pattern, first_frame: int, out, fps: float = 24.0) -> bool:
-    """H.264 MP4 of numbered frames (printf pattern, e.g. 'out/frame_%04d.png')
-    with ffmpeg, written atomically; False (and no file) when ffmpeg is missing."""
-    return _native.encode_video(os.fspath(pattern), int(first_frame), float(fps), os.fspath(out))
 
 
 def _float(array):

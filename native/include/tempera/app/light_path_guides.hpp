@@ -64,7 +64,7 @@ std::vector<std::string> active_guide_names(const GuideWeights& weights);
 
 // Linear radiance -> guide values in [0, 1): NaN and negatives to 0, +inf to
 // 1e6, Reinhard x / (1 + x), then the sRGB encoding. The same numbers as
-// tempera.methods.stylit.stylize.tonemap (computed in double, stored as float).
+// tempera.engine.guides.tonemap (computed in double, stored as float).
 Image tonemap_guide(const ImageView& linear);
 
 }  // namespace tempera

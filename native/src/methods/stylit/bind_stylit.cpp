@@ -1,6 +1,5 @@
 // Python binding of StyLit's options (StylitOptions), per frame and of the
-// sequence driver (StylizeJob), plus the contact sheet, flicker and video
-// helpers they use; the job's config is StylizeJobConfig, bound field by
+// sequence driver (StylizeJob), plus its flicker measure; the job's config is StylizeJobConfig, bound field by
 // field. tempera.methods.stylit.stylize wraps these with keyword arguments.
 // The GIL is released while native code runs.
 #include <pybind11/functional.h>
@@ -14,9 +13,6 @@
 #include "bind_job_config.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
-#include "tempera/app/contact_sheet.hpp"
-#include "tempera/app/process.hpp"
-#include "tempera/engine/pyramid.hpp"
 #include "tempera/methods/stylit/stylit.hpp"
 #include "tempera/methods/stylit/stylize_job.hpp"
 
@@ -140,41 +136,6 @@ void bind_stylit(py::module_& m) {
       },
       py::arg("previous"), py::arg("current"), py::arg("velocity_backward"), py::arg("visible"),
       "Mean absolute colour change along valid motion; use tempera.engine.temporal.flicker.");
-  m.def(
-      "box_blur",
-      [](const FloatArray& image, float width) {
-        const ImageView v = py_bridge::view_of(image, "image");
-        Image out;
-        {
-          py::gil_scoped_release release;
-          out = box_blur(v, width);
-        }
-        return py_bridge::to_numpy(std::move(out));
-      },
-      py::arg("image"), py::arg("width"), "Box low-pass of `width` pixels (pyramid.hpp), clamped at the borders.");
-  m.def(
-      "contact_sheet",
-      [](const std::vector<FloatArray>& images, int columns, int gap, int margin, std::vector<float> background) {
-        std::vector<ImageView> views;
-        for (std::size_t i = 0; i < images.size(); ++i)
-          views.push_back(py_bridge::view_of(images[i], concat("contact_sheet: image ", i)));
-        Image sheet;
-        {
-          py::gil_scoped_release release;
-          sheet = contact_sheet(views, ContactSheetLayout{columns, gap, margin, std::move(background)});
-        }
-        return py_bridge::to_numpy(std::move(sheet));
-      },
-      py::arg("images"), py::arg("columns"), py::arg("gap"), py::arg("margin"), py::arg("background"),
-      "Grid of images; use tempera.contact_sheet.");
-  m.def(
-      "encode_video",
-      [](const std::string& pattern, int first_frame, double fps, const std::string& out) {
-        py::gil_scoped_release release;
-        return encode_video(pattern, first_frame, fps, out);
-      },
-      py::arg("pattern"), py::arg("first_frame"), py::arg("fps"), py::arg("out"),
-      "H.264 MP4 of numbered frames with ffmpeg, atomically; False (no file) without ffmpeg.");
 }
 
 // module.cpp runs it after the core's bindings (py_bridge::method_bindings).

@@ -20,7 +20,7 @@ from . import keyframes, layers
 from ...guide_operator import format_duration
 from .keyframes import TEMPERA_OT_add_keyframe, TEMPERA_OT_import_keyframe, TEMPERA_OT_remove_keyframe, key_list
 from .layers import TEMPERA_OT_add_tcia_layer, TEMPERA_OT_remove_tcia_layer, layer_list
-from ...panels import draw_stylit
+from ...panels import draw_light_path_settings
 from ...stylize_operator import StylizeRun, require_consecutive
 
 MEDIUM = False
@@ -89,7 +89,7 @@ CLASSES = (TemperaKeyframe, TemperaLayer, *keyframes.CLASSES, *layers.CLASSES)
 def draw(box, settings):
     """The keyframes and layers, then StyLit's settings, which the method shares."""
     draw_keyframes(box, settings)
-    draw_stylit(box, settings)
+    draw_light_path_settings(box, settings)
 
 
 def draw_list(box, settings, items, index, add, remove, rows):

@@ -33,7 +33,7 @@ def keyframe_ground(scene, frame):
     its StyLit result if there is one, else its render in low contrast."""
     import tempera
     from tempera.app import guide_cache
-    from tempera.methods.stylit.stylize import tonemap
+    from tempera.engine.guides import tonemap
 
 
     settings = scene.tempera
