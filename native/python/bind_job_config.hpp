@@ -6,6 +6,7 @@
 // attribute per field whose setter names the field and what it expects
 // ("frames expects a list of whole numbers, got '1-3'"), paths as str or
 // os.PathLike, None for an optional field, enums by name, and a repr.
+#include <algorithm>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -116,8 +117,6 @@ class ConfigClass {
     return *this;
   }
 
-  py::class_<S>& cls() { return cls_; }
-
  private:
   using Setter = std::function<void(S&, const py::handle&)>;
   static std::string known(const std::vector<std::pair<std::string, Setter>>& setters) {
@@ -175,6 +174,12 @@ inline void require_job_config(const JobConfig& c, const std::string& what) {
   if (c.exemplar.empty()) throw ValueError(concat(what, " needs 'exemplar'"));
   if (c.frames.empty()) throw ValueError(concat(what, " needs 'frames'"));
   if (c.out.empty()) throw ValueError(concat(what, " needs 'out'"));
+}
+
+// The same, and the exemplar render's guide cache of a light-path method's config.
+inline void require_light_path_shot(const LightPathShotConfig& c, const std::string& what) {
+  require_job_config(c, what);
+  if (c.exemplar_guides.empty()) throw ValueError(concat(what, " needs 'exemplar_guides'"));
 }
 
 }  // namespace tempera::py_bridge

@@ -40,9 +40,8 @@ const StylitOptions& checked(const StylitOptions& opt) {
 
 StylizeJobConfig job_config(const StylizeJobConfig& config, const StylitOptions& options) {
   const std::string what = "StylizeJob config";
-  py_bridge::require_job_config(config, what);
+  py_bridge::require_light_path_shot(config, what);
   if (config.guides.empty()) throw ValueError(what + " needs 'guides'");
-  if (config.exemplar_guides.empty()) throw ValueError(what + " needs 'exemplar_guides'");
   StylizeJobConfig c = config;
   c.stylit = checked(options);
   return c;

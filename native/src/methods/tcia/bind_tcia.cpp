@@ -97,8 +97,7 @@ void bind_tcia(py::module_& m) {
   py::class_<TciaJob, SegmentJob>(m, "TciaJob",
                                   "The coherent method over a guide cache; use tempera.methods.tcia.tcia.ShotJob.")
       .def(py::init([](const TciaJobConfig& config, const TciaOptions& options) {
-             py_bridge::require_job_config(config, "ShotJob config");
-             if (config.exemplar_guides.empty()) throw ValueError("ShotJob config needs 'exemplar_guides'");
+             py_bridge::require_light_path_shot(config, "ShotJob config");
              TciaJobConfig c = config;
              active_guides(c.weights);
              c.tcia = options;
