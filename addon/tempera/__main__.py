@@ -3,8 +3,8 @@
 
 `tempera farm ...` and `tempera stylize --scheduler ADDRESS ...` run a shot on
 a Dask cluster (tempera.app.farm); `tempera exemplar ...` writes one of the
-project's own smoke/fire/ink exemplars (tempera.app.exemplar_cli), which `tempera stylize --method M`
-also uses when M has a default exemplar and --exemplar is left out; every other command is the
+project's own smoke/fire/ink exemplars (tempera.app.exemplar_cli), which `tempera stylize [--method M]`
+also uses when the method has a default exemplar and --exemplar is left out; every other command is the
 native batch CLI
 (tempera_native/bin/tempera: synth, stylize, render-guides), run with this
 package as the add-on that `render-guides` hands to Blender.
@@ -52,12 +52,13 @@ def main(argv=None):
         from .app.farm import main as farm_main
 
         return farm_main(argv[1:])
-    if argv[:1] == ["stylize"] and stylize_method(argv[1:]) is not None:
+    if argv[:1] == ["stylize"] and len(argv) > 1:  # alone, it prints the overview
         from .app.exemplar_cli import with_default_exemplar
         from .methods import registry
 
         try:
-            argv = ["stylize", *with_default_exemplar(argv[1:], registry.find(stylize_method(argv[1:])))]
+            method = registry.find(stylize_method(argv[1:]) or registry.default_name())
+            argv = ["stylize", *with_default_exemplar(argv[1:], method)]
         except (ValueError, OSError) as exc:  # an unknown method, an output folder that cannot be written
             print(f"tempera stylize: error: {exc}", file=sys.stderr)
             return 2 if isinstance(exc, ValueError) else 1

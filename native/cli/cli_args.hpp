@@ -53,10 +53,9 @@ class ArgReader {
 int run_synth(const Args& args);
 int run_render_guides(const Args& args);
 int run_stylize(const Args& args);
-int run_noisy(const Args& args);
 // `stylize --method NAME` for a method the registry runs by its job factory (method_command.cpp).
 int run_registered_method(const MethodEntry& method, const Args& args);
-// The method of `stylize` arguments: the last --method's value, else stylit.
+// The method of `stylize` arguments: the last --method's value, else the registry's default_method().
 // run_stylize sends the arguments to that method's command (methods/registry.hpp).
 std::string method_of(const Args& args);
 

@@ -90,7 +90,7 @@ bool names_a_method(const Args& args) { return std::find(args.begin(), args.end(
 }  // namespace
 
 std::string method_of(const Args& args) {
-  std::string method = "stylit";
+  std::string method = default_method().name;
   for (std::size_t i = 0; i + 1 < args.size(); ++i)
     if (args[i] == "--method") method = args[i + 1];
   return method;

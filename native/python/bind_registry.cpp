@@ -135,6 +135,9 @@ void bind_registry(py::module_& m) {
       "light_path_guides, docs, job: has a job factory (a segment job's for the unit 'segment'), "
       "options_help, default_exemplar), in the panel's order.");
   m.def(
+      "default_method", [] { return default_method().name; },
+      "The name of the method when none is named (tempera stylize without --method): the registry's first.");
+  m.def(
       "find_method", [](const std::string& name) { return method_dict(find_method(name)); }, py::arg("name"),
       "The registry's entry of `name`; ValueError naming every method.");
   m.def("method_segment_job", &method_segment_job, py::arg("name"), py::arg("config"),

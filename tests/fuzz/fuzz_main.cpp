@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "cli_args.hpp"
+#include "commands.hpp"
 #include "tempera/engine/error.hpp"
 #include "tempera/app/image_io.hpp"
 #include "tempera/tracer/lpe.hpp"
@@ -250,7 +251,7 @@ void fuzz_sidecar(FuzzRng& rng, const std::function<bool()>& more) {
 // One command line of a method: its entry point and the words before the options.
 struct MethodCommand {
   const char* name;
-  int (*run)(const cli::Args&);
+  std::function<int(const cli::Args&)> run;
   cli::Args prefix;
 };
 
@@ -261,7 +262,7 @@ const std::vector<MethodCommand>& method_commands() {
       {"stylize --method tcia", cli::run_stylize, {"--method", "tcia"}},
       {"stylize --method lazyfluids", cli::run_stylize, {"--method", "lazyfluids"}},
       {"stylize --method fluidymation", cli::run_stylize, {"--method", "fluidymation"}},
-      {"noisy", cli::run_noisy, {}},
+      {"noisy", cli::commands().at("noisy").run, {}},  // registered by its method's folder
       {"render-guides", cli::run_render_guides, {}},
   };
   return commands;

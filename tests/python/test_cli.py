@@ -26,6 +26,20 @@ def test_help(cli_path):
     assert "--version" in result.stdout
 
 
+def test_help_lists_the_core_commands_and_those_method_folders_register(cli_path):
+    """`tempera noisy` is registered by Color Me Noisy's folder (native/cli/commands.hpp);
+    the moved `tempera rigid` is registered too, but not listed."""
+    listed = [line.split()[0] for line in run(cli_path, "--help").stdout.split("commands:\n")[1].splitlines()
+              if line.startswith("  ")]
+    assert listed == ["noisy", "render-guides", "stylize", "synth"]
+
+
+def test_the_moved_rigid_command_names_its_new_form(cli_path):
+    result = run(cli_path, "rigid", "--cache", "c")
+    assert result.returncode == 2
+    assert "'tempera rigid' is now 'tempera stylize --method rigid" in result.stderr
+
+
 def test_no_arguments_prints_usage_and_fails(cli_path):
     result = run(cli_path)
     assert result.returncode == 2

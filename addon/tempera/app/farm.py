@@ -114,7 +114,7 @@ def shot_method(stylize_args):
     method the registry does not know."""
     from ..methods import registry  # here: a worker that only runs commands needs no native module
     try:
-        return registry.find((_option_values(stylize_args, "--method") or ["stylit"])[-1])
+        return registry.find((_option_values(stylize_args, "--method") or [registry.default_name()])[-1])
     except ValueError as e:
         raise FarmError(str(e)) from None
 

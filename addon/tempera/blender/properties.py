@@ -261,7 +261,7 @@ class TemperaSettings(PropertyGroup):
     __annotations__.update(noise_pass.PROPERTIES)
 
     # The method (tempera.methods.registry); its own settings come from its module.
-    method: EnumProperty(name="Method", items=METHOD_ITEMS, default="STYLIT",
+    method: EnumProperty(name="Method", items=METHOD_ITEMS, default=registry.default_name().upper(),
                          description="How Stylize Animation paints the shot")
 
     # The exemplar of a medium, for the methods whose module says MEDIUM

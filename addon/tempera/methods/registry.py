@@ -18,6 +18,12 @@ def names() -> list:
     return [m["name"] for m in METHODS]
 
 
+def default_name() -> str:
+    """The method when none is named (`tempera stylize` without --method, the
+    panel's Method, the farm): the registry's first."""
+    return _native.default_method()
+
+
 def find(name: str) -> dict:
     """The entry of `name`; ValueError naming every method (the CLI's message)."""
     return _native.find_method(str(name))

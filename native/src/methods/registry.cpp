@@ -74,6 +74,8 @@ ValueError unknown_method_option(const std::string& name, const std::string& fla
                            " (see tempera stylize --method ", name, " --help)"));
 }
 
+const MethodEntry& default_method() { return method_registry().front(); }
+
 const MethodEntry& find_method(const std::string& name) {
   const auto& registry = method_registry();
   std::string choices;

@@ -96,6 +96,10 @@ void register_method(MethodEntry entry);
 // pointing to its --help: what every job factory throws for one.
 ValueError unknown_method_option(const std::string& name, const std::string& flag);
 
+// The method when none is named (`tempera stylize` without --method, the
+// panel's and the farm's default): the registry's first entry.
+const MethodEntry& default_method();
+
 // The entry of `name`; ValueError "unknown --method 'X' (choose ...)" naming every one.
 const MethodEntry& find_method(const std::string& name);
 

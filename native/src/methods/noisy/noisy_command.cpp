@@ -1,10 +1,13 @@
 // `tempera noisy`: Color Me Noisy on a folder of coherent frames (R), one
 // output frame each (noisy.hpp). Frames are independent, so a farm may split
 // the range anywhere; each finished frame is written atomically with a key
-// beside it, and a rerun skips frames whose key still matches.
+// beside it, and a rerun skips frames whose key still matches. Compiled into
+// the command line only (this folder's CMakeLists.txt), which it joins by
+// registering itself (cli/commands.hpp).
 #include <iostream>
 
 #include "cli_args.hpp"
+#include "commands.hpp"
 #include "frame_loop.hpp"
 #include "tempera/engine/error.hpp"
 #include "tempera/methods/noisy/noisy_sequence.hpp"
@@ -39,8 +42,6 @@ std::string noisy_help() {
          "\nCtrl-C stops within the current frame; finished frames are kept.\n"
          "Exit status: 0 done, 1 error, 2 bad usage, 130 interrupted.\n";
 }
-
-}  // namespace
 
 int run_noisy(const Args& args) {
   ArgReader r(args, "noisy");
@@ -82,4 +83,8 @@ int run_noisy(const Args& args) {
   return 0;
 }
 
+const CommandRegistration kCommand("noisy", "add temporal noise to a coherent sequence (Color Me Noisy, resumable)",
+                                   run_noisy);
+
+}  // namespace
 }  // namespace tempera::cli
