@@ -78,7 +78,7 @@ def _panel_props():
 def test_methods_and_their_options_in_the_panel(media_scene):
     from tempera.blender.properties import METHOD_ITEMS
 
-    assert [i[:2] for i in METHOD_ITEMS[3:]] == [("LAZYFLUIDS", "Fluid (LazyFluids)"),
+    assert [i[:2] for i in METHOD_ITEMS[3:5]] == [("LAZYFLUIDS", "Fluid (LazyFluids)"),
                                                   ("FLUIDYMATION", "Natural Media (Fluidymation)")]
     media_scene.tempera.method = "LAZYFLUIDS"
     props = _panel_props()

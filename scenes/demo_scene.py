@@ -48,6 +48,7 @@ FRAMES_PER_ROW = 6  # on the comparison sheet
 NOISE_LEVEL = 4  # the noisy variant: Temporal Noise step 4, f = 2.2 px (docs/noisy.md)
 KEY_FRAMES = (2, 11)  # the coherent run's painted keys: segments 1-2, 2-11 and 11-12
 COHERENT = "coherent"  # OUT/coherent/: the coherent method's frames, sheet and video
+NOISY_RENDER = "noisy_render"  # OUT/noisy_render/noisy/: Temporal Noise as the method, on the render
 
 
 # --------------------------------------------------------------------------- scene
@@ -197,6 +198,21 @@ def run_coherent(scene, out):
     return mean_flicker(out / "frames"), mean_flicker(out / COHERENT / "frames")
 
 
+def run_noisy_render(scene, out):
+    """Stylize Animation with Method "Temporal Noise (Color Me Noisy)": the
+    render itself boiled (the paper's 3D case), the Exemplar field empty, so
+    the medium is the first render under a paper grain; the guides are
+    current, so only the frames run, into out/noisy_render/noisy/frames."""
+    settings = scene.tempera
+    settings.method = "NOISY"
+    settings.media_exemplar = ""
+    settings.output_dir = str(out / NOISY_RENDER)
+    settings.load_result = "NONE"
+    result = bpy.ops.tempera.stylize(mode="ANIMATION")
+    if result != {"FINISHED"}:
+        raise RuntimeError(f"Stylize Animation with Temporal Noise on the render ended with {result}")
+
+
 # --------------------------------------------------------------------------- main
 
 def main():
@@ -234,6 +250,7 @@ def run(out, started):
     if result != {"FINISHED"}:
         raise RuntimeError(f"Stylize Animation with Temporal Noise ended with {result}; see the messages above")
     per_frame, coherent = run_coherent(scene, out)
+    run_noisy_render(scene, out)
     blend = out / "demo.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(blend), check_existing=False)
 
@@ -248,6 +265,7 @@ def run(out, started):
     print(f"blend file:       {blend} (scene 'Demo' and the sequencer scene 'Demo Tempera')")
     print(f"coherent:         {out / COHERENT}/frames/frame_####.png (Bénard 2013, keys {out / 'keys'})")
     print(f"mean flicker:     per-frame {per_frame:.4f}, coherent {coherent:.4f}")
+    print(f"render boiled:    {out / NOISY_RENDER}/noisy/frames/frame_####.png (Temporal Noise as the method)")
     print(f"total {time.monotonic() - started:.1f} s")
 
 

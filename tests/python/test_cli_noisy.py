@@ -227,3 +227,76 @@ def test_stylize_guided_noise_is_a_new_setting_and_errors_are_named(cli_path, ca
     assert bad.returncode == 2 and "--guides" in bad.stderr
     bad = run(cli_path, *lone, "--guides", caches / "cache")
     assert bad.returncode == 2 and "--exemplar-guides" in bad.stderr
+
+
+def test_the_method_boils_the_shots_render(cli_path, caches):
+    """`tempera stylize --method noisy`: the paper's 3D case, the render (the
+    cache's FULL guide in display sRGB) boiled with the medium. At noise 0
+    the frames are the render; at 2.2 they boil while their large shapes stay
+    the render's; resume skips current frames; `tempera noisy --guides`
+    makes the same frames."""
+    from tempera.app import beauty
+
+    help_text = stylize(cli_path, "--method", "noisy", "--help")
+    assert help_text.returncode == 0 and "--reference DIR" in help_text.stdout and "--noise V" in help_text.stdout
+    base = ("--method", "noisy", "--guides", caches / "cache", "--exemplar", caches / "paint.png", "--frames", "1-3",
+            "--threads", "2")
+    calm = stylize(cli_path, *base, "--out", caches / "calm", "--noise", "0")
+    assert calm.returncode == 0, calm.stderr
+    renders = [beauty.render_image(str(caches / "cache"), f) for f in (1, 2, 3)]
+    for got, render in zip(frames(caches / "calm" / "frames"), renders):
+        assert np.abs(got - render).max() <= 0.5 / 255 + 1e-6  # the render, as an 8-bit PNG holds it
+    boiled = stylize(cli_path, *base, "--out", caches / "boiled", "--noise", "2.2")
+    assert boiled.returncode == 0, boiled.stderr
+    made = frames(caches / "boiled" / "frames")
+    assert np.abs(made[0] - made[1]).mean() > 0.01  # the frames boil
+
+    def blurred(image):  # h_f * image for f = 2.2, roughly: a 3x3 box
+        padded = np.pad(image, ((1, 1), (1, 1), (0, 0)), mode="edge")
+        h, w = image.shape[:2]
+        return sum(padded[y:y + h, x:x + w] for y in range(3) for x in range(3)) / 9
+
+    for got, render in zip(made, renders):
+        assert np.abs(blurred(got) - blurred(render)).mean() < np.abs(got - render).mean()
+    again = stylize(cli_path, *base, "--out", caches / "boiled", "--noise", "2.2")
+    assert again.returncode == 0 and "3 skipped" in again.stdout, again.stdout
+    command = run(cli_path, "--guides", caches / "cache", "--exemplar", caches / "paint.png", "--frames", "1-3",
+                  "--threads", "2", "--noise", "2.2", "--out", caches / "command")
+    assert command.returncode == 0, command.stderr
+    for f in (1, 2, 3):
+        name = f"frame_{f:04d}.png"
+        assert (caches / "command" / name).read_bytes() == (caches / "boiled" / "frames" / name).read_bytes()
+
+
+def test_the_method_names_a_bad_medium_and_a_missing_render(cli_path, caches, tmp_path):
+    rgba = tmp_path / "rgba.png"
+    tempera.write_image(str(rgba), np.full((40, 40, 4), 0.5, np.float32))
+    base = ("--method", "noisy", "--frames", "1-3", "--out", tmp_path / "o")
+    wrong = stylize(cli_path, *base, "--guides", caches / "cache", "--exemplar", rgba)
+    assert wrong.returncode == 2 and "the render has 3 channels but the exemplar" in wrong.stderr, wrong.stderr
+    missing = stylize(cli_path, *base, "--guides", tmp_path / "nowhere", "--exemplar", caches / "paint.png")
+    assert missing.returncode != 0 and "nowhere" in missing.stderr, missing.stderr
+
+
+def test_without_a_medium_the_method_boils_the_render_under_a_paper_grain(cli_path, caches):
+    """The default medium (render_medium.hpp): the first render under a grain,
+    the same for a seed; a folder of frames still needs a medium."""
+    from tempera.app import beauty
+
+    base = ("--method", "noisy", "--guides", caches / "cache", "--frames", "1-3", "--threads", "2", "--noise", "2.2")
+    for out in ("a", "b"):
+        result = stylize(cli_path, *base, "--out", caches / out)
+        assert result.returncode == 0, result.stderr
+    for f in (1, 2, 3):
+        name = f"frames/frame_{f:04d}.png"
+        assert (caches / "a" / name).read_bytes() == (caches / "b" / name).read_bytes()
+    made, renders = frames(caches / "a" / "frames"), [beauty.render_image(str(caches / "cache"), f) for f in (1, 2, 3)]
+    assert np.abs(made[0] - made[1]).mean() > 0.01
+    for got, render in zip(made, renders):
+        assert np.abs(got - render).mean() < 0.1  # the render's colours: the medium has them
+    other_seed = stylize(cli_path, *base, "--seed", "2", "--out", caches / "c")
+    assert other_seed.returncode == 0, other_seed.stderr
+    assert (caches / "c" / "frames/frame_0001.png").read_bytes() != (caches / "a" / "frames/frame_0001.png").read_bytes()
+    folder = stylize(cli_path, "--method", "noisy", "--reference", caches / "a" / "frames", "--frames", "1-3",
+                     "--guides", caches / "cache", "--out", caches / "d")
+    assert folder.returncode == 2 and "required to boil frames of a folder" in folder.stderr, folder.stderr

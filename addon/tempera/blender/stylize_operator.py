@@ -176,7 +176,7 @@ class StylizeRun:
     def eta_seconds(self):
         """Time left stylizing, once it means something: two frames actually
         stylized (the first also reads the painting and guides) and more to do."""
-        stylized = [r for r in self.results if r["status"] == "stylized"]
+        stylized = [r for r in self.results if r["status"] != "skipped"]
         left = len(self.frames) - len(self.results)
         if len(stylized) < ETA_AFTER_FRAMES or left <= 0:
             return None
@@ -203,7 +203,7 @@ class StylizeRun:
         return sum(values) / len(values) if values else None
 
     def summary(self):
-        done = [r for r in self.results if r["status"] == "stylized"]
+        done = [r for r in self.results if r["status"] != "skipped"]  # "stylized"; the noise job's "made"
         parts = [f"{len(done)} stylized"]
         skipped = len(self.results) - len(done)
         if skipped:
@@ -260,7 +260,7 @@ class MethodRun(StylizeRun):
                 print(f"Tempera: {warning}", flush=True)
         i = self.index - len(self.frames)
         result = self.job.run_frame(i, progress)
-        if result["status"] == "stylized":
+        if result["status"] != "skipped":
             self.stylize_seconds += result["seconds"]
         self.results.append(result)
         if bpy.app.background:

@@ -9,7 +9,19 @@ namespace {
 double linear(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
 double lab_f(double t) { return t > 216.0 / 24389.0 ? std::cbrt(t) : (24389.0 / 27.0 * t + 16.0) / 116.0; }
 
+double encoded(double c) { return c <= 0.0031308 ? c * 12.92 : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055; }
+
 }  // namespace
+
+Image linear_to_srgb(const ImageView& linear) {
+  Image out = Image::copy_of(linear);
+  const int colour = std::min(linear.channels, 3);
+  for (std::size_t i = 0; i < linear.pixel_count(); ++i) {
+    float* p = out.data() + i * linear.channels;
+    for (int c = 0; c < colour; ++c) p[c] = std::isnan(p[c]) ? 0.0f : float(encoded(std::clamp<double>(p[c], 0, 1)));
+  }
+  return out;
+}
 
 Image srgb_to_lab(const ImageView& rgb) {
   Image out = Image::copy_of(rgb);

@@ -6,6 +6,7 @@
 #include "tempera/engine/error.hpp"
 #include "tempera/methods/fluidymation/fluidymation_method.hpp"
 #include "tempera/methods/lazyfluids/lazyfluids_method.hpp"
+#include "tempera/methods/noisy/noisy_method.hpp"
 #include "tempera/methods/rigid/rigid_method.hpp"
 #include "tempera/methods/stylit/stylit_method.hpp"
 #include "tempera/methods/tcia/tcia_method.hpp"
@@ -23,6 +24,7 @@ std::deque<MethodEntry>& registry() {
       rigid_method(),
       lazyfluids_method(),
       fluidymation_method(),
+      noisy_method(),
   };
   return registry;
 }

@@ -5,8 +5,9 @@
 // (tempera/methods/registry.py), the `tempera` console script and the farm
 // planner all read it; a new method adds one entry in registry.cpp, with
 // its job factory (make_job), and needs no command of its own
-// (docs/adding_a_method.md). Color Me Noisy is not a method of this list: it
-// is a pass over any method's frames (`--noise`, `tempera noisy`).
+// (docs/adding_a_method.md). Color Me Noisy is both a method of this list
+// (the render boiled, `--method noisy`) and a pass over a light-path
+// method's frames (`--noise`); `tempera noisy` boils any folder of frames.
 #include <deque>
 #include <functional>
 #include <memory>

@@ -16,19 +16,22 @@ namespace tempera::cli {
 namespace {
 
 std::string noisy_help() {
-  return "usage: tempera noisy --exemplar MEDIUM.png --reference DIR --frames A-B --out DIR [options]\n"
+  return "usage: tempera noisy --exemplar MEDIUM.png (--reference DIR | --guides DIR) --frames A-B --out DIR\n"
+         "                     [options]\n"
          "\n"
          "Makes a coherent stylized sequence boil like hand-coloured animation (Color Me Noisy,\n"
          "Fiser et al. 2014): below the width --noise the frames follow the reference frames,\n"
          "above it the medium's texture is synthesized again every frame.\n"
          "\n"
          "  --exemplar FILE         a sample of the medium (the painting, or a scan of the paper/pencil)\n"
-         "  --reference DIR         the coherent frames R: DIR/<prefix>0001.png ...\n"
+         "  --reference DIR         the coherent frames R: DIR/<prefix>0001.png ... (default: the\n"
+         "                          render of --guides, its FULL guide in display sRGB)\n"
          "  --frames RANGE          e.g. 1-24 or 1-10,15\n"
          "  --out DIR               output folder: OUT/<prefix>0001.png ...\n"
          "  --noise-map FILE|GUIDE  where the noise goes: an image of R's size, or a guide of --guides\n"
          "                          (alpha, mask.OB_Name, an AOV); 0 = R as it is, 1 = --noise\n"
-         "  --guides DIR            the frames' guide cache: for a GUIDE noise map and --noise-guides\n"
+         "  --guides DIR            the frames' guide cache: its render without --reference, a GUIDE\n"
+         "                          noise map, --noise-guides\n"
          "  --exemplar-guides DIR   guide cache of the exemplar render (for --noise-guides)\n"
          "  --exemplar-frame N      its frame (default: the only frame in --exemplar-guides)\n"
          "  --weights NAME=W,...    light-path guide weights for --noise-guides (as tempera stylize)\n"
@@ -70,7 +73,8 @@ int run_noisy(const Args& args) {
       throw ValueError(concat("unknown option '", flag, "' (see tempera noisy --help)"));
   }
   if (c.exemplar.empty()) throw ValueError("--exemplar is required (a sample of the medium)");
-  if (c.reference.empty()) throw ValueError("--reference is required (the folder of coherent frames)");
+  if (c.reference.empty() && c.guides.empty())
+    throw ValueError("--reference is required (the folder of coherent frames), or --guides to boil the render");
   if (frames_text.empty()) throw ValueError("--frames is required (e.g. --frames 1-24)");
   if (c.out.empty()) throw ValueError("--out is required (the output folder)");
   NoisySequence sequence(c);

@@ -3,17 +3,23 @@
 #include <chrono>
 #include <filesystem>
 
+#include "tempera/engine/color.hpp"
 #include "tempera/engine/error.hpp"
+#include "tempera/app/contact_sheet.hpp"
 #include "tempera/app/file_keys.hpp"
 #include "tempera/app/guide_cache.hpp"
 #include "tempera/app/image_io.hpp"
 #include "tempera/app/record.hpp"
 #include "tempera/app/light_path_guides.hpp"
+#include "tempera/methods/noisy/render_medium.hpp"
 
 namespace fs = std::filesystem;
 
 namespace tempera {
 namespace {
+
+// The guide that is the render (Cycles' Combined pass, app/light_path_guides.hpp).
+constexpr const char* kRenderGuide = "FULL";
 
 // The format line of a frame's resume record (app/record.hpp). Before it,
 // the record was the bare key: such frames are made again once.
@@ -31,18 +37,35 @@ NoisySequence::NoisySequence(NoisySequenceConfig config) : config_(std::move(con
   validate(c.options.synthesis);
   check_job_config(c);
   if (c.format != "png") throw ValueError(concat("the noise pass writes PNG frames, not '", c.format, "'"));
-  if (c.exemplar.empty()) throw ValueError("the exemplar (a sample of the medium) is required");
-  if (c.reference.empty()) throw ValueError("the folder of coherent reference frames is required");
-  if (!fs::is_directory(c.reference))
-    throw FileNotFoundError(concat("the reference folder '", c.reference, "' does not exist"));
+  if (c.exemplar.empty() && !renders())
+    throw ValueError("the exemplar (a sample of the medium) is required to boil frames of a folder");
+  if (renders() && c.guides.empty())
+    throw ValueError("the coherent frames are required: a folder of them, or a guide cache whose render is boiled");
+  const std::string folder = renders() ? c.guides : c.reference;
+  if (!fs::is_directory(folder))
+    throw FileNotFoundError(concat(renders() ? "the guide cache '" : "the reference folder '", folder,
+                                   "' does not exist"));
   for (int frame : c.frames)
     if (!fs::is_regular_file(reference_path(frame)))
-      throw FileNotFoundError(concat("reference frame not found: '", reference_path(frame), "'"));
+      throw FileNotFoundError(concat(renders() ? "guide frame not found: '" : "reference frame not found: '",
+                                     reference_path(frame), "'"));
   refuse_writing_on_inputs();
-  medium_ = read_image(c.exemplar);
+  settings_ = settings_text(c.options, noisy_option_table()) +
+              settings_text(c.options.synthesis, synthesis_option_table()) + (renders() ? "|render" : "");
+  if (c.exemplar.empty()) {  // the first render under a paper grain (render_medium.hpp)
+    medium_ = render_medium(reference_frame(c.frames.front()).view(), c.options.synthesis.seed);
+    settings_ += "|medium from " + file_stamp(reference_path(c.frames.front()));
+  } else {
+    medium_ = read_image(c.exemplar);
+    settings_ += file_stamp(c.exemplar);
+  }
   check_noisy_exemplar_size(c.options.noise, medium_.width(), medium_.height(), c.options.synthesis.patch_size);
-  settings_ = settings_text(c.options, noisy_option_table()) + settings_text(c.options.synthesis, synthesis_option_table()) +
-              file_stamp(c.exemplar);
+  if (renders()) {  // names a cache without a render, or a medium of other channels, now, not after hours
+    const int channels = reference_frame(c.frames.front()).channels();
+    if (channels != medium_.channels())
+      throw ValueError(concat("the render has ", channels, " channels but the exemplar '", c.exemplar, "' has ",
+                              medium_.channels(), " (give an RGB sample of the medium)"));
+  }
   if (guided()) read_exemplar_guides();
   if (!c.noise_map.empty()) {
     map_file_ = fs::is_regular_file(c.noise_map);
@@ -63,7 +86,7 @@ NoisySequence::NoisySequence(NoisySequenceConfig config) : config_(std::move(con
 // map or the guides: refuse before anything is.
 void NoisySequence::refuse_writing_on_inputs() {
   const NoisySequenceConfig& c = config_;
-  inputs_.add_folder(c.reference, "reference", "the coherent frames");
+  if (!renders()) inputs_.add_folder(c.reference, "reference", "the coherent frames");
   inputs_.add_folder(c.guides, "guide cache", "the guides");
   inputs_.add_folder(c.exemplar_guides, "exemplar guide cache", "the guides");
   inputs_.add_file(c.exemplar, "exemplar");
@@ -116,7 +139,14 @@ std::vector<Image> NoisySequence::frame_guides(int frame) const {
 }
 
 std::string NoisySequence::reference_path(int frame) const {
+  if (renders()) return guide_path(frame);
   return (fs::path(config_.reference) / frame_file(config_.prefix, frame, "png")).string();
+}
+
+Image NoisySequence::reference_frame(int frame) const {
+  if (!renders()) return read_image(reference_path(frame));
+  const GuideFrame g = GuideFrame::read(guide_path(frame), {kRenderGuide});
+  return linear_to_srgb(g.get(kRenderGuide).view());
 }
 
 std::string NoisySequence::guide_path(int frame) const {
@@ -140,6 +170,15 @@ std::string NoisySequence::key(int frame) const {
   return hash_hex(text);
 }
 
+void NoisySequence::write_contact_sheet(const std::string& path, int columns) const {
+  inputs_.refuse_file(path);
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (int frame : config_.frames)
+    if (fs::is_regular_file(output_path(frame), ec)) files.push_back(output_path(frame));
+  write_frames_contact_sheet(path, medium_.view(), files, columns);
+}
+
 FrameResult NoisySequence::run_frame(std::size_t index, const ProgressCallback& progress) {
   if (index >= config_.frames.size())
     throw ValueError(concat("frame index ", index, " out of range (", config_.frames.size(), " frames)"));
@@ -152,7 +191,7 @@ FrameResult NoisySequence::run_frame(std::size_t index, const ProgressCallback& 
   const std::string k = key(frame);
   if (config_.resume && record_current(record.string(), kRecordFormat, k, {result.path})) return result;
   const auto t0 = std::chrono::steady_clock::now();
-  const Image r = read_image(reference_path(frame));
+  const Image r = reference_frame(frame);
   const Image map = noise_map(frame);
   std::vector<Image> targets;
   std::vector<NoisyGuide> guides;

@@ -1,7 +1,8 @@
 #pragma once
 // Color Me Noisy over a sequence: a folder of coherent frames R (Tempera's
-// own coherent result, or frames from elsewhere) in, one noisy frame each
-// out. Shared by `tempera noisy`, `tempera stylize --noise` and the Blender
+// own coherent result, or frames from elsewhere), or the render of a guide
+// cache (the paper's 3D case: a render whose materials look like the
+// medium), in, one noisy frame each out. Shared by `tempera noisy`, `tempera stylize --noise` and the Blender
 // add-on, which calls run_frame() once per modal step. Frames are
 // independent, so a farm may split the range anywhere; each output is
 // written atomically with a key beside it (OUT/.tempera_noisy/0001.key), and
@@ -19,11 +20,14 @@
 
 namespace tempera {
 
-// exemplar: the medium S (the painting, or a scan of the paper); out: the
+// exemplar: the medium S (the painting, or a scan of the paper; empty when R
+// is the render: its first frame under a paper grain, render_medium.hpp); out: the
 // output folder (created), <prefix>0001.png ...; format: png only; guides:
 // the guide cache, for a guide noise map and guided noise.
 struct NoisySequenceConfig : JobConfig {
-  std::string reference;          // folder of the coherent frames R: <prefix>0001.png ...
+  // Folder of the coherent frames R: <prefix>0001.png ...; empty: the render,
+  // the guide cache's FULL guide (Cycles' Combined pass) in display sRGB.
+  std::string reference;
   std::string prefix = "frame_";  // of the reference and the output frames
   // Optional local noise map (§3.3), f_p = noise * map: an image file (R's
   // size), or the name of a guide in the guide cache `guides` ("alpha",
@@ -49,10 +53,15 @@ class NoisySequence : public FrameJob {
   // Makes frames()[index] (or skips it when its output is current).
   // `progress` returning false cancels: CancelledError, nothing written.
   FrameResult run_frame(std::size_t index, const ProgressCallback& progress = {}) override;
+  // The medium followed by the frames written so far.
+  bool has_contact_sheet() const override { return true; }
+  void write_contact_sheet(const std::string& path, int columns = 0) const override;
 
  private:
   void refuse_writing_on_inputs();
-  std::string reference_path(int frame) const;
+  bool renders() const { return config_.reference.empty(); }  // R is the guide cache's render
+  std::string reference_path(int frame) const;  // its file (the guide frame when it renders)
+  Image reference_frame(int frame) const;
   std::string guide_path(int frame) const;
   bool map_is_guide() const { return !config_.noise_map.empty() && !map_file_; }
   Image noise_map(int frame) const;
