@@ -278,10 +278,11 @@ using FixedSsd = std::int64_t (*)(const T*, const T*, int);
 // summed row by row until the sum reaches `limit` (the early exit). One call
 // a candidate, not one a row: a candidate costs a few rows, and the call and
 // the 64-bit reduction per row were as dear as the arithmetic. A row of up to
-// kShortRow values (a 5x5 patch of 8 channels is 40) is reduced in 32 bits:
-// its sum, and so every partial sum of its lanes, is at most
-// 96 * 4095^2 < 2^31. Longer rows go through the blocked row kernels.
-constexpr int kShortRow = 96;
+// kShortRow values (a 5x5 patch of 8 channels is 40; StyLit's four guides and
+// its temporal guide, 24 padded channels, 120) is reduced in 32 bits: its
+// sum, and so every partial sum of its lanes, is at most
+// 128 * 4095^2 < 2^31. Longer rows go through the blocked row kernels.
+constexpr int kShortRow = 128;
 
 template <class T>
 using PatchSsd = std::int64_t (*)(const T*, std::size_t, const T*, std::size_t, int, int, std::int64_t);
@@ -520,13 +521,31 @@ float distance_fixed(const PatchSpace& s, int sx, int sy, int tx, int ty, float 
       return f.fixed_pixel(x, y);
   };
   // The integer sum reaches `limit` exactly when it reaches its ceiling.
-  const std::int64_t stop = limit < 9e18 ? std::int64_t(std::ceil(limit)) : std::numeric_limits<std::int64_t>::max();
+  constexpr std::int64_t kNoStop = std::numeric_limits<std::int64_t>::max();
+  const bool weighted = s.weighted_patches && s.weighted_patches[std::size_t(ty) * s.target->width + tx];
+  const std::int64_t stop = weighted || !(limit < 9e18) ? kNoStop : std::int64_t(std::ceil(limit));
   const std::size_t pitch_a = std::size_t(s.source->width) * s.source->stride;
   const std::size_t pitch_b = std::size_t(s.target->width) * s.target->stride;
   const std::int64_t sum = best_patch_ssd(row(*s.source, sx + w.dx0, sy + w.dy0), pitch_a,
                                           row(*s.target, tx + w.dx0, ty + w.dy0), pitch_b, w.dy1 - w.dy0 + 1, n,
                                           stop);
-  return float(double(sum) * step2);
+  if (!weighted) return float(double(sum) * step2);
+  // Weighted target pixels: their channels count (weight - 1) times more, on
+  // the same integer differences, so the result is the weighted SSD of the
+  // quantized features (no early stop: the correction may lower the sum).
+  double corrected = double(sum);
+  for (int dy = w.dy0; dy <= w.dy1; ++dy)
+    for (int dx = w.dx0; dx <= w.dx1; ++dx) {
+      if (!s.weighted_pixels[std::size_t(ty + dy) * s.target->width + tx + dx]) continue;
+      const T* a = row(*s.source, sx + dx, sy + dy);
+      const T* b = row(*s.target, tx + dx, ty + dy);
+      const float* weight = s.target_weights->pixel(tx + dx, ty + dy);
+      for (int c = 0; c < s.target->stride; ++c) {
+        const double d = double(a[c]) - double(b[c]);
+        corrected += (double(weight[c]) - 1.0) * d * d;
+      }
+    }
+  return float(std::max(0.0, corrected) * step2);
 }
 
 // Axis-aligned patches under a window: each pixel's SSD is weighted.

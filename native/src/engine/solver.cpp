@@ -274,6 +274,7 @@ struct Solver::Plan {
 // One pyramid level: features, constraints and the patch space over them.
 struct Solver::Level {
   FeatureImage source, target, target_weights;
+  std::vector<std::uint8_t> weighted_pixels, weighted_patches;  // PatchSpace's, with quantized weighted features
   SearchConstraints constraints;
   PatchSpace space;
   Image style;          // A' at this level (unweighted), what voting copies
@@ -492,7 +493,7 @@ void Solver::build_level(int l, Level& level, const LevelStart* start) const {
   }
   if (start) add_guide_target_writes(l, *start, target_writes);
   const bool weighted = std::any_of(p.weight_maps.begin(), p.weight_maps.end(), [](auto& m) { return !m.empty(); });
-  allocate_features(level, source_writes, target_writes, weighted);
+  allocate_features(level, source_writes, target_writes, weighted && !options_.fixed_point_weights);
   level.space.source = &level.source;
   level.space.target = &level.target;
   level.source.set_channels(source_writes);  // source_writes dangle from here on
@@ -513,6 +514,7 @@ void Solver::build_level(int l, Level& level, const LevelStart* start) const {
           level.target_weights.data[i * level.target_weights.stride + first + c] = std::max(0.0f, map.data()[i]);
     }
     level.space.target_weights = &level.target_weights;
+    if (level.target.quantized()) mark_weighted_patches(level);
   }
   SearchConstraints& cons = level.constraints;
   const int margin = level.space.source_margin();
@@ -551,16 +553,41 @@ void Solver::build_level(int l, Level& level, const LevelStart* start) const {
   cons.finalize();
 }
 
+// The target pixels whose weights are not all 1, and the patches that cover
+// one: the fixed-point distance corrects only those (patch_distance.hpp).
+void Solver::mark_weighted_patches(Level& level) const {
+  const FeatureImage& weights = level.target_weights;
+  const int tw = weights.width, th = weights.height, r = level.space.radius;
+  level.weighted_pixels.assign(std::size_t(tw) * th, 0);
+  level.weighted_patches.assign(std::size_t(tw) * th, 0);
+  for (int y = 0; y < th; ++y)
+    for (int x = 0; x < tw; ++x) {
+      const float* w = weights.pixel(x, y);
+      if (std::any_of(w, w + weights.stride, [](float v) { return v != 1.0f; }))
+        level.weighted_pixels[std::size_t(y) * tw + x] = 1;
+    }
+  for (int y = 0; y < th; ++y)
+    for (int x = 0; x < tw; ++x) {
+      if (!level.weighted_pixels[std::size_t(y) * tw + x]) continue;
+      for (int py = std::max(0, y - r); py <= std::min(th - 1, y + r); ++py)
+        std::fill_n(level.weighted_patches.begin() + std::ptrdiff_t(std::size_t(py) * tw + std::max(0, x - r)),
+                    std::min(tw - 1, x + r) - std::max(0, x - r) + 1, std::uint8_t(1));
+    }
+  level.space.weighted_pixels = level.weighted_pixels.data();
+  level.space.weighted_patches = level.weighted_patches.data();
+}
+
 // Fixed-point features where the patch distance has a fixed-point path:
-// axis-aligned patches with no window and no per-pixel weights. Their offsets
+// axis-aligned patches with no window; per-pixel weights are corrected for
+// the patches that meet them (mark_weighted_patches), unless `in_float`. Their offsets
 // and step are read off the writes, so the level's features are never held
 // in float as well (that copy was twice their size, and the peak at 1 Mpix).
 void Solver::allocate_features(Level& level, const std::vector<ChannelWrite>& source_writes,
-                               const std::vector<ChannelWrite>& target_writes, bool weighted) const {
+                               const std::vector<ChannelWrite>& target_writes, bool in_float) const {
   const int total = source_writes.front().image.channels;
   const int sw = level.source.width, sh = level.source.height, tw = level.target.width, th = level.target.height;
   const PatchSpace& s = level.space;
-  if (options_.feature_precision == FeaturePrecision::Float || s.rotated() || s.window || weighted) {
+  if (in_float || options_.feature_precision == FeaturePrecision::Float || s.rotated() || s.window) {
     level.source = FeatureImage(sw, sh, total);
     level.target = FeatureImage(tw, th, total);
     return;

@@ -124,6 +124,12 @@ struct PatchSpace {
   // Optional per-target-pixel channel weights (same layout as `target`), for
   // guides whose influence varies over the frame.
   const FeatureImage* target_weights = nullptr;
+  // With target_weights over quantized features: per target pixel, 1 where
+  // some channel's weight is not 1 (weighted_pixels), and 1 where the patch
+  // centred there covers such a pixel (weighted_patches). Other patches take
+  // the fixed-point kernel as they are; these are corrected pixel by pixel.
+  const std::uint8_t* weighted_pixels = nullptr;
+  const std::uint8_t* weighted_patches = nullptr;
   int radius = 2;
   const float* source_angle = nullptr;
   const float* target_angle = nullptr;

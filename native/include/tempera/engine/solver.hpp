@@ -105,7 +105,8 @@ class Solver {
   void fix_pixels(int level, const Level& lv, const Image* values, OffsetField& field, Image& bprime) const;
   void set_target_style(Level& lv, const Image& bprime) const;
   void allocate_features(Level& lv, const std::vector<ChannelWrite>& source_writes,
-                         const std::vector<ChannelWrite>& target_writes, bool weighted) const;
+                         const std::vector<ChannelWrite>& target_writes, bool in_float) const;
+  void mark_weighted_patches(Level& lv) const;
   void add_guide_target_writes(int level, const LevelStart& start, std::vector<ChannelWrite>& writes) const;
   std::unique_ptr<Plan> plan_;
   SynthesisOptions options_;

@@ -88,6 +88,10 @@ py::tuple stylize_frame_py(const FloatArray& style, const py::dict& exemplar, co
   stats["seconds"] = result.seconds;
   stats["source_coverage"] = result.source_coverage;
   stats["guide_channels"] = result.guide_channels;
+  // The finest level's energy after its last iteration (the solver's objective, for comparisons).
+  stats["final_energy"] = result.levels.empty() || result.levels.back().energy.empty()
+                              ? 0.0
+                              : double(result.levels.back().energy.back());
   return py::make_tuple(py_bridge::to_numpy(std::move(result.image)), stats);
 }
 

@@ -28,6 +28,9 @@ std::vector<std::pair<std::string, float>> active_guides(const StylitOptions& op
 
 SynthesisOptions engine_options(const StylitOptions& options) {
   SynthesisOptions opt = options.synthesis;
+  // The temporal guide's occlusion weights keep the fixed-point features:
+  // 1.5x faster frames, energy within 1% (docs/benchmarks.md, issue 32).
+  opt.fixed_point_weights = true;
   if (options.quality == Quality::Preview) {
     // Measured at 320x240 (docs/engine.md): about 5x faster than final; the
     // coarse levels settle with few iterations and the finest level gets the

@@ -30,6 +30,9 @@ std::string settings_text(const StylizeJobConfig& c) {
   for (const auto& [name, weight] : active_guides(c.stylit)) s << name << ":" << weight << ",";
   s << ";temporal=" << c.stylit.temporal_weight << ";quality=" << enum_name(c.stylit.quality) << ";"
     << settings_text(o, synthesis_option_table()) << "format=" << c.format;
+  // Frames with the temporal guide are matched on fixed-point features since
+  // 2026-12-05 (engine_options): those made before are made again.
+  if (c.stylit.temporal_weight > 0 && o.fixed_point_weights) s << ";weights=fixed";
   return s.str();
 }
 
