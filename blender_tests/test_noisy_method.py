@@ -34,15 +34,9 @@ def noisy_scene(tmp_path):
     remove_scene(scene)
 
 
-def _panel_props():
-    from test_addon import _Recorder
-
-    calls = []
-    bpy.types.TEMPERA_PT_output.draw(type("FakePanel", (), {"layout": _Recorder(calls)})(), bpy.context)
-    return [name for kind, name in calls if kind == "prop"]
-
-
 def test_the_panel_shows_the_medium_and_the_noise(noisy_scene):
+    from test_media_methods import _panel_props
+
     props = _panel_props()
     assert "media_exemplar" in props and "exemplar_style" not in props
     i = props.index("method")

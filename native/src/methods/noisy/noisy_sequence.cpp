@@ -52,20 +52,20 @@ NoisySequence::NoisySequence(NoisySequenceConfig config) : config_(std::move(con
   refuse_writing_on_inputs();
   settings_ = settings_text(c.options, noisy_option_table()) +
               settings_text(c.options.synthesis, synthesis_option_table()) + (renders() ? "|render" : "");
+  // The first render, read once: the default medium's colours, and it names a
+  // cache without a render, or a medium of other channels, now, not after hours.
+  const Image first = renders() ? reference_frame(c.frames.front()) : Image();
   if (c.exemplar.empty()) {  // the first render under a paper grain (render_medium.hpp)
-    medium_ = render_medium(reference_frame(c.frames.front()).view(), c.options.synthesis.seed);
+    medium_ = render_medium(first.view(), c.options.synthesis.seed);
     settings_ += "|medium from " + file_stamp(reference_path(c.frames.front()));
   } else {
     medium_ = read_image(c.exemplar);
     settings_ += file_stamp(c.exemplar);
   }
   check_noisy_exemplar_size(c.options.noise, medium_.width(), medium_.height(), c.options.synthesis.patch_size);
-  if (renders()) {  // names a cache without a render, or a medium of other channels, now, not after hours
-    const int channels = reference_frame(c.frames.front()).channels();
-    if (channels != medium_.channels())
-      throw ValueError(concat("the render has ", channels, " channels but the exemplar '", c.exemplar, "' has ",
-                              medium_.channels(), " (give an RGB sample of the medium)"));
-  }
+  if (renders() && first.channels() != medium_.channels())
+    throw ValueError(concat("the render has ", first.channels(), " channels but the exemplar '", c.exemplar,
+                            "' has ", medium_.channels(), " (give an RGB sample of the medium)"));
   if (guided()) read_exemplar_guides();
   if (!c.noise_map.empty()) {
     map_file_ = fs::is_regular_file(c.noise_map);
