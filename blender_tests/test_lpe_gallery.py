@@ -17,11 +17,24 @@ film). Figures:
   least CORRELATION_TOLERANCE = 0.98 (light in the right places).
 A buffer Cycles leaves (nearly) empty, below 0.2 % of FULL's mean, must be as
 empty in the tracer (its mean below 2 % of FULL's) and is not correlated.
+
+FULL and LDDE are also compared object by object, over each object's pixels
+(Cycles' Object Index pass), so that light wrong on one object and right on
+average shows (issue 35: a backdrop 40 % too bright beside a darker sphere):
+* FULL: mean error at most 5 %, correlation at least 0.97 unless the object
+  is lit evenly (the standard deviation of its blurred FULL under 10 % of
+  its mean: a flat wall's correlation is noise);
+* LDDE: the difference of the means at most 2 % of the object's FULL mean
+  (indirect light that would change how bright the object looks by more).
+  Relative to LDDE itself, the small indirect light of glass and glossy
+  objects is noise at the gallery's samples (15 % on the glass cube at 128
+  samples, 2 % at 1024).
 """
 import os
 import sys
 from pathlib import Path
 
+import bpy
 import numpy as np
 import pytest
 
@@ -45,14 +58,22 @@ SAMPLES = int(os.environ.get("GALLERY_SAMPLES", 128))  # Cycles and the tracer a
 #   highlight; in Cycles 4 its LSE error is 5.7 % at 128 samples, 1.5 % at
 #   256 and 2.1 % at 1024 (both renderers' 128-sample means are 4 % off their
 #   converged values).
+# - rough_glass: its sphere's own FULL (light through rough glass) correlates
+#   0.957 with Cycles' at 128 samples in 3.4, 0.995 at 256.
 SCENE_SAMPLES = {} if "GALLERY_SAMPLES" in os.environ else {
-    "layer_weight": 16 * SAMPLES, "bounce_limits": 16 * SAMPLES, "principled_layers": 2 * SAMPLES}
+    "layer_weight": 16 * SAMPLES, "bounce_limits": 16 * SAMPLES, "principled_layers": 2 * SAMPLES,
+    "rough_glass": 2 * SAMPLES}
 MEAN_TOLERANCE = 0.05
 CORRELATION_TOLERANCE = 0.98
 BLUR = 2  # box radius in pixels: 5 x 5
 BUFFERS = {"FULL": "L.*E", "LDE": "LDE", "LSE": "LSE", "LDDE": "L.*DDE"}
 PASSES = {"Combined": "RGBA", "DiffDir": "RGB", "DiffInd": "RGB", "DiffCol": "RGB", "GlossDir": "RGB",
-          "GlossCol": "RGB"}
+          "GlossCol": "RGB", "IndexOB": "X"}
+OBJECT_BUFFERS = ("FULL", "LDDE")  # compared per object too
+OBJECT_CORRELATION_TOLERANCE = 0.97
+OBJECT_LDDE_TOLERANCE = 0.02  # of the object's FULL mean
+MIN_OBJECT_CONTRAST = 0.1  # below it an object's correlation is not asserted (see object_failures)
+MIN_OBJECT_PIXELS = 100  # smaller objects (of 4800 pixels) are left to the whole-image figures
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722], np.float32)
 # Measured and not understood, so reported but not asserted (docs/lpe_guides.md, "Limitations"):
 KNOWN_DEVIATIONS = {
@@ -62,7 +83,22 @@ KNOWN_DEVIATIONS = {
     ("world_visibility", "LSE"): "a world invisible to glossy rays still reaches glossy lobes in Cycles 3.4 "
                                  "through light sampling (about 12 % of its visible LSE); the tracer leaves it "
                                  "out entirely",
+    # What a light beyond its own Max Bounces still gives is the MIS share of
+    # the BSDF rays that hit it, so it rests on Cycles' own pdfs (which lobe
+    # it samples, which light it picks): under 5.0's default Principled
+    # surface the tracer's is 22 % lower on the floor (0.14 % of its FULL; 4.5,
+    # with the Diffuse default surface: 1.3 %).
+    **({("light_max_bounces", "LDDE"): "the indirect light of a light beyond its Max Bounces (BSDF rays "
+                                       "weighted by MIS) is 8 % lower than Cycles 5.0's under its default "
+                                       "Principled surfaces; each object's LDDE within 0.14 % of its FULL"}
+       if bpy.app.version >= (5, 0, 0) else {}),
 }
+# The same for one object's FULL, keyed (scene, object), in the Cycles that shows it.
+KNOWN_OBJECT_DEVIATIONS = {
+    ("rough_glass", "Sphere"): "Cycles 4 shows what is seen through the rough glass sphere 9 % brighter than "
+                               "the tracer (4.2, 256 samples; 0.6 % in 3.4), while the whole image agrees within "
+                               "0.8 %",
+} if bpy.app.version >= (4, 0, 0) else {}
 
 
 def samples_for(key):
@@ -106,9 +142,15 @@ def compare(traced, reference, mask, full_mean):
 
 
 def cycles_buffers(scene, tmp, samples=SAMPLES, seed=0):
-    """Cycles' buffers of the scene, with the guide cache's render settings."""
+    """Cycles' buffers of the scene, with the guide cache's render settings;
+    "index" is each pixel's object, "objects" maps the objects' names to it."""
     from tempera.blender import guide_render
 
+    objects = {}
+    for i, obj in enumerate(sorted((o for o in scene.objects if o.type == "MESH"), key=lambda o: o.name)):
+        obj.pass_index = i + 1
+        name = obj.name.split(".")[0]  # "Sphere.003" -> "Sphere": the gallery's own names
+        objects[obj.name if name in objects else name] = i + 1
     layer = scene.view_layers[0]
     guide_render._configure(scene, layer, samples, PASSES, seed)
     path = guide_render._render(scene, Path(tmp) / f"{scene.name}.exr", 1)
@@ -116,26 +158,85 @@ def cycles_buffers(scene, tmp, samples=SAMPLES, seed=0):
     rgb = {k: v[:, :, :3] for k, v in p.items()}
     return {"FULL": rgb["Combined"], "LDE": rgb["DiffDir"] * rgb["DiffCol"],
             "LSE": rgb["GlossDir"] * rgb["GlossCol"], "LDDE": rgb["DiffInd"] * rgb["DiffCol"],
-            "alpha": p["Combined"][:, :, 3]}
+            "alpha": p["Combined"][:, :, 3], "index": np.rint(p["IndexOB"][:, :, 0]), "objects": objects}
 
 
-def traced_buffers(scene, samples=SAMPLES, seed=0):
+def traced_buffers(scene, samples=SAMPLES, seed=0, edit=None):
     """The tracer's buffers at the scene's current settings (after
-    cycles_buffers: caustics off, as Cycles rendered)."""
+    cycles_buffers: caustics off, as Cycles rendered); `edit(scene_dict)`
+    may change the exported scene first."""
     from tempera.blender.scene_export import evaluated_depsgraph, export_scene, path_settings
     from tempera.tracer.lpe import trace_lpe
 
     size = (scene.render.resolution_x, scene.render.resolution_y)
     scene_dict, warnings = export_scene(scene, evaluated_depsgraph(scene, scene.view_layers[0], 1), size)
+    if edit:
+        edit(scene_dict)
     images, alpha = trace_lpe(scene_dict, list(BUFFERS.values()), samples=samples, seed=seed,
                               **path_settings(scene))
     return dict(zip(BUFFERS, images), alpha=alpha), warnings
 
 
-def gallery_figures(cycles, traced):
-    mask = cycles["alpha"] > 0.99
+def gallery_figures(cycles, traced, mask=None, buffers=BUFFERS):
+    """({buffer: compare's figures}, FULL's mean) over `mask` (default: every
+    pixel Cycles sees only geometry in)."""
+    mask = cycles["alpha"] > 0.99 if mask is None else mask
     full_mean = float((cycles["FULL"] @ LUMINANCE)[mask].mean())
-    return {b: compare(traced[b], cycles[b], mask, full_mean) for b in BUFFERS}, full_mean
+    return {b: compare(traced[b], cycles[b], mask, full_mean) for b in buffers}, full_mean
+
+
+def object_figures(cycles, traced):
+    """{object name: (figures, FULL's mean, FULL's contrast)}: gallery_figures
+    of OBJECT_BUFFERS over that object's pixels, and the spread of its blurred
+    Cycles FULL (standard deviation over mean)."""
+    geometry = cycles["alpha"] > 0.99
+    out = {}
+    for name, index in cycles["objects"].items():
+        mask = geometry & (cycles["index"] == index)
+        if mask.sum() >= MIN_OBJECT_PIXELS:
+            figures, full_mean = gallery_figures(cycles, traced, mask, OBJECT_BUFFERS)
+            blurred = masked_blur(cycles["FULL"] @ LUMINANCE, mask)[mask]
+            out[name] = figures, full_mean, float(blurred.std() / blurred.mean())
+    return out
+
+
+def object_failures(cycles, traced, label):
+    """Prints each object's FULL and LDDE figures; returns the failures'
+    descriptions (tolerances in the module's docstring)."""
+    failures = []
+    for name, (figures, full_mean, contrast) in object_figures(cycles, traced).items():
+        # An evenly lit object has no light to put in the wrong place: its
+        # correlation is noise, its mean still counts.
+        correlation_tolerance = OBJECT_CORRELATION_TOLERANCE if contrast >= MIN_OBJECT_CONTRAST else -1
+        print(f"{label} {name}: FULL contrast {contrast:.3f}")
+        known = {"FULL": KNOWN_OBJECT_DEVIATIONS[label, name]} if (label, name) in KNOWN_OBJECT_DEVIATIONS else ()
+        failures += figure_failures({"FULL": figures["FULL"]}, full_mean, f"{label} {name}", correlation_tolerance,
+                                    known)
+        _, _, r_mean, t_mean = figures["LDDE"]
+        shift = abs(t_mean - r_mean) / full_mean
+        print(f"{label} {name} LDDE: Cycles {r_mean:.4g}, tracer {t_mean:.4g}: {100 * shift:.2f} % of its FULL")
+        if shift > OBJECT_LDDE_TOLERANCE:
+            failures.append(f"{label} {name} LDDE: {100 * shift:.1f} % of its FULL")
+    return failures
+
+
+def figure_failures(figures, full_mean, label, correlation_tolerance=CORRELATION_TOLERANCE, known=()):
+    """Prints each buffer's figures; returns the failures' descriptions."""
+    failures = []
+    for buffer, (error, correlation, r_mean, t_mean) in figures.items():
+        if error is None:
+            print(f"{label} {buffer}: empty in Cycles ({r_mean:.4g}), tracer {t_mean:.4g}")
+            if t_mean > 0.02 * full_mean:
+                failures.append(f"{label} {buffer}: Cycles empty, tracer mean {t_mean:.4g}")
+            continue
+        print(f"{label} {buffer}: mean error {error:.4f}, correlation {correlation:.4f} "
+              f"(Cycles {r_mean:.4g}, tracer {t_mean:.4g})")
+        if buffer in known:
+            print(f"{label} {buffer}: known deviation, not asserted: {known[buffer]}")
+            continue
+        if not (error <= MEAN_TOLERANCE and correlation >= correlation_tolerance):
+            failures.append(f"{label} {buffer}: mean error {error:.4f}, correlation {correlation:.4f}")
+    return failures
 
 
 @pytest.mark.parametrize("key", list(lpe_gallery.SCENES))
@@ -146,21 +247,10 @@ def test_gallery_scene_matches_cycles(key, tmp_path):
         traced, warnings = traced_buffers(scene, samples_for(key))
     finally:
         lpe_gallery.remove(scene)
+    known = {b: reason for (k, b), reason in KNOWN_DEVIATIONS.items() if k == key}
     figures, full_mean = gallery_figures(cycles, traced)
-    failures = []
-    for buffer, (error, correlation, r_mean, t_mean) in figures.items():
-        if error is None:
-            print(f"{key} {buffer}: empty in Cycles ({r_mean:.4g}), tracer {t_mean:.4g}")
-            if t_mean > 0.02 * full_mean:
-                failures.append(f"{buffer}: Cycles empty, tracer mean {t_mean:.4g}")
-            continue
-        print(f"{key} {buffer}: mean error {error:.4f}, correlation {correlation:.4f} "
-              f"(Cycles {r_mean:.4g}, tracer {t_mean:.4g})")
-        if (key, buffer) in KNOWN_DEVIATIONS:
-            print(f"{key} {buffer}: known deviation, not asserted: {KNOWN_DEVIATIONS[key, buffer]}")
-            continue
-        if not (error <= MEAN_TOLERANCE and correlation >= CORRELATION_TOLERANCE):
-            failures.append(f"{buffer}: mean error {error:.4f}, correlation {correlation:.4f}")
+    failures = figure_failures(figures, full_mean, key, known=known)
+    failures += object_failures(cycles, traced, key)
     print(f"{key} warnings: {warnings}")
     assert not failures, f"{key}: " + "; ".join(failures)
 
@@ -168,25 +258,43 @@ def test_gallery_scene_matches_cycles(key, tmp_path):
 def test_gallery_figures_catch_a_wrong_material(tmp_path):
     """The figures are not lenient: the Mix Shader sphere traced as what the
     exporter used to make of it (a diffuse surface of a viewport white) fails them."""
-    from tempera.blender.scene_export import evaluated_depsgraph, export_scene, path_settings
-    from tempera.tracer.lpe import trace_lpe
+    def white_diffuse_sphere(scene_dict):
+        mixed = [i for i, m in enumerate(scene_dict["materials"]) if len(m["closures"]) == 2]
+        assert len(mixed) == 1  # the sphere's Mix Shader: a diffuse and a glossy closure
+        scene_dict["materials"][mixed[0]] = {"base_color": np.full(3, 0.8, np.float32)}
 
     scene = lpe_gallery.build("mix_glossy_diffuse")
     try:
         cycles = cycles_buffers(scene, tmp_path)
-        size = (scene.render.resolution_x, scene.render.resolution_y)
-        scene_dict, _ = export_scene(scene, evaluated_depsgraph(scene, scene.view_layers[0], 1), size)
-        mixed = [i for i, m in enumerate(scene_dict["materials"]) if len(m["closures"]) == 2]
-        assert len(mixed) == 1  # the sphere's Mix Shader: a diffuse and a glossy closure
-        scene_dict["materials"][mixed[0]] = {"base_color": np.full(3, 0.8, np.float32)}
-        images, _ = trace_lpe(scene_dict, list(BUFFERS.values()), samples=SAMPLES, **path_settings(scene))
+        traced, _ = traced_buffers(scene, edit=white_diffuse_sphere)
     finally:
         lpe_gallery.remove(scene)
-    figures, _ = gallery_figures(cycles, dict(zip(BUFFERS, images)))
+    figures, _ = gallery_figures(cycles, traced)
     failing = [b for b, (e, c, _, _) in figures.items()
                if e is not None and not (e <= MEAN_TOLERANCE and c >= CORRELATION_TOLERANCE)]
     print(f"wrong material: failing buffers {failing}")
     assert {"FULL", "LDE"} <= set(failing)
+
+
+@pytest.mark.parametrize("key, setting", [("light_max_bounces", "max_bounces"),
+                                          ("light_without_mis", "multiple_importance")])
+def test_gallery_figures_catch_an_ignored_light_setting(key, setting, tmp_path):
+    """The scenes of the lights' own Max Bounces and Multiple Importance fail
+    when the tracer is not told them (as before issue 35)."""
+    def forget(scene_dict):
+        for light in scene_dict["lights"]:
+            light.pop(setting)
+
+    scene = lpe_gallery.build(key)
+    try:
+        cycles = cycles_buffers(scene, tmp_path, samples_for(key))
+        traced, _ = traced_buffers(scene, samples_for(key), edit=forget)
+    finally:
+        lpe_gallery.remove(scene)
+    figures, full_mean = gallery_figures(cycles, traced)
+    failures = figure_failures(figures, full_mean, key) + object_failures(cycles, traced, key)
+    print(f"{key} without {setting}: {failures}")
+    assert failures
 
 
 def test_pixel_filter_matches_cycles_per_pixel(tmp_path):

@@ -579,6 +579,43 @@ def s_public_style(name):
     return scene
 
 
+def s_light_max_bounces(name):
+    """A scene set up for StyLit as Creative Flow+'s renders set one up
+    (creativefloworg/creativeflow, blender/stylit_util.py): a Mix Shader of
+    Diffuse and Glossy on the sphere, a backdrop of objects without material
+    (Cycles' default surface), a large soft point light whose own Max Bounces
+    is 0 (Light > Settings: it lights directly only) and whose radius reaches
+    the floor, and a dark world."""
+    scene = base_scene(name, wall_material=False)
+    for obj in scene.objects:
+        if obj.type == "MESH":
+            obj.data.materials.clear()  # the floor: a mesh with no slot
+    _mesh_object(scene, "Wall", plane, [None], location=(0, 2.0, 1.2), rotation=(math.radians(90), 0, 0),
+                 scale=(3.0, 1.2, 1))
+    _sphere(scene, mix_glossy_diffuse(f"{name} sphere", (0.8, 0.05, 0.05), 0.2, 0.5))
+    key = add_light(scene, "POINT", 1500.0, (2.2, -1.8, 1.8), shadow_soft_size=2.2)
+    key.data.cycles.max_bounces = 0
+    scene.world = color_world(f"{name} world", (0.05, 0.05, 0.05), 1.0)
+    return scene
+
+
+def s_light_without_mis(name):
+    """A mirror sphere reflecting two area lights, one with Multiple
+    Importance off (Light > Settings): only BSDF rays find a light in a
+    mirror, and they pass through that one, so the mirror does not show it."""
+    scene = base_scene(name)
+    mat, tree, out = _tree(f"{name} mirror")
+    node = _node(tree, "ShaderNodeBsdfGlossy", Color=(0.8, 0.8, 0.8, 1))
+    _compat().set_sharp_distribution(node)
+    tree.links.new(node.outputs[0], out.inputs["Surface"])
+    _sphere(scene, mat)
+    _cube(scene, diffuse(f"{name} cube", (0.2, 0.4, 0.8)))
+    add_light(scene, "AREA", 300.0, (2.0, -2.0, 2.5), SPHERE_AT, size=0.8)
+    without = add_light(scene, "AREA", 300.0, (-2.0, -2.0, 2.5), SPHERE_AT, size=0.8)
+    without.data.cycles.use_multiple_importance_sampling = False
+    return scene
+
+
 SCENES = {
     "mix_glossy_diffuse": s_mix_glossy_diffuse,
     "fresnel_beckmann": s_fresnel_beckmann,
@@ -602,6 +639,8 @@ SCENES = {
     "glass": s_glass,
     "rough_glass": s_rough_glass,
     "public_style": s_public_style,
+    "light_max_bounces": s_light_max_bounces,
+    "light_without_mis": s_light_without_mis,
 }
 
 

@@ -184,7 +184,10 @@ void bind_scene_types(py::module_& m) {
       .def_readwrite("size_u", &Light::size_u)
       .def_readwrite("size_v", &Light::size_v)
       .def_readwrite("visibility", &Light::visibility)
-      .def_readwrite("cast_shadow", &Light::cast_shadow);
+      .def_readwrite("cast_shadow", &Light::cast_shadow)
+      .def_readwrite("max_bounces", &Light::max_bounces, "bounces before a vertex that NEE lights (Cycles' Max Bounces)")
+      .def_readwrite("multiple_importance", &Light::multiple_importance,
+                     "BSDF rays hit the light, weighted by MIS (Cycles' Multiple Importance)");
   for (auto [name, member] : {std::pair{"position", &Light::position}, {"direction", &Light::direction},
                               {"intensity", &Light::intensity}, {"irradiance", &Light::irradiance},
                               {"center", &Light::center}, {"axis_u", &Light::axis_u}, {"axis_v", &Light::axis_v},

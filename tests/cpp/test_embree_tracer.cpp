@@ -255,6 +255,9 @@ TEST(Tracer, RejectsBadInput) {
   s = sun_scene(1);
   s.camera.width = 0;
   EXPECT_THROW(trace_lpe(s, {"LDE"}, options(1)), ValueError);
+  s = sun_scene(1);
+  s.lights[0].max_bounces = -1;
+  EXPECT_THROW(trace_lpe(s, {"LDE"}, options(1)), ValueError);
 }
 
 TEST(Tracer, ProgressCanCancel) {
@@ -466,6 +469,85 @@ TEST(Tracer, SoftPointLightAsDiskOrSphere) {
     const double expected = 0.5 / kPi * 10 / 9;
     EXPECT_NEAR(mean(r.images[0]), expected, 0.03 * expected) << int(shape);
   }
+}
+
+namespace {
+
+// A white-ish diffuse floor and wall under a large soft point light: much of
+// the light the camera sees has bounced off the other surface.
+Scene corner_under_soft_light(float radius) {
+  Scene s;
+  s.materials = {lambert(0.8f)};
+  add_floor(s, 4, 0);
+  add_quad(s, {-4, 1, 0}, {4, 1, 0}, {4, 1, 6}, {-4, 1, 6}, 0);
+  Light point;
+  point.type = Light::Type::point;
+  point.position = {0, -1, 3};
+  point.radius = radius;
+  point.intensity = {40, 40, 40};
+  s.lights = {point};
+  s.camera = top_camera(5, 3, 12);
+  return s;
+}
+
+}  // namespace
+
+TEST(Tracer, LightMaxBouncesLimitsItsNextEventEstimation) {
+  // Cycles' Light > Max Bounces: the light is sampled only at vertices after
+  // at most that many bounces; BSDF rays still reach it, weighted by MIS.
+  Scene s = corner_under_soft_light(0.5f);
+  const std::vector<std::string> lpes = {"LDE", "LD{2}E", "LD{3,}E"};
+  const TraceResult all = trace_lpe(s, lpes, options(64));
+  s.lights[0].max_bounces = 1;
+  const TraceResult one = trace_lpe(s, lpes, options(64));
+  s.lights[0].max_bounces = 0;
+  const TraceResult none = trace_lpe(s, lpes, options(64));
+  // The random numbers of a skipped light are drawn all the same, so the
+  // paths the limit allows are the same paths, bit for bit.
+  EXPECT_EQ(mean(one.images[0]), mean(all.images[0]));
+  EXPECT_EQ(mean(one.images[1]), mean(all.images[1]));
+  EXPECT_EQ(mean(none.images[0]), mean(all.images[0]));
+  ASSERT_GT(mean(all.images[2]), 0.0);
+  // Beyond the limit only the BSDF-sampled hits of the disk remain, weighted
+  // by MIS against a sampling that no longer happens: most light is gone.
+  EXPECT_LT(mean(one.images[2]), 0.3 * mean(all.images[2]));
+  EXPECT_GT(mean(one.images[2]), 0.0);
+  EXPECT_LT(mean(none.images[1]), 0.3 * mean(all.images[1]));
+  EXPECT_GT(mean(none.images[1]), 0.0);
+}
+
+TEST(Tracer, SoftLightReachingTheSurfaceKeepsItsEnergy) {
+  // A disk light whose radius is larger than its height above the floor (a
+  // large light near a backdrop): BSDF rays from floor points closer to the
+  // light than its radius still hit the disk facing them, as in Cycles, so
+  // MIS and light sampling alone agree in the mean.
+  Scene s = corner_under_soft_light(4.0f);
+  const double mis = mean(trace_lpe(s, {"LDE"}, options(256)).images[0]);
+  s.lights[0].multiple_importance = false;
+  const double light_only = mean(trace_lpe(s, {"LDE"}, options(256)).images[0]);
+  EXPECT_NEAR(mis, light_only, 0.02 * light_only);
+}
+
+TEST(Tracer, LightWithoutMultipleImportanceIsOnlyFoundBySampling) {
+  // With Multiple Importance off BSDF rays pass through the light and its
+  // samples take full weight: the same light in the mean. The light is large,
+  // so that BSDF rays carry about a sixth of it under MIS: skipping them
+  // while the samples kept their MIS weights would fail.
+  Scene s = corner_under_soft_light(2.5f);
+  const double mis = mean(trace_lpe(s, {"LDE"}, options(256)).images[0]);
+  s.lights[0].multiple_importance = false;
+  const double light_only = mean(trace_lpe(s, {"LDE"}, options(256)).images[0]);
+  EXPECT_NEAR(light_only, mis, 0.02 * mis);
+
+  // Only BSDF rays find a light in a mirror: without Multiple Importance the
+  // mirror shows none, as in Cycles.
+  Scene mirror = corner_under_soft_light(1.0f);
+  mirror.materials = {of({closure(Closure::Type::glossy, {1, 1, 1}, 0)})};
+  mirror.materials[0].closures[0].distribution = Closure::Distribution::sharp;
+  mirror.lights[0].position = {0, 0, 3};
+  EXPECT_GT(mean(trace_lpe(mirror, {"LSE"}, options(16)).images[0]), 0.0);
+  mirror.lights[0].multiple_importance = false;
+  EXPECT_EQ(mean(trace_lpe(mirror, {"LSE"}, options(16)).images[0]), 0.0);
 }
 
 TEST(Tracer, DiffuseRoughnessIsOrenNayar) {

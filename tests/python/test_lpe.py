@@ -168,6 +168,24 @@ def test_typed_scene_is_the_dict_scene():
         light.position = (1.0, 2.0)
 
 
+def test_a_lights_own_path_settings_reach_the_tracer():
+    """Cycles' Light > Max Bounces and Multiple Importance, as the exporter
+    writes them: read into the typed light, a bad count named."""
+    from tempera.tracer.lpe import scene_from_dict
+
+    scene = plane_scene()
+    light = scene_from_dict(scene).lights[0]
+    assert (light.max_bounces, light.multiple_importance) == (1024, True)  # Cycles' defaults
+    scene["lights"][0].update(max_bounces=0, multiple_importance=False)
+    light = scene_from_dict(scene).lights[0]
+    assert (light.max_bounces, light.multiple_importance) == (0, False)
+    (direct,), _ = tempera.trace_lpe(scene, ["LDE"], samples=4)
+    assert direct.mean() > 0  # direct light is bounce 0: still lit
+    scene["lights"][0]["max_bounces"] = -1
+    with pytest.raises(ValueError, match="light 0 max_bounces must be >= 0, got -1"):
+        tempera.trace_lpe(scene, ["LDE"], samples=1)
+
+
 def test_closure_model_reaches_the_tracer():
     """The exporter's closure_model (compat.cycles_closure_model) is read key
     by key: Cycles 4.0's height-correlated shadowing brightens a rough glossy

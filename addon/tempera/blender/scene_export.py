@@ -69,7 +69,7 @@ def export_scene(scene, depsgraph, size):
         matrix = np.array(instance.matrix_world, np.float64)
         if obj.type == "LIGHT":
             light = _light(obj, matrix, warnings)
-            light.update(_light_visibility(owner))
+            light.update(_light_paths(owner))
             lights.append(light)
             continue
         if obj.type not in GEOMETRY_TYPES:
@@ -138,8 +138,9 @@ def _world_visibility(world):
     return bits
 
 
-def _light_visibility(obj):
-    """A light object's ray visibility (which bounces it lights) and shadow casting."""
+def _light_paths(obj):
+    """Which paths a light object lights: its ray visibility, shadow casting,
+    and Cycles' Max Bounces and Multiple Importance of the light."""
     out = {"visibility": _visibility(obj) | 16}
     light = obj.data
     cycles = getattr(light, "cycles", None)
@@ -147,6 +148,8 @@ def _light_visibility(obj):
     if cast is None:
         cast = getattr(light, "use_shadow", True)
     out["cast_shadow"] = bool(cast)
+    out["max_bounces"] = int(getattr(cycles, "max_bounces", 1024))
+    out["multiple_importance"] = bool(getattr(cycles, "use_multiple_importance_sampling", True))
     return out
 
 

@@ -179,6 +179,8 @@ def _light(value, index):
         light.shape = _enum(_native.Light.Shape, r.text("shape", ("rect", "disk"), "rect"))
     light.visibility = r.integer("visibility", 255)
     light.cast_shadow = bool(r.get("cast_shadow", True))
+    light.max_bounces = r.integer("max_bounces", 1024)
+    light.multiple_importance = bool(r.get("multiple_importance", True))
     r.finish()
     return light
 

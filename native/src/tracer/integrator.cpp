@@ -12,7 +12,8 @@
 // label) so that LDE and LSE stay apart; BSDF-sampled hits on area lights,
 // emissive triangles and a mapped world are weighted against NEE by the power
 // heuristic with the BSDF's mixture pdf. Point, spot and sun lights are
-// reached by NEE only; a constant world only by BSDF-sampled rays.
+// reached by NEE only; a constant world only by BSDF-sampled rays. A light's
+// own Max Bounces and Multiple Importance switches act as in Cycles (scene.hpp).
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -181,7 +182,7 @@ class Tracer {
         const float blur_pdf = min_ray_pdf / options_.filter_glossy;
         if (blur_pdf < 1) blur_glossy(s, std::sqrt(1 - blur_pdf) * 0.5f);
       }
-      next_event(s, throughput, states, sums, rng);
+      next_event(s, throughput, bounces, states, sums, rng);
 
       Scatter scatter;
       if (!sample(s, rng, scatter)) return;
@@ -291,6 +292,7 @@ class Tracer {
                                std::vector<Float3>& sums) const {
     for (const Light& l : scene_.lights) {
       if (!(l.visibility & kind)) continue;
+      if (!l.multiple_importance && kind != kVisibleCamera) continue;
       float t, pdf;
       Float3 radiance = l.radiance;
       if (l.type == Light::Type::area) {
@@ -354,9 +356,10 @@ class Tracer {
     }
   }
 
-  // Next-event estimation at s: one sample per light (one for all emissive
-  // triangles, one for a mapped world), each event's lobes filed under it.
-  void next_event(const ShadingPoint& s, Float3 throughput, const std::vector<int>& states,
+  // Next-event estimation at s, after `bounce` bounces: one sample per light
+  // (one for all emissive triangles, one for a mapped world), each event's
+  // lobes filed under it.
+  void next_event(const ShadingPoint& s, Float3 throughput, int bounce, const std::vector<int>& states,
                   std::vector<Float3>& sums, Rng& rng) const {
     constexpr int kEvents = 3;
     const LpeEvent events[kEvents] = {LpeEvent::D, LpeEvent::S, LpeEvent::T};
@@ -370,7 +373,7 @@ class Tracer {
         wanted[e] = dfas_[k].accepts(dfas_[k].step(dfas_[k].step(states[k], events[e]), LpeEvent::L));
     if (!wanted[0] && !wanted[1] && !wanted[2]) return;
 
-    auto shade_sample = [&](const LightSample& ls, unsigned light_visibility, bool shadows) {
+    auto shade_sample = [&](const LightSample& ls, unsigned light_visibility, bool shadows, bool mis) {
       Float3 f[kEvents];
       bool any = false;
       for (int i = 0; i < s.count; ++i) {
@@ -383,7 +386,7 @@ class Tracer {
         if (v.pdf > 0) f[e] += v.f, any = true;
       }
       if (!any) return;
-      const float bsdf_pdf = ls.pdf > 0 ? mixture_pdf(s, ls.wi) : 0.0f;
+      const float bsdf_pdf = mis && ls.pdf > 0 ? mixture_pdf(s, ls.wi) : 0.0f;
       // Both ends are off their surfaces, so the segment between them can
       // only hit other geometry.
       const Float3 origin = offset(s.p, s.ng, ls.wi);
@@ -410,12 +413,13 @@ class Tracer {
     LightSample ls;
     for (const Light& l : scene_.lights) {
       const float u1 = rng.uniform(), u2 = rng.uniform();
-      if (sample_light(l, s.p, u1, u2, ls)) shade_sample(ls, l.visibility, l.cast_shadow);
+      if (bounce > l.max_bounces) continue;  // drawn all the same: the other lights keep their numbers
+      if (sample_light(l, s.p, u1, u2, ls)) shade_sample(ls, l.visibility, l.cast_shadow, l.multiple_importance);
     }
-    if (!emissive_.empty() && sample_emissive_triangle(s.p, rng, ls)) shade_sample(ls, kVisibleAll, true);
+    if (!emissive_.empty() && sample_emissive_triangle(s.p, rng, ls)) shade_sample(ls, kVisibleAll, true, true);
     if (world_.sampled()) {
       const float u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform(), u4 = rng.uniform();
-      if (world_.sample(u1, u2, u3, u4, ls)) shade_sample(ls, scene_.world_visibility, true);
+      if (world_.sample(u1, u2, u3, u4, ls)) shade_sample(ls, scene_.world_visibility, true, true);
     }
   }
 

@@ -111,16 +111,18 @@ bool cross_soft_light(const Light& l, Float3 o, Float3 d, float t_near, float t_
   if (!(l.radius > 0)) return false;
   const Float3 to_centre = l.position - o;
   const float d0 = length(to_centre);
-  if (!(d0 > l.radius)) return false;
+  if (!(d0 > 0)) return false;
   const float r2 = l.radius * l.radius;
   if (l.soft_shape == Light::SoftShape::sphere) {
+    if (!(d0 > l.radius)) return false;  // inside the sphere: not modelled (NEE skips it too)
     const float b = dot(d, to_centre), c = d0 * d0 - r2, disc = b * b - c;
     if (disc < 0 || b <= 0) return false;
     t = b - std::sqrt(disc);
     const float cos_max = std::sqrt(std::fmax(0.0f, 1 - r2 / (d0 * d0)));
     pdf = 1 / (2 * kPi * (1 - cos_max));
   } else {
-    // The disk facing the ray's origin (Cycles 3.x).
+    // The disk facing the ray's origin (Cycles 3.x), also from points closer
+    // to the light than its radius (a large light near a floor).
     const Float3 n = to_centre / d0;  // from the origin towards the light
     const float cos_l = dot(d, n);
     if (cos_l <= 0) return false;

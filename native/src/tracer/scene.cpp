@@ -64,6 +64,7 @@ void validate_closures(const Material& m, std::size_t textures, const std::strin
 }
 
 void validate_light(const Light& l, const std::string& what) {
+  require(l.max_bounces >= 0, concat(what, " max_bounces must be >= 0, got ", l.max_bounces));
   switch (l.type) {
     case Light::Type::spot:
       require_unit(l.direction, what + " direction");

@@ -140,6 +140,14 @@ struct Light {
   // object): bits of Visibility; cast_shadow false: not occluded.
   unsigned visibility = 0xFFu;
   bool cast_shadow = true;
+  // Cycles' Light > Max Bounces: next-event estimation samples the light only
+  // at vertices with at most this many bounces before them (0: direct light
+  // only). BSDF rays still reach it beyond that, weighted by MIS as if it were
+  // sampled, as Cycles does: most of its indirect light is then gone.
+  int max_bounces = 1024;
+  // Cycles' Light > Multiple Importance: off, BSDF rays pass through the light
+  // (camera rays still see an area light) and its samples take full weight.
+  bool multiple_importance = true;
 };
 
 // Ray visibility bits (objects and lights), as Blender's Ray Visibility panel.

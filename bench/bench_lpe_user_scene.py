@@ -1,0 +1,132 @@
+"""The tracer against Cycles, object by object, on a scene made by someone else
+and set up for StyLit the way Creative Flow+ sets scenes up (issue 35).
+
+    PYTHONPATH=addon blender -b lpe_render_a.blend --factory-startup \\
+        --python bench/bench_lpe_user_scene.py -- [--size 600x456] [--samples 128] [--json out.json]
+
+The blend: dcharata/StyLit's Blender/blend_scenes/lpe_render_a.blend (a sphere
+on a floor before a backdrop; not redistributed here). The script lights and
+paints it as Creative Flow+'s StyLit set-up does (creativefloworg/creativeflow,
+blender/stylit_util.py; re-written here, not copied): the scene's lights are
+replaced by one point light between the camera and the sphere, to the
+camera's right, of radius 0.3 d and power 800 d W (d: the camera's distance to
+the sphere) whose own Max Bounces is 0; the sphere gets a Mix Shader of a red
+Diffuse and a red Glossy; the backdrop objects lose their materials (Cycles'
+default surface). The blend's dark world stays.
+
+Cycles renders it with the guide cache's settings and the tracer traces it,
+as blender_tests/test_lpe_gallery.py compares the gallery: FULL, LDE, LSE and
+LDDE over the whole image, FULL and LDDE per object. "before" traces the
+scene as the exporter wrote it before issue 35 (the lights' Max Bounces and
+Multiple Importance ignored).
+"""
+import argparse
+import json
+import sys
+import tempfile
+from pathlib import Path
+
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path[:0] = [str(ROOT / "scenes"), str(ROOT / "blender_tests")]
+
+import bpy  # noqa: E402
+from mathutils import Matrix, Vector  # noqa: E402
+import test_lpe_gallery as gallery  # noqa: E402
+
+
+def stylit_material():
+    """Creative Flow+'s StyLit material: a Mix Shader (0.5) of a red Diffuse
+    (roughness 0.25) and a red Glossy (roughness 0.1)."""
+    mat = bpy.data.materials.new("stylit red")
+    mat.use_nodes = True
+    tree = mat.node_tree
+    tree.nodes.remove(tree.nodes["Principled BSDF"])
+    d = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    d.inputs["Color"].default_value, d.inputs["Roughness"].default_value = (1, 0, 0, 1), 0.25
+    g = tree.nodes.new("ShaderNodeBsdfGlossy")
+    g.inputs["Color"].default_value, g.inputs["Roughness"].default_value = (1, 0.05, 0.05, 1), 0.1
+    mix = tree.nodes.new("ShaderNodeMixShader")
+    tree.links.new(d.outputs[0], mix.inputs[1])
+    tree.links.new(g.outputs[0], mix.inputs[2])
+    tree.links.new(mix.outputs[0], tree.nodes["Material Output"].inputs["Surface"])
+    return mat
+
+
+def set_up_for_stylit(scene, subject_name):
+    for obj in [o for o in scene.objects if o.type == "LIGHT"]:
+        bpy.data.objects.remove(obj)
+    subject = scene.objects[subject_name]
+    for obj in scene.objects:
+        if obj.type == "MESH":
+            obj.data.materials.clear()
+    subject.data.materials.append(stylit_material())
+    camera = scene.camera
+    centre = subject.matrix_world @ (sum((Vector(c) for c in subject.bound_box), Vector()) / 8)
+    distance = (camera.location - centre).length
+    # Creative Flow+ draws the angle in [fov / 2, fov] and the distance in
+    # [0.5, 0.75] d at random; the middles here.
+    turn = Matrix.Rotation(-0.75 * camera.data.angle, 4, "Y")
+    offset = camera.matrix_world.to_quaternion() @ turn.to_quaternion() @ Vector((0, 0, -0.625 * distance))
+    data = bpy.data.lights.new("stylit key", "POINT")
+    data.energy = 800.0 * distance
+    data.shadow_soft_size = 0.3 * distance
+    data.cycles.max_bounces = 0
+    light = bpy.data.objects.new("stylit key", data)
+    light.location = camera.location + offset
+    scene.collection.objects.link(light)
+    return {"distance": distance, "radius": data.shadow_soft_size, "power": data.energy}
+
+
+def traced(scene, samples, before):
+    from tempera.blender.scene_export import evaluated_depsgraph, export_scene, path_settings
+    from tempera.tracer.lpe import trace_lpe
+
+    size = (scene.render.resolution_x, scene.render.resolution_y)
+    scene_dict, _ = export_scene(scene, evaluated_depsgraph(scene, scene.view_layers[0], scene.frame_current), size)
+    if before:
+        for light in scene_dict["lights"]:
+            light.pop("max_bounces", None)
+            light.pop("multiple_importance", None)
+    images, alpha = trace_lpe(scene_dict, list(gallery.BUFFERS.values()), samples=samples, **path_settings(scene))
+    return dict(zip(gallery.BUFFERS, images), alpha=alpha)
+
+
+def figures(cycles, traced_buffers):
+    whole, _ = gallery.gallery_figures(cycles, traced_buffers)
+    out = {"image": {b: list(f) for b, f in whole.items()}}
+    for name, (object_figures, _, _) in gallery.object_figures(cycles, traced_buffers).items():
+        out[name] = {b: list(f) for b, f in object_figures.items()}
+    return out
+
+
+def main():
+    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    parser = argparse.ArgumentParser(prog="bench_lpe_user_scene.py")
+    parser.add_argument("--subject", default="Sphere")
+    parser.add_argument("--size", default="600x456")
+    parser.add_argument("--samples", type=int, default=gallery.SAMPLES)
+    parser.add_argument("--json")
+    args = parser.parse_args(argv)
+
+    scene = bpy.context.scene
+    scene.render.resolution_x, scene.render.resolution_y = (int(v) for v in args.size.split("x"))
+    scene.render.resolution_percentage = 100
+    light = set_up_for_stylit(scene, args.subject)
+    print(f"key light: radius {light['radius']:.2f} m, {light['power']:.0f} W, "
+          f"{light['distance']:.2f} m from the camera to the subject")
+    with tempfile.TemporaryDirectory() as tmp:
+        cycles = gallery.cycles_buffers(scene, tmp, args.samples)
+    result = {"blend": bpy.data.filepath, "size": args.size, "samples": args.samples, "light": light}
+    for label in ("before", "now"):
+        result[label] = figures(cycles, traced(scene, args.samples, before=label == "before"))
+        for region, buffers in result[label].items():
+            for buffer, (error, correlation, r_mean, t_mean) in buffers.items():
+                shown = "empty in Cycles" if error is None else f"mean error {100 * error:5.1f} %, " \
+                                                                 f"correlation {correlation:.3f}"
+                print(f"{label:6s} {region:10s} {buffer:4s}: Cycles {r_mean:.4f}, tracer {t_mean:.4f}: {shown}")
+    if args.json:
+        Path(args.json).write_text(json.dumps(result, indent=1))
+
+
+main()
