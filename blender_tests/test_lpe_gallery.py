@@ -297,6 +297,26 @@ def test_gallery_figures_catch_an_ignored_light_setting(key, setting, tmp_path):
     assert failures
 
 
+def test_gallery_figures_catch_the_other_oren_nayar(tmp_path):
+    """Rough Diffuse BSDFs traced as the other Cycles renders them (3.x's
+    Fujii form in 4.3+, 4.3's energy-preserving one before) fail the figures."""
+    def other(scene_dict):
+        model = scene_dict["closure_model"]
+        model["energy_preserving_oren_nayar"] = not model["energy_preserving_oren_nayar"]
+
+    scene = lpe_gallery.build("diffuse_roughness")
+    try:
+        cycles = cycles_buffers(scene, tmp_path)
+        traced, _ = traced_buffers(scene, edit=other)
+    finally:
+        lpe_gallery.remove(scene)
+    figures, full_mean = gallery_figures(cycles, traced)
+    failures = figure_failures(figures, full_mean, "diffuse_roughness") + \
+        object_failures(cycles, traced, "diffuse_roughness")
+    print(f"the other Oren-Nayar: {failures}")
+    assert failures
+
+
 def test_pixel_filter_matches_cycles_per_pixel(tmp_path):
     """Cycles' Blackman-Harris pixel filter (its default, width 1.5, spread
     over 3 pixels): the tracer with the scene's filter agrees pixel by pixel

@@ -418,6 +418,20 @@ def s_large_point(name):
     return scene
 
 
+def s_diffuse_roughness(name):
+    """Diffuse BSDFs with a roughness: Oren-Nayar, whose energy Cycles 4.3
+    restores by a multiple-scattering term (3.x's loses it)."""
+    scene = base_scene(name)
+    mat = diffuse(f"{name} sphere", (0.8, 0.8, 0.8))
+    mat.node_tree.nodes["Diffuse BSDF"].inputs["Roughness"].default_value = 1.0
+    _sphere(scene, mat)
+    mat = diffuse(f"{name} cube", (0.2, 0.4, 0.8))
+    mat.node_tree.nodes["Diffuse BSDF"].inputs["Roughness"].default_value = 0.5
+    _cube(scene, mat)
+    _key(scene, radius=0.5)
+    return scene
+
+
 def s_spot(name):
     """A spot light with a blend, and a node tree tinting it."""
     scene = base_scene(name)
@@ -625,6 +639,7 @@ SCENES = {
     "principled_layers": s_principled_layers,
     "default_surfaces": s_default_surfaces,
     "large_point": s_large_point,
+    "diffuse_roughness": s_diffuse_roughness,
     "spot": s_spot,
     "area_shapes": s_area_shapes,
     "sun_angle": s_sun_angle,

@@ -229,7 +229,9 @@ void bind_scene_types(py::module_& m) {
       .def_readwrite("microfacet_glass_fresnel", &ClosureModel::microfacet_glass_fresnel,
                      "rough glass weighted by the Fresnel of each microfacet (Cycles 4.0+), not of the normal")
       .def_readwrite("principled_v2", &ClosureModel::principled_v2,
-                     "Principled closures are Cycles 4.0's layered Principled v2, not 3.x's v1");
+                     "Principled closures are Cycles 4.0's layered Principled v2, not 3.x's v1")
+      .def_readwrite("energy_preserving_oren_nayar", &ClosureModel::energy_preserving_oren_nayar,
+                     "Diffuse roughness is Cycles 4.3's Oren-Nayar with its multiple-scattering term");
 
   py::class_<Scene> scene(m, "Scene", "The tracer's scene: triangles, materials, lights, world and camera.");
   scene.def(py::init<>())

@@ -560,6 +560,31 @@ TEST(Tracer, DiffuseRoughnessIsOrenNayar) {
   EXPECT_NEAR(mean(r.images[0], 0), expected, 0.01 * expected);
 }
 
+TEST(Tracer, EnergyPreservingOrenNayarKeepsAWhiteFurnaceWhite) {
+  // Cycles 4.3's Oren-Nayar adds back, by OpenPBR's multiple-scattering term,
+  // what Fujii's single scattering loses: a white rough plane under a white
+  // world returns all of it, 3.x's form only E(straight up) = pi a = 0.78.
+  // A grey one returns less than Lambert of its colour and more than 3.x's.
+  for (const float albedo : {1.0f, 0.5f}) {
+    Scene s;
+    s.materials = {of({closure(Closure::Type::diffuse, {albedo, albedo, albedo}, 1.0f)})};
+    add_floor(s, 1000, 0);
+    s.world_radiance = {1, 1, 1};
+    s.camera = top_camera(5, 2, 8);
+    const double fujii = mean(trace_lpe(s, {"LDE"}, options(256)).images[0]);
+    s.closure_model.energy_preserving_oren_nayar = true;
+    const double preserving = mean(trace_lpe(s, {"LDE"}, options(256)).images[0]);
+    const double single = albedo * kPi / (kPi + (kPi / 2 - 2.0 / 3));
+    EXPECT_NEAR(fujii, single, 0.02 * single) << albedo;
+    if (albedo == 1.0f) {
+      EXPECT_NEAR(preserving, 1.0, 0.02);
+    } else {  // + c^3 E_avg (1 - E) / (1 - c (1 - E_avg)), E_avg = 0.833
+      EXPECT_NEAR(preserving, single + 0.0253, 0.02 * single);
+      EXPECT_LT(preserving, albedo);
+    }
+  }
+}
+
 TEST(Tracer, RoughGlassSphereInAFurnaceLosesLittleEnergy) {
   // Clear glass in a white world: what comes out is at most what went in,
   // and a single-scattering microfacet model loses only a little at roughness 0.3.

@@ -196,9 +196,11 @@ def test_closure_model_reaches_the_tracer():
     scene["materials"] = [{"closures": [{"type": "glossy", "color": [1, 1, 1], "roughness": 1.0}]}]
     scene["lights"][0]["direction"] = [0.97, 0.0, 0.243]  # 76 degrees from the normal
     (separable,), _ = tempera.trace_lpe(scene, ["LSE"], samples=16)
-    scene["closure_model"] = {"height_correlated_shadowing": True, "microfacet_glass_fresnel": True}
+    scene["closure_model"] = {"height_correlated_shadowing": True, "microfacet_glass_fresnel": True,
+                              "energy_preserving_oren_nayar": True}
     typed = scene_from_dict(scene)
     assert typed.closure_model.height_correlated_shadowing and typed.closure_model.microfacet_glass_fresnel
+    assert typed.closure_model.energy_preserving_oren_nayar
     (correlated,), _ = tempera.trace_lpe(scene, ["LSE"], samples=16)
     assert correlated.mean() > 1.008 * separable.mean()  # +1.2 %: the same samples, weighted by G2
     scene["closure_model"] = {"height_correlated": True}

@@ -190,9 +190,13 @@ def cycles_closure_model():
     microfacet). No RNA property of a registered type tells them apart (the
     node types are not in bpy.types until a node exists), so the version does.
     Cycles 4.0 also brought Principled v2 (coat, F82 metal, Lambertian diffuse
-    under a dielectric layer), which the tracer models as "principled_v2"."""
+    under a dielectric layer), which the tracer models as "principled_v2".
+    Cycles 4.3, the release that gave the Principled BSDF its Diffuse
+    Roughness, made the Diffuse BSDF's roughness an energy-preserving
+    Oren-Nayar (measured: 4.2 renders 3.x's, 4.5 and 5.0 the new one)."""
     cycles4 = bpy.app.version >= (4, 0, 0)
-    return {"height_correlated_shadowing": cycles4, "microfacet_glass_fresnel": cycles4, "principled_v2": cycles4}
+    return {"height_correlated_shadowing": cycles4, "microfacet_glass_fresnel": cycles4, "principled_v2": cycles4,
+            "energy_preserving_oren_nayar": bpy.app.version >= (4, 3, 0)}
 
 
 def set_sharp_distribution(node):

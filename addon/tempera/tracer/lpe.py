@@ -262,7 +262,8 @@ def scene_from_dict(scene: dict):
     s.camera = _camera(r.required("camera"))
     if r.has("closure_model"):  # which Cycles' microfacets: {"height_correlated_shadowing": bool, ...}
         c = _Reader(r.required("closure_model"), "scene closure_model")
-        for key in ("height_correlated_shadowing", "microfacet_glass_fresnel", "principled_v2"):
+        for key in ("height_correlated_shadowing", "microfacet_glass_fresnel", "principled_v2",
+                    "energy_preserving_oren_nayar"):
             setattr(s.closure_model, key, bool(c.get(key, False)))
         c.finish()
     r.finish()

@@ -145,6 +145,40 @@ void add_principled(ShadingPoint& s, Float3 weight, Float3 base, float metallic,
   add_lobe(s, glass);
 }
 
+// Directional albedo of Fujii's single-scattering Oren-Nayar with constants
+// a, b, lit or seen at cos_theta: a pi + b G(theta), G in closed form (as the
+// OpenPBR specification gives it), its limit near grazing below 1e-6.
+float oren_nayar_albedo(float a, float b, float cos_theta) {
+  float g;
+  if (cos_theta < 1e-6f) {
+    g = (kPi / 2 - 2.0f / 3) - cos_theta;
+  } else {
+    const float sin_t = std::sqrt(std::max(0.0f, 1 - cos_theta * cos_theta));
+    const float theta = std::acos(std::min(cos_theta, 1.0f));
+    g = sin_t * (theta - 2.0f / 3 - sin_t * cos_theta) +
+        (2.0f / 3) * (sin_t / cos_theta) * (1 - sin_t * sin_t * sin_t);
+  }
+  return a * kPi + b * g;
+}
+
+// Cycles 4.3's Diffuse BSDF with a roughness: Fujii's form with the constants
+// a = 1 / (pi + sigma (pi/2 - 2/3)), b = sigma a, plus OpenPBR's multiple
+// scattering, which returns what single scattering loses: E_ms (1 - E(wo))
+// (1 - E(wi)), E_ms from the colour and the average albedo E_avg. The part
+// that depends on the viewer is fixed here; evaluate() adds 1 - E(wi).
+void energy_preserving_oren_nayar(Lobe& l, float sigma, Float3 color, float cos_v) {
+  l.kind = LobeKind::oren_nayar;
+  l.a = 1 / (kPi + sigma * (kPi / 2 - 2.0f / 3));
+  l.b = sigma * l.a;
+  const float e_avg = l.a * kPi + ((2 * kPi - 5.6f) / 3) * l.b;
+  const float seen = 1 - oren_nayar_albedo(l.a, l.b, cos_v);
+  auto multiple = [&](float albedo) {
+    albedo = std::clamp(albedo, 0.0f, 1.0f);
+    return albedo * albedo * (e_avg / (1 - e_avg)) / (kPi * (1 - albedo * (1 - e_avg))) * seen;
+  };
+  l.multiscatter = {multiple(color.x), multiple(color.y), multiple(color.z)};
+}
+
 void add_closure(const Scene& scene, ShadingPoint& s, const Closure& c, const SurfaceInput& at) {
   const Float3 weight = closure_weight(scene, c, at);
   if (!(max_component(weight) > 0)) return;
@@ -171,7 +205,9 @@ void add_closure(const Scene& scene, ShadingPoint& s, const Closure& c, const Su
       Lobe l;
       l.weight = weight * color;
       const float sigma = closure_roughness(scene, c, at);
-      if (sigma > 0) {  // Cycles' Oren-Nayar (Fujii's form), roughness as sigma
+      if (sigma > 0 && scene.closure_model.energy_preserving_oren_nayar) {
+        energy_preserving_oren_nayar(l, sigma, color, std::max(dot(s.n, s.wo), 0.0f));
+      } else if (sigma > 0) {  // Cycles 3.x's Oren-Nayar (Fujii's form), roughness as sigma
         l.kind = LobeKind::oren_nayar;
         const float div = 1 / (kPi + ((3 * kPi - 4) / 6) * sigma);
         l.a = div;
@@ -414,6 +450,10 @@ LobeValue evaluate_lobe(const ShadingPoint& s, const Lobe& l, Float3 wi) {
     const float cos_v = std::max(dot(s.n, s.wo), 0.0f);
     float t = dot(wi, s.wo) - cos_i * cos_v;
     if (t > 0) t /= std::max(cos_i, cos_v) + 1e-30f;
+    if (max_component(l.multiscatter) > 0) {  // what the single scattering loses towards wi, returned
+      const Float3 multi = l.multiscatter * (1 - oren_nayar_albedo(l.a, l.b, cos_i));
+      return {l.weight * (Float3{1, 1, 1} * (l.a + l.b * t) + multi) * cos_i, cos_i / kPi};
+    }
     return {l.weight * (cos_i * (l.a + l.b * t)), cos_i / kPi};
   }
   if (l.kind == LobeKind::principled_diffuse) {

@@ -31,6 +31,7 @@ struct Lobe {
   Float3 weight;            // colour times closure weight
   float alpha2 = 0;         // microfacet: alpha^2
   float a = 0, b = 0;       // oren_nayar: A, B; principled_diffuse: a = roughness
+  Float3 multiscatter;      // oren_nayar, energy preserving: E_ms (1 - E(viewer)); else 0
   bool beckmann = false;    // microfacet: Beckmann instead of GGX
   bool correlated = false;  // microfacet: height-correlated Smith shadowing (ClosureModel)
   FresnelMode fresnel = FresnelMode::none;  // microfacet_transmission, dielectric: 1 - F(microfacet)

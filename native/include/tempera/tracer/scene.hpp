@@ -196,6 +196,10 @@ struct ClosureModel {
   // diffuse, each layer weighted by 1 - the albedo of the layers above;
   // false: Cycles 3.x's v1 (Disney diffuse, Principled Fresnel, clearcoat).
   bool principled_v2 = false;
+  // Diffuse BSDF roughness is Cycles 4.3's Oren-Nayar: Fujii's form with other
+  // constants plus the OpenPBR multiple-scattering term that keeps its energy
+  // (bsdf.cpp); false: Cycles 3.x's Fujii form, which loses energy with roughness.
+  bool energy_preserving_oren_nayar = false;
 };
 
 struct Scene {
