@@ -558,7 +558,8 @@ class ShaderInterpreter:
         if v2:
             self.principled_v2(node, closure, ctx)
         ignored = []
-        for names, neutral in ((("Sheen Weight", "Sheen"), 0.0), (("Anisotropic",), 0.0)):
+        for names, neutral in ((("Sheen Weight", "Sheen"), 0.0), (("Anisotropic",), 0.0),
+                               (("Diffuse Roughness",), 0.0)):  # Blender 4.3+: traced as 0 (Lambertian)
             socket = get(*names)
             if socket is not None and (socket.is_linked or abs(float(socket.default_value) - neutral) > 1e-6):
                 ignored.append(socket.name)
