@@ -239,14 +239,27 @@ def figure_failures(figures, full_mean, label, correlation_tolerance=CORRELATION
     return failures
 
 
-@pytest.mark.parametrize("key", list(lpe_gallery.SCENES))
-def test_gallery_scene_matches_cycles(key, tmp_path):
+def rendered_and_traced(key, tmp, edit=None):
+    """(Cycles' buffers, the tracer's, the exporter's warnings) of gallery
+    scene `key` at its samples; `edit` as traced_buffers takes it."""
     scene = lpe_gallery.build(key)
     try:
-        cycles = cycles_buffers(scene, tmp_path, samples_for(key))
-        traced, warnings = traced_buffers(scene, samples_for(key))
+        cycles = cycles_buffers(scene, tmp, samples_for(key))
+        traced, warnings = traced_buffers(scene, samples_for(key), edit=edit)
     finally:
         lpe_gallery.remove(scene)
+    return cycles, traced, warnings
+
+
+def all_failures(cycles, traced, label):
+    """The whole image's failures and each object's, nothing known."""
+    figures, full_mean = gallery_figures(cycles, traced)
+    return figure_failures(figures, full_mean, label) + object_failures(cycles, traced, label)
+
+
+@pytest.mark.parametrize("key", list(lpe_gallery.SCENES))
+def test_gallery_scene_matches_cycles(key, tmp_path):
+    cycles, traced, warnings = rendered_and_traced(key, tmp_path)
     known = {b: reason for (k, b), reason in KNOWN_DEVIATIONS.items() if k == key}
     figures, full_mean = gallery_figures(cycles, traced)
     failures = figure_failures(figures, full_mean, key, known=known)
@@ -263,12 +276,7 @@ def test_gallery_figures_catch_a_wrong_material(tmp_path):
         assert len(mixed) == 1  # the sphere's Mix Shader: a diffuse and a glossy closure
         scene_dict["materials"][mixed[0]] = {"base_color": np.full(3, 0.8, np.float32)}
 
-    scene = lpe_gallery.build("mix_glossy_diffuse")
-    try:
-        cycles = cycles_buffers(scene, tmp_path)
-        traced, _ = traced_buffers(scene, edit=white_diffuse_sphere)
-    finally:
-        lpe_gallery.remove(scene)
+    cycles, traced, _ = rendered_and_traced("mix_glossy_diffuse", tmp_path, white_diffuse_sphere)
     figures, _ = gallery_figures(cycles, traced)
     failing = [b for b, (e, c, _, _) in figures.items()
                if e is not None and not (e <= MEAN_TOLERANCE and c >= CORRELATION_TOLERANCE)]
@@ -285,14 +293,8 @@ def test_gallery_figures_catch_an_ignored_light_setting(key, setting, tmp_path):
         for light in scene_dict["lights"]:
             light.pop(setting)
 
-    scene = lpe_gallery.build(key)
-    try:
-        cycles = cycles_buffers(scene, tmp_path, samples_for(key))
-        traced, _ = traced_buffers(scene, samples_for(key), edit=forget)
-    finally:
-        lpe_gallery.remove(scene)
-    figures, full_mean = gallery_figures(cycles, traced)
-    failures = figure_failures(figures, full_mean, key) + object_failures(cycles, traced, key)
+    cycles, traced, _ = rendered_and_traced(key, tmp_path, forget)
+    failures = all_failures(cycles, traced, key)
     print(f"{key} without {setting}: {failures}")
     assert failures
 
@@ -304,15 +306,8 @@ def test_gallery_figures_catch_the_other_oren_nayar(tmp_path):
         model = scene_dict["closure_model"]
         model["energy_preserving_oren_nayar"] = not model["energy_preserving_oren_nayar"]
 
-    scene = lpe_gallery.build("diffuse_roughness")
-    try:
-        cycles = cycles_buffers(scene, tmp_path)
-        traced, _ = traced_buffers(scene, edit=other)
-    finally:
-        lpe_gallery.remove(scene)
-    figures, full_mean = gallery_figures(cycles, traced)
-    failures = figure_failures(figures, full_mean, "diffuse_roughness") + \
-        object_failures(cycles, traced, "diffuse_roughness")
+    cycles, traced, _ = rendered_and_traced("diffuse_roughness", tmp_path, other)
+    failures = all_failures(cycles, traced, "diffuse_roughness")
     print(f"the other Oren-Nayar: {failures}")
     assert failures
 

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <utility>
 
 #include "tempera/tracer/embree_tracer.hpp"
 #include "tempera/engine/error.hpp"
@@ -490,6 +491,15 @@ Scene corner_under_soft_light(float radius) {
   return s;
 }
 
+// Mean LDE of a corner under a soft light of `radius`, with MIS and with light
+// sampling alone (the light's Multiple Importance off): both are unbiased.
+std::pair<double, double> lde_with_and_without_mis(float radius) {
+  Scene s = corner_under_soft_light(radius);
+  const double mis = mean(trace_lpe(s, {"LDE"}, options(256)).images[0]);
+  s.lights[0].multiple_importance = false;
+  return {mis, mean(trace_lpe(s, {"LDE"}, options(256)).images[0])};
+}
+
 }  // namespace
 
 TEST(Tracer, LightMaxBouncesLimitsItsNextEventEstimation) {
@@ -521,10 +531,7 @@ TEST(Tracer, SoftLightReachingTheSurfaceKeepsItsEnergy) {
   // large light near a backdrop): BSDF rays from floor points closer to the
   // light than its radius still hit the disk facing them, as in Cycles, so
   // MIS and light sampling alone agree in the mean.
-  Scene s = corner_under_soft_light(4.0f);
-  const double mis = mean(trace_lpe(s, {"LDE"}, options(256)).images[0]);
-  s.lights[0].multiple_importance = false;
-  const double light_only = mean(trace_lpe(s, {"LDE"}, options(256)).images[0]);
+  const auto [mis, light_only] = lde_with_and_without_mis(4.0f);
   EXPECT_NEAR(mis, light_only, 0.02 * light_only);
 }
 
@@ -533,10 +540,7 @@ TEST(Tracer, LightWithoutMultipleImportanceIsOnlyFoundBySampling) {
   // samples take full weight: the same light in the mean. The light is large,
   // so that BSDF rays carry about a sixth of it under MIS: skipping them
   // while the samples kept their MIS weights would fail.
-  Scene s = corner_under_soft_light(2.5f);
-  const double mis = mean(trace_lpe(s, {"LDE"}, options(256)).images[0]);
-  s.lights[0].multiple_importance = false;
-  const double light_only = mean(trace_lpe(s, {"LDE"}, options(256)).images[0]);
+  const auto [mis, light_only] = lde_with_and_without_mis(2.5f);
   EXPECT_NEAR(light_only, mis, 0.02 * mis);
 
   // Only BSDF rays find a light in a mirror: without Multiple Importance the
