@@ -82,18 +82,12 @@ def set_up_for_stylit(scene, subject_name):
     return {"distance": distance, "radius": data.shadow_soft_size, "power": data.energy}
 
 
-def traced(scene, samples, before):
-    from tempera.blender.scene_export import evaluated_depsgraph, export_scene, path_settings
-    from tempera.tracer.lpe import trace_lpe
-
-    size = (scene.render.resolution_x, scene.render.resolution_y)
-    scene_dict, _ = export_scene(scene, evaluated_depsgraph(scene, scene.view_layers[0], scene.frame_current), size)
-    if before:
-        for light in scene_dict["lights"]:
-            light.pop("max_bounces", None)
-            light.pop("multiple_importance", None)
-    images, alpha = trace_lpe(scene_dict, list(gallery.BUFFERS.values()), samples=samples, **path_settings(scene))
-    return dict(zip(gallery.BUFFERS, images), alpha=alpha)
+def forget_light_settings(scene_dict):
+    """The scene as the exporter wrote it before issue 35: no light's own Max
+    Bounces or Multiple Importance."""
+    for light in scene_dict["lights"]:
+        light.pop("max_bounces", None)
+        light.pop("multiple_importance", None)
 
 
 def figures(cycles, traced_buffers):
@@ -128,7 +122,8 @@ def main():
     result = {"blend": Path(bpy.data.filepath).name, "blender": bpy.app.version_string, "size": args.size, "samples": args.samples, "light": light}
     buffers = {}
     for label in ("before", "now"):
-        buffers[label] = traced(scene, args.samples, before=label == "before")
+        edit = forget_light_settings if label == "before" else None
+        buffers[label], _ = gallery.traced_buffers(scene, args.samples, edit=edit)
         result[label] = figures(cycles, buffers[label])
         for region, region_figures in result[label].items():
             for buffer, (error, correlation, r_mean, t_mean) in region_figures.items():
