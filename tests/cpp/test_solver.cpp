@@ -151,6 +151,38 @@ TEST(Solver, WarmStartFromItsOwnFieldIsNoWorseInHalfTheTime) {
   EXPECT_LE(warm_seconds, 0.5 * cold_seconds);
 }
 
+// synthesize_warm (issue 32): the finest level alone, started from the
+// previous frame's field moved along the motion. With no search the output is
+// the previous frame's carried 3 px to the right; the field's size is checked.
+TEST(Solver, SynthesizeWarmStartsFromThePreviousFieldAdvected) {
+  const int w = 80, h = 40;
+  const Image style = smooth_noise(w, h, 3, 5);
+  SynthesisInput in;
+  in.style = style.view();
+  in.target_width = w;
+  in.target_height = h;
+  SynthesisOptions opt = options(PatchUsage::None);
+  opt.output = OutputMode::Centre;
+  const SynthesisResult first = synthesize(in, opt);
+  Image velocity(w, h, 2, 0.0f);
+  for (std::size_t i = 0; i < velocity.pixel_count(); ++i) velocity.data()[2 * i] = 3.0f;
+  opt.em_iterations = 1;
+  opt.pm_iterations = 0;
+  const SynthesisResult warm = synthesize_warm(in, opt, first.field, velocity.view());
+  ASSERT_EQ(warm.levels.size(), 1u);
+  EXPECT_EQ(warm.levels[0].width, w);
+  EXPECT_NEAR(horizontal_shift(first.image, warm.image, 6, 8), 3.0, 0.1);
+  const SynthesisResult cold = synthesize(in, opt);  // the same options from a cold start: no such shift
+  EXPECT_GT(std::abs(horizontal_shift(first.image, cold.image, 6, 8) - 3.0), 1.0);
+  EXPECT_THROW(synthesize_warm(in, opt, OffsetField(w - 1, h), velocity.view()), ValueError);
+  // A field through its positions image (what the jobs write) comes back the same.
+  const OffsetField back = field_from_positions(field_positions(first.field).view());
+  for (std::size_t i = 0; i < back.x.size(); ++i) {
+    ASSERT_EQ(back.x[i], first.field.x[i]);
+    ASSERT_EQ(back.ry[i], first.field.ry[i]);
+  }
+}
+
 TEST(Solver, SubPixelMotionAccumulatesOverAdvection) {
   // 0.3 px per frame to the right for 10 frames moves the output 3 px; with
   // integer offsets each step would round back to where it was.

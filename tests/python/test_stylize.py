@@ -178,3 +178,60 @@ def test_stylit_options_are_a_typed_class():
         opts.validate()
     with pytest.raises(ValueError, match="temporal"):
         stylize.options(temporal_weight=-1)
+
+
+def test_warm_start_carries_the_matches_along_the_motion():
+    """A warm frame starts from the previous frame's matches moved along the
+    motion: most of its matches are those, where a cold frame finds its own.
+    Flat guides leave every placement of the painting equally good, so only
+    the start decides."""
+    rng = np.random.default_rng(1)
+    style = rng.random((H, W, 3), dtype=np.float32)
+    first_guides = next_guides = {k: np.full((H, W, 3), 0.5, np.float32) for k in light_paths(W / 2)}
+    velocity = np.zeros((H, W, 2), np.float32)
+    velocity[..., 0] = 2.0
+    visible = np.ones((H, W), np.float32)
+    image, stats = stylize_frame(style, first_guides, first_guides, threads=2)
+    assert stats["field"].shape == (H, W, 2) and stats["field"].dtype == np.float32
+    advected = np.roll(stats["field"], 2, axis=1)  # p - V-(p): two pixels to the left
+
+    def held(field):  # interior matches within a pixel of the advected ones
+        return float((np.abs(field - advected).max(axis=2) <= 1.0)[4:-4, 8:-8].mean())
+
+    common = dict(previous=image, velocity_backward=velocity, occlusion_backward=visible, temporal_weight=0.5,
+                  threads=2)
+    _, warm = stylize_frame(style, first_guides, next_guides, previous_field=stats["field"], warm_start=True,
+                            **common)
+    _, cold = stylize_frame(style, first_guides, next_guides, **common)
+    assert held(warm["field"]) > 0.5 and held(warm["field"]) > held(cold["field"]) + 0.2
+    with pytest.raises(ValueError, match="field"):
+        stylize_frame(style, first_guides, next_guides, previous_field=stats["field"][:-1], warm_start=True,
+                      **common)
+
+
+def test_warm_start_job_resumes_like_an_uninterrupted_run(inputs):
+    whole = job(inputs, temporal_weight=0.5, warm_start=True, threads=2)
+    assert [whole.run_frame(i)["status"] for i in range(3)] == ["stylized"] * 3
+    fields = inputs / "out" / "tempera_stylize"
+    assert sorted(f.name for f in fields.iterdir()) == [f"field_000{f}.exr" for f in (1, 2, 3)]
+    uninterrupted = [tempera.read_image(whole.output_path(f)) for f in (1, 2, 3)]
+
+    cold = StylizeJob(inputs / "paint.png", inputs / "exemplar", inputs / "cache", [1, 2, 3], inputs / "cold",
+                      temporal_weight=0.5, threads=2)
+    [cold.run_frame(i) for i in range(3)]
+    assert np.abs(tempera.read_image(cold.output_path(3)) - uninterrupted[2]).max() > 0.05  # the warm start counts
+    assert not (inputs / "cold" / "tempera_stylize").exists()
+
+    # Interrupted after frame 2 (frame 3 and its matches gone), then resumed.
+    (inputs / "out" / "frame_0003.png").unlink()
+    (fields / "field_0003.exr").unlink()
+    resumed = job(inputs, temporal_weight=0.5, warm_start=True, threads=2)
+    assert [resumed.run_frame(i)["status"] for i in range(3)] == ["skipped", "skipped", "stylized"]
+    np.testing.assert_array_equal(tempera.read_image(resumed.output_path(3)), uninterrupted[2])
+    # A frame whose matches are gone is made again: the next one starts from them.
+    (fields / "field_0002.exr").unlink()
+    again = job(inputs, temporal_weight=0.5, warm_start=True, threads=2)
+    assert again.run_frame(1)["status"] == "stylized" and (fields / "field_0002.exr").exists()
+    # Switching the warm start off makes the frames again, cold.
+    off = job(inputs, temporal_weight=0.5, threads=2)
+    assert off.run_frame(1)["status"] == "stylized"

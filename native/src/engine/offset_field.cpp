@@ -85,4 +85,26 @@ OffsetField advect_field(const OffsetField& prev, const ImageView& v, const Fiel
   return out;
 }
 
+Image field_positions(const OffsetField& field) {
+  Image out(field.width, field.height, 2);
+  for (std::size_t i = 0; i < out.pixel_count(); ++i)
+    out.data()[2 * i] = field.position_x(i), out.data()[2 * i + 1] = field.position_y(i);
+  return out;
+}
+
+OffsetField field_from_positions(const ImageView& positions) {
+  if (positions.channels != 2)
+    throw ValueError(concat("a field's positions need 2 channels, got ", positions.channels));
+  OffsetField field(positions.width, positions.height);
+  std::fill(field.dist.begin(), field.dist.end(), kInf);
+  for (int y = 0; y < positions.height; ++y)
+    for (int x = 0; x < positions.width; ++x) {
+      const float px = positions.at(x, y, 0), py = positions.at(x, y, 1);
+      if (!std::isfinite(px) || !std::isfinite(py))
+        throw ValueError(concat("a field's position at (", x, ", ", y, ") is not finite"));
+      field.set_position(field.index(x, y), px, py);
+    }
+  return field;
+}
+
 }  // namespace tempera

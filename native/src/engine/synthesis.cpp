@@ -7,6 +7,22 @@
 #include "tempera/engine/solver.hpp"
 
 namespace tempera {
+namespace {
+
+// `result` completed with the finest level's field, image and figures.
+SynthesisResult finest_result(const Solver& solver, LevelResult level, SynthesisResult result,
+                              std::chrono::steady_clock::time_point t_start) {
+  result.image = std::move(level.image);
+  result.field = std::move(level.field);
+  result.layout = solver.layout(0);
+  result.source_coverage = result.levels.back().source_coverage;
+  result.guide_channels = solver.guide_channels();
+  result.kept_guide_variance = solver.kept_guide_variance();
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  return result;
+}
+
+}  // namespace
 
 // The whole solve: coarse to fine, each level started from the coarser
 // level's field (the cold start at the coarsest).
@@ -37,14 +53,25 @@ SynthesisResult synthesize(const SynthesisInput& in, const SynthesisOptions& opt
     done_work += work;
     result.levels.push_back(level.stats);
   }
-  result.image = std::move(level.image);
-  result.field = std::move(level.field);
-  result.layout = solver.layout(0);
-  result.source_coverage = result.levels.back().source_coverage;
-  result.guide_channels = solver.guide_channels();
-  result.kept_guide_variance = solver.kept_guide_variance();
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-  return result;
+  return finest_result(solver, std::move(level), std::move(result), t_start);
+}
+
+SynthesisResult synthesize_warm(const SynthesisInput& in, const SynthesisOptions& opt,
+                                const OffsetField& previous_field, const ImageView& velocity_backward,
+                                const ProgressCallback& progress) {
+  const auto t_start = std::chrono::steady_clock::now();
+  const Solver solver(in, opt);
+  if (previous_field.width != solver.target_width(0) || previous_field.height != solver.target_height(0))
+    throw ValueError(concat("the previous frame's field is ", previous_field.width, "x", previous_field.height,
+                            " but the target is ", solver.target_width(0), "x", solver.target_height(0)));
+  LevelStart start;
+  start.last_use = true;
+  OffsetField advected = solver.advect(previous_field, 0, velocity_backward);
+  start.take_field = &advected;
+  LevelResult level = solver.solve_level(0, start, progress);
+  SynthesisResult result;
+  result.levels = {level.stats};
+  return finest_result(solver, std::move(level), std::move(result), t_start);
 }
 
 }  // namespace tempera

@@ -73,20 +73,26 @@ class StylizeJob(SheetFrameJob):
 
 
 def stylize_frame(style, exemplar: Mapping, target: Mapping, *, previous=None, velocity_backward=None,
-                  occlusion_backward=None, weights=None, temporal_weight=None, quality=None,
-                  progress: ProgressFn = None, **engine):
+                  occlusion_backward=None, previous_field=None, weights=None, temporal_weight=None, quality=None,
+                  warm_start=None, progress: ProgressFn = None, **engine):
     """One StyLit frame from arrays: ``exemplar`` and ``target`` map guide names
     (FULL, LDE, ...) to linear (H, W, 3) arrays as in a guide cache (they are
     tone-mapped here). Give ``previous`` (the previous stylized frame) with the
     target's ``velocity_backward`` and ``occlusion_backward`` to add the
-    temporal guide. Returns (image, stats)."""
+    temporal guide; with ``warm_start=True``, give the previous frame's
+    ``stats["field"]`` as ``previous_field`` (and the motion) to start from its
+    matches. Returns (image, stats); stats["field"] holds the final matches
+    (H, W, 2 source positions)."""
     temporal = None
-    if previous is not None:
+    if previous is not None or previous_field is not None:
         if velocity_backward is None or occlusion_backward is None:
-            raise ValueError("previous needs velocity_backward and occlusion_backward")
-        temporal = dict(previous=_float(previous), velocity_backward=_float(velocity_backward),
-                        occlusion_backward=_float(occlusion_backward))
-    opts = options(weights, temporal_weight=temporal_weight, quality=quality, **engine)
+            raise ValueError("previous and previous_field need velocity_backward and occlusion_backward")
+        temporal = dict(velocity_backward=_float(velocity_backward), occlusion_backward=_float(occlusion_backward))
+        if previous is not None:
+            temporal["previous"] = _float(previous)
+        if previous_field is not None:
+            temporal["previous_field"] = _float(previous_field)
+    opts = options(weights, temporal_weight=temporal_weight, quality=quality, warm_start=warm_start, **engine)
     return _native.stylize_frame(_float(style), {k: _float(v) for k, v in exemplar.items()},
                                  {k: _float(v) for k, v in target.items()}, opts, temporal, progress)
 

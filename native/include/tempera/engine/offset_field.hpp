@@ -60,4 +60,10 @@ OffsetField resample_field(const OffsetField& from, const SourceLayout& from_lay
 // Distances are +inf.
 OffsetField advect_field(const OffsetField& previous, const ImageView& velocity_backward, const FieldGeometry& at);
 
+// A field's source positions (x + rx, y + ry) as a 2-channel float image,
+// and back (distances +inf): what a warm start of the next frame needs,
+// exactly, through an EXR file or numpy.
+Image field_positions(const OffsetField& field);
+OffsetField field_from_positions(const ImageView& positions);
+
 }  // namespace tempera

@@ -95,4 +95,14 @@ using ProgressCallback = std::function<bool(double)>;
 SynthesisResult synthesize(const SynthesisInput& input, const SynthesisOptions& options,
                            const ProgressCallback& progress = {});
 
+// A warm start along a shot (issue 32): the finest level alone, started from
+// the previous frame's final field advected along the target's V- (pixels,
+// x right, y down; Solver::advect), instead of coarse to fine from a cold
+// start. `previous_field` is the finest level's size. The finest level runs
+// the options' iterations for level 0. Reported like synthesize(), with one
+// level.
+SynthesisResult synthesize_warm(const SynthesisInput& input, const SynthesisOptions& options,
+                                const OffsetField& previous_field, const ImageView& velocity_backward,
+                                const ProgressCallback& progress = {});
+
 }  // namespace tempera

@@ -2,13 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <chrono>
 #include <deque>
 
 #include "tempera/engine/error.hpp"
 #include "tempera/engine/patch_distance.hpp"  // sample_bilinear
 #include "tempera/engine/pyramid.hpp"
-#include "tempera/engine/solver.hpp"
 
 namespace tempera {
 
@@ -236,30 +234,6 @@ SynthesisInput fluid_synthesis_input(const FluidFrameInput& in, const AlphaSegme
   return si;
 }
 
-// The engine's coarse-to-fine solve, or with a warm start only the finest
-// level from the previous frame's field advected along F^{t-1} (the
-// semi-Lagrangian stand-in for V-, as for the advected output).
-SynthesisResult solve(const SynthesisInput& si, const SynthesisOptions& engine, const FluidFrameInput& in,
-                      bool warm, const ProgressCallback& progress) {
-  if (!warm) return synthesize(si, engine, progress);
-  const auto t0 = std::chrono::steady_clock::now();
-  const Solver solver(si, engine);
-  if (in.previous_field->width != in.target_alpha.width || in.previous_field->height != in.target_alpha.height)
-    throw ValueError(concat("the previous frame's field is ", in.previous_field->width, "x", in.previous_field->height,
-                            " but the target alpha is ", in.target_alpha.width, "x", in.target_alpha.height));
-  const OffsetField start = solver.advect(*in.previous_field, 0, in.flow_previous);
-  LevelResult level = solver.solve_level(0, {&start}, progress);
-  SynthesisResult r;
-  r.image = std::move(level.image);
-  r.field = std::move(level.field);
-  r.layout = solver.layout(0);
-  r.source_coverage = level.stats.source_coverage;
-  r.levels = {level.stats};
-  r.guide_channels = solver.guide_channels();
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return r;
-}
-
 }  // namespace
 
 FluidFrameResult stylize_fluid_frame(const FluidFrameInput& in, const LazyFluidsOptions& o,
@@ -285,7 +259,10 @@ FluidFrameResult stylize_fluid_frame(const FluidFrameInput& in, const LazyFluids
   engine.levels = fluid_levels(alpha_segments(channel(in.style, kAlpha).view(), segment_options(o)), target, engine);
   const bool warm = o.warm_start && in.previous_field && !in.previous_field->x.empty();
   if (warm) require_channels(in.flow_previous, 2, "previous flow");
-  result.synthesis = solve(si, engine, in, warm, progress);
+  // Warm: the finest level from the previous frame's field advected along
+  // F^{t-1} (the semi-Lagrangian stand-in for V-, as for the advected output).
+  result.synthesis = warm ? synthesize_warm(si, engine, *in.previous_field, in.flow_previous, progress)
+                          : synthesize(si, engine, progress);
   result.image = Image::copy_of(result.synthesis.image.view());
   clear_outside(result.image, target.labels);
   return result;

@@ -63,21 +63,6 @@ std::string frame_list(const std::vector<int>& frames) {
   return out;
 }
 
-// A field's source positions (x + rx, y + ry) as a 2-channel float image,
-// and back: what a warm start of the next frame needs, exactly.
-Image field_positions(const OffsetField& field) {
-  Image out(field.width, field.height, 2);
-  for (std::size_t i = 0; i < out.pixel_count(); ++i)
-    out.data()[2 * i] = field.position_x(i), out.data()[2 * i + 1] = field.position_y(i);
-  return out;
-}
-
-OffsetField field_from_positions(const Image& positions) {
-  OffsetField field(positions.width(), positions.height());
-  for (std::size_t i = 0; i < positions.pixel_count(); ++i)
-    field.set_position(i, positions.data()[2 * i], positions.data()[2 * i + 1]);
-  return field;
-}
 
 void check_config(const LazyFluidsJobConfig& c) {
   validate(c.options);
@@ -211,7 +196,7 @@ FrameResult LazyFluidsJob::make_frame(std::size_t index, const ProgressCallback&
   OffsetField previous_field;
   std::error_code ec;
   if (index > 0 && config_.options.warm_start && fs::is_regular_file(field_path(f - 1), ec)) {
-    previous_field = field_from_positions(read_image(field_path(f - 1)));
+    previous_field = field_from_positions(read_image(field_path(f - 1)).view());
     in.previous_field = &previous_field;
     in.flow_previous = flow_previous.view();
   }

@@ -65,17 +65,24 @@ py::tuple stylize_frame_py(const FloatArray& style, const py::dict& exemplar, co
   std::vector<FloatArray> keep;
   const GuideFrame ex = guide_frame(exemplar, "exemplar", keep), tg = guide_frame(target, "target", keep);
   TemporalInput t;
+  OffsetField previous_field;
   const bool has_temporal = !temporal.is_none();
   if (has_temporal) {
     const py::dict d = temporal.cast<py::dict>();
-    reject_unknown(d, {"previous", "velocity_backward", "occlusion_backward"}, "temporal");
-    for (const char* key : {"previous", "velocity_backward", "occlusion_backward"}) {
+    reject_unknown(d, {"previous", "velocity_backward", "occlusion_backward", "previous_field"}, "temporal");
+    for (const char* key : {"velocity_backward", "occlusion_backward"})
       if (!d.contains(key)) throw ValueError(concat("temporal needs '", key, "'"));
+    auto view = [&](const char* key) {
       keep.push_back(d[key].cast<FloatArray>());
+      return py_bridge::view_of(keep.back(), key);
+    };
+    t.velocity_backward = view("velocity_backward");
+    t.occlusion_backward = view("occlusion_backward");
+    if (d.contains("previous")) t.previous = view("previous");
+    if (d.contains("previous_field")) {
+      previous_field = field_from_positions(view("previous_field"));
+      t.previous_field = &previous_field;
     }
-    const std::size_t n = keep.size();
-    t = {py_bridge::view_of(keep[n - 3], "previous"), py_bridge::view_of(keep[n - 2], "velocity_backward"),
-         py_bridge::view_of(keep[n - 1], "occlusion_backward")};
   }
   const ImageView style_view = py_bridge::view_of(style, "style");
   const ProgressCallback callback = py_bridge::python_progress(progress);
@@ -92,6 +99,8 @@ py::tuple stylize_frame_py(const FloatArray& style, const py::dict& exemplar, co
   stats["final_energy"] = result.levels.empty() || result.levels.back().energy.empty()
                               ? 0.0
                               : double(result.levels.back().energy.back());
+  // The final matches as source positions (H, W, 2): the next frame's `previous_field`.
+  stats["field"] = py_bridge::to_numpy(field_positions(result.field));
   return py::make_tuple(py_bridge::to_numpy(std::move(result.image)), stats);
 }
 

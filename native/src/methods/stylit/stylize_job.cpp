@@ -20,6 +20,7 @@ namespace {
 
 constexpr const char* kReportName = "tempera_stylize.json";
 constexpr const char* kReportFormat = "tempera-stylize 2";
+constexpr const char* kFieldFolder = "tempera_stylize";  // warm start: each frame's final matches
 
 // Canonical text of everything that changes a stylized frame but the files.
 // Threads are left out: the engine's result does not depend on them.
@@ -33,6 +34,7 @@ std::string settings_text(const StylizeJobConfig& c) {
   // Frames with the temporal guide are matched on fixed-point features since
   // 2026-12-05 (engine_options): those made before are made again.
   if (c.stylit.temporal_weight > 0 && o.fixed_point_weights) s << ";weights=fixed";
+  if (c.stylit.warm_start) s << ";warm_start";  // absent when off: the keys of cold frames stay as they were
   return s.str();
 }
 
@@ -55,6 +57,8 @@ StylizeJob::StylizeJob(StylizeJobConfig config)
       shot_(checked_shot(config_, warnings_)) {
   check_temporal_guides();
   shot_.inputs().refuse_file(report_path());  // nothing may be written onto an input: refuse before anything is
+  if (config_.stylit.warm_start)
+    for (int frame : config_.frames) shot_.inputs().refuse_file(field_path(frame));
   shot_.prepare_output();
   settings_ = settings_text(config_);
   const std::string base = hash_hex(settings_ + "\n" + file_stamp(config_.exemplar) + "\n" + file_stamp(shot_.exemplar_path()));
@@ -65,17 +69,23 @@ StylizeJob::StylizeJob(StylizeJobConfig config)
     keys_.push_back(hash_hex(concat(base, "\n", frame, "\n", file_stamp(shot_.target_path(frame)))));
 }
 
-// The temporal guide needs the motion guides of every frame that follows
-// its predecessor (the light-path guides are checked by the shot).
+// The temporal guide and the warm start need the motion guides of every
+// frame that follows its predecessor (the light-path guides are checked by
+// the shot).
 void StylizeJob::check_temporal_guides() const {
-  if (config_.stylit.temporal_weight <= 0) return;
+  if (config_.stylit.temporal_weight <= 0 && !config_.stylit.warm_start) return;
+  const char* what = config_.stylit.temporal_weight > 0 ? "the temporal guide" : "the warm start";
   for (std::size_t i = 0; i < config_.frames.size(); ++i)
     if (!shot_.has_motion(i) && has_temporal_predecessor(i))
-      throw ValueError(concat("the temporal guide needs velocity_backward and occlusion_backward, missing from '",
+      throw ValueError(concat(what, " needs velocity_backward and occlusion_backward, missing from '",
                               shot_.target_path(config_.frames[i]), "'"));
 }
 
 std::string StylizeJob::report_path() const { return report_.path(); }
+
+std::string StylizeJob::field_path(int frame) const {
+  return (fs::path(config_.out) / kFieldFolder / frame_file("field_", frame, "exr")).string();
+}
 
 // Velocities of frame f point to frame f - 1, so only that frame can be chained.
 bool StylizeJob::has_temporal_predecessor(std::size_t index) const {
@@ -94,7 +104,9 @@ FrameResult StylizeJob::run_frame(std::size_t index, const ProgressCallback& pro
   if (config_.resume) {
     // Current: same key, and the file is the one written (size and checksum),
     // so a truncated or overwritten output is made again.
-    if (const auto done = report_.current(result.frame, keys_[index], result.path, warnings_)) {
+    // A warm start's next frame reads this frame's matches: without them it is made again.
+    const auto done = report_.current(result.frame, keys_[index], result.path, warnings_);
+    if (done && (!config_.stylit.warm_start || fs::is_regular_file(field_path(result.frame), ec))) {
       result.status = "skipped";
       result.flicker = done->flicker;
       result.source_coverage = done->source_coverage;
@@ -105,18 +117,35 @@ FrameResult StylizeJob::run_frame(std::size_t index, const ProgressCallback& pro
   if (shot_.has_motion(index)) names.insert(names.end(), {"velocity_backward", "occlusion_backward"});
   const GuideFrame target = GuideFrame::read(shot_.target_path(result.frame), names);
 
-  // The predecessor as written to disk, whether made now or in an earlier run:
-  // a resumed sequence then continues exactly like an uninterrupted one.
+  // The predecessor (and its matches) as written to disk, whether made now
+  // or in an earlier run: a resumed sequence then continues exactly like an
+  // uninterrupted one.
   Image previous;
-  const std::string previous_path = index > 0 ? output_path(config_.frames[index - 1]) : "";
-  if (has_temporal_predecessor(index) && shot_.has_motion(index) && fs::is_regular_file(previous_path, ec))
-    previous = read_image(previous_path);
+  OffsetField previous_field;
+  const bool chained = has_temporal_predecessor(index) && shot_.has_motion(index);
+  if (chained) {  // the temporal guide's, and the flicker figure's
+    const std::string path = output_path(config_.frames[index - 1]);
+    if (fs::is_regular_file(path, ec)) previous = read_image(path);
+  }
+  if (chained && config_.stylit.warm_start) {
+    const std::string path = field_path(config_.frames[index - 1]);
+    if (fs::is_regular_file(path, ec)) previous_field = field_from_positions(read_image(path).view());
+  }
   TemporalInput temporal;
-  if (!previous.empty())
-    temporal = {previous.view(), target.get("velocity_backward").view(), target.get("occlusion_backward").view()};
+  const bool has_temporal = !previous.empty() || !previous_field.x.empty();
+  if (has_temporal) {
+    temporal.previous = previous.view();
+    temporal.velocity_backward = target.get("velocity_backward").view();
+    temporal.occlusion_backward = target.get("occlusion_backward").view();
+    if (!previous_field.x.empty()) temporal.previous_field = &previous_field;
+  }
 
-  SynthesisResult synth = stylize_frame(shot_.style().view(), shot_.exemplar(), target, previous.empty() ? nullptr : &temporal,
-                                        config_.stylit, progress);
+  SynthesisResult synth = stylize_frame(shot_.style().view(), shot_.exemplar(), target,
+                                        has_temporal ? &temporal : nullptr, config_.stylit, progress);
+  if (config_.stylit.warm_start) {  // before the frame: a frame on disk always has its matches
+    create_output_folder((fs::path(config_.out) / kFieldFolder).string());
+    write_image(field_path(result.frame), field_positions(synth.field).view());
+  }
   write_image(result.path, synth.image.view());
   result.status = "stylized";
   result.source_coverage = synth.source_coverage;

@@ -34,6 +34,10 @@ struct StylitOptions {
   // (settings.PANEL_TEMPORAL_WEIGHT).
   float temporal_weight = 0.0f;
   Quality quality = Quality::Final;
+  // Frames after the first start from the previous frame's matches advected
+  // along the motion and solve the finest level alone (synthesize_warm):
+  // needs the previous frame's field (TemporalInput::previous_field).
+  bool warm_start = false;
   // Engine options. usage, patch_size, seed, threads (and anything else) are
   // taken as they are, except that the quality preset sets the iteration counts.
   SynthesisOptions synthesis;
@@ -51,7 +55,10 @@ inline const auto& stylit_option_table() {
             "let the paint stick and smear; 0 stylizes each frame on its own (0.5 typical)",
             0.0),
       field(&S::quality, "quality", "quality",
-            "solver effort per frame: preview is about 5x faster, for trying settings"));
+            "solver effort per frame: preview is about 5x faster, for trying settings"),
+      field(&S::warm_start, "warm_start", "warm-start",
+            "frames after the first start from the previous frame's matches moved along the rendered motion and "
+            "solve only at full size (chains the frames, as the temporal guide does)"));
   return table;
 }
 
@@ -67,10 +74,15 @@ struct TemporalInput {
   ImageView previous;            // previous stylized frame: target size, style channels
   ImageView velocity_backward;   // target's V-: 2 channels, pixels (x right, y down)
   ImageView occlusion_backward;  // target's χ-: 1 channel, 1 = visible in the previous frame
+  // The previous frame's final matches (SynthesisResult::field), for a warm
+  // start; null: a cold start.
+  const OffsetField* previous_field = nullptr;
 };
 
 // One stylized frame. `style` is the painting, the size of the exemplar's
-// guides. `temporal` may be null (first frame, or temporal_weight 0).
+// guides. `temporal` may be null (first frame, or temporal_weight 0 without
+// a warm start); `previous` is only read for a temporal weight > 0, and
+// `previous_field` only with warm_start.
 // The result carries the engine's statistics (seconds, source coverage, ...).
 SynthesisResult stylize_frame(const ImageView& style, const GuideFrame& exemplar, const GuideFrame& target,
                               const TemporalInput* temporal, const StylitOptions& options,

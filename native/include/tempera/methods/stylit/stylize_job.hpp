@@ -37,6 +37,8 @@ class StylizeJob : public FrameJob {
   const JobInputs& inputs() const override { return shot_.inputs(); }
   std::string output_path(int frame) const override { return shot_.output_path(frame); }
   std::string report_path() const;
+  // With warm_start: the frame's final matches (source positions), read by the next frame.
+  std::string field_path(int frame) const;
   // The painting, the exemplar's guides and the shot's frames, as read and checked.
   const LightPathShot& shot() const { return shot_; }
 
