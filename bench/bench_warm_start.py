@@ -7,7 +7,7 @@ see the same machine load.
 
     PYTHONPATH=addon /usr/bin/python3 bench/bench_warm_start.py --guides GUIDE_CACHE \\
         --exemplar PAINTING (--exemplar-guides GUIDE_CACHE | --exemplar-pngs DIR) [--frames 1-8] \\
-        [--exemplar-shrink 2] [--temporal 0.5] [--variants cold,warm] [--json out.json]
+        [--exemplar-shrink 2] [--temporal 0.5] [--variants cold,warm] [--json out.json] [--save DIR]
 
 --exemplar-pngs reads StyLit guides rendered elsewhere as display PNGs in
 ebsynth's naming (jamriska/ebsynth examples/stylit: source_fullgi.png,
@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tempera import read_image
+from tempera import read_image, write_image
 from tempera.app import guide_cache
 from tempera.app.frames import parse_frames
 from tempera.engine import temporal
@@ -39,7 +39,7 @@ GUIDES = ["FULL", "LDE", "LSE", "LDDE"]
 MOTION = ["velocity_backward", "occlusion_backward"]
 EBSYNTH_PNGS = {"FULL": "source_fullgi.png", "LDE": "source_dirdif.png", "LSE": "source_dirspc.png",
                 "LDDE": "source_indirb.png"}
-VARIANTS = {"cold": {}, "warm": {"warm_start": True}}
+VARIANTS = {"cold": {"warm_start": "off"}, "warm": {"warm_start": "on"}}
 
 
 def exemplar_from_pngs(folder):
@@ -78,6 +78,7 @@ def main():
     parser.add_argument("--variants", default="cold,warm")
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--json")
+    parser.add_argument("--save", help="folder: each variant's frames as VARIANT_NNNN.png")
     args = parser.parse_args()
     variants = args.variants.split(",")
     style = np.asarray(read_image(args.exemplar), np.float32)[:, :, :3]
@@ -111,6 +112,9 @@ def main():
             warp = (temporal.flicker(prev["image"], image, target["velocity_backward"],
                                      target["occlusion_backward"]) if prev else float("nan"))
             images[variant] = image
+            if args.save:
+                Path(args.save).mkdir(parents=True, exist_ok=True)
+                write_image(str(Path(args.save) / f"{variant}_{frame:04d}.png"), np.clip(image, 0, 1))
             state[variant] = {"image": image, "field": stats["field"]}
             apart = float(np.abs(images["cold"] - image).mean()) if "cold" in images else float("nan")
             row = dict(frame=frame, variant=variant, seconds=seconds, energy=stats["final_energy"], warp=warp,

@@ -187,7 +187,8 @@ def test_output_panel_draws_settings_with_the_frames_by_the_buttons():
     props = [name for kind, name in calls if kind == "prop"]
     labels = [text for kind, text in calls if kind == "label"]
     assert props == ["guide_frame_range", "exemplar_source", "weight_full", "weight_lde", "weight_lse",
-                     "weight_ldde", "weight_ld12e", "method", "quality", "usage", "temporal_weight", "patch_size", "seed",
+                     "weight_ldde", "weight_ld12e", "method", "quality", "usage", "temporal_weight", "warm_start", "patch_size",
+                     "seed",
                      "noise_level",
                      "output_dir", "output_format", "make_video", "load_result",
                      "guide_dir", "guide_samples",

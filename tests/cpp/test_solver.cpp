@@ -175,6 +175,22 @@ TEST(Solver, SynthesizeWarmStartsFromThePreviousFieldAdvected) {
   const SynthesisResult cold = synthesize(in, opt);  // the same options from a cold start: no such shift
   EXPECT_GT(std::abs(horizontal_shift(first.image, cold.image, 6, 8) - 3.0), 1.0);
   EXPECT_THROW(synthesize_warm(in, opt, OffsetField(w - 1, h), velocity.view()), ValueError);
+  // Pixels not visible in the previous frame (a band) restart at random; the others carry their match.
+  Image visible(w, h, 1, 1.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 30; x < 40; ++x) visible.at(x, y, 0) = 0.0f;
+  const SynthesisResult restarted = synthesize_warm(in, opt, first.field, velocity.view(), visible.view());
+  int carried_inside = 0, carried_outside = 0, outside = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 3; x < w; ++x) {
+      const std::size_t i = restarted.field.index(x, y), p = first.field.index(x - 3, y);
+      const bool carried = restarted.field.x[i] == first.field.x[p] && restarted.field.y[i] == first.field.y[p];
+      if (x >= 30 && x < 40) carried_inside += carried;
+      else carried_outside += carried, ++outside;
+    }
+  EXPECT_LT(carried_inside, h * 10 / 20);
+  EXPECT_EQ(carried_outside, outside);
+  EXPECT_THROW(synthesize_warm(in, opt, first.field, velocity.view(), Image(w, h - 1, 1).view()), ValueError);
   // A field through its positions image (what the jobs write) comes back the same.
   const OffsetField back = field_from_positions(field_positions(first.field).view());
   for (std::size_t i = 0; i < back.x.size(); ++i) {

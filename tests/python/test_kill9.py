@@ -1,6 +1,7 @@
 """Issue 18: `kill -9` at any moment of a `tempera stylize` run leaves only
 complete frames, and the rerun produces exactly the frames of a run that was
-never interrupted (temporal guide on, so each frame depends on the last)."""
+never interrupted (temporal guide on, so each frame depends on the last, and
+warm-started from the last one's matches)."""
 import os
 import signal
 import subprocess
@@ -70,8 +71,13 @@ def test_sigkill_leaves_complete_frames_and_the_rerun_matches(cli_path, shot, tm
     assert again.returncode == 0, again.stderr
     for f, image in frames_of(tmp_path).items():
         np.testing.assert_array_equal(image, reference[f], err_msg=f"frame {f} after a kill {moment}")
-    visible = [x.name for x in (tmp_path / "frames").iterdir() if not x.name.startswith(".")]
-    assert sorted(visible) == sorted([f"frame_{f:04d}.png" for f in FRAMES] + ["tempera_stylize.json"])
+    def visible(folder):
+        return sorted(x.name for x in folder.iterdir() if not x.name.startswith("."))
+
+    assert visible(tmp_path / "frames") == sorted([f"frame_{f:04d}.png" for f in FRAMES]
+                                                  + ["tempera_stylize.json", "tempera_stylize"])
+    # The warm start's matches (the temporal guide warm-starts by default), one file per frame.
+    assert visible(tmp_path / "frames" / "tempera_stylize") == [f"field_{f:04d}.exr" for f in FRAMES]
 
 
 def test_temporaries_of_killed_writers_are_removed_once_stale(cli_path, shot, tmp_path):

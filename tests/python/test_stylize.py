@@ -200,38 +200,44 @@ def test_warm_start_carries_the_matches_along_the_motion():
 
     common = dict(previous=image, velocity_backward=velocity, occlusion_backward=visible, temporal_weight=0.5,
                   threads=2)
-    _, warm = stylize_frame(style, first_guides, next_guides, previous_field=stats["field"], warm_start=True,
+    _, warm = stylize_frame(style, first_guides, next_guides, previous_field=stats["field"], warm_start="on",
                             **common)
-    _, cold = stylize_frame(style, first_guides, next_guides, **common)
+    _, cold = stylize_frame(style, first_guides, next_guides, warm_start="off", **common)
     assert held(warm["field"]) > 0.5 and held(warm["field"]) > held(cold["field"]) + 0.2
     with pytest.raises(ValueError, match="field"):
-        stylize_frame(style, first_guides, next_guides, previous_field=stats["field"][:-1], warm_start=True,
+        stylize_frame(style, first_guides, next_guides, previous_field=stats["field"][:-1], warm_start="on",
                       **common)
 
 
 def test_warm_start_job_resumes_like_an_uninterrupted_run(inputs):
-    whole = job(inputs, temporal_weight=0.5, warm_start=True, threads=2)
+    whole = job(inputs, temporal_weight=0.5, warm_start="on", threads=2)
     assert [whole.run_frame(i)["status"] for i in range(3)] == ["stylized"] * 3
     fields = inputs / "out" / "tempera_stylize"
     assert sorted(f.name for f in fields.iterdir()) == [f"field_000{f}.exr" for f in (1, 2, 3)]
     uninterrupted = [tempera.read_image(whole.output_path(f)) for f in (1, 2, 3)]
 
     cold = StylizeJob(inputs / "paint.png", inputs / "exemplar", inputs / "cache", [1, 2, 3], inputs / "cold",
-                      temporal_weight=0.5, threads=2)
+                      temporal_weight=0.5, warm_start="off", threads=2)
     [cold.run_frame(i) for i in range(3)]
     assert np.abs(tempera.read_image(cold.output_path(3)) - uninterrupted[2]).max() > 0.05  # the warm start counts
     assert not (inputs / "cold" / "tempera_stylize").exists()
+    # auto, the default, warm-starts only with the temporal guide.
+    for weight, warm in ((0.0, None), (0.0, "on")):
+        j = StylizeJob(inputs / "paint.png", inputs / "exemplar", inputs / "cache", [1, 2], inputs / f"t0{warm}",
+                       temporal_weight=weight, warm_start=warm, threads=2)
+        [j.run_frame(i) for i in range(2)]
+        assert (inputs / f"t0{warm}" / "tempera_stylize").exists() == (warm == "on")
 
     # Interrupted after frame 2 (frame 3 and its matches gone), then resumed.
     (inputs / "out" / "frame_0003.png").unlink()
     (fields / "field_0003.exr").unlink()
-    resumed = job(inputs, temporal_weight=0.5, warm_start=True, threads=2)
+    resumed = job(inputs, temporal_weight=0.5, warm_start="on", threads=2)
     assert [resumed.run_frame(i)["status"] for i in range(3)] == ["skipped", "skipped", "stylized"]
     np.testing.assert_array_equal(tempera.read_image(resumed.output_path(3)), uninterrupted[2])
     # A frame whose matches are gone is made again: the next one starts from them.
     (fields / "field_0002.exr").unlink()
-    again = job(inputs, temporal_weight=0.5, warm_start=True, threads=2)
+    again = job(inputs, temporal_weight=0.5, warm_start="on", threads=2)
     assert again.run_frame(1)["status"] == "stylized" and (fields / "field_0002.exr").exists()
-    # Switching the warm start off makes the frames again, cold.
-    off = job(inputs, temporal_weight=0.5, threads=2)
-    assert off.run_frame(1)["status"] == "stylized"
+    # With the temporal guide the warm start is the default; switched off, the frames are made again, cold.
+    assert [job(inputs, temporal_weight=0.5, threads=2).run_frame(i)["status"] for i in range(3)] == ["skipped"] * 3
+    assert job(inputs, temporal_weight=0.5, warm_start="off", threads=2).run_frame(1)["status"] == "stylized"

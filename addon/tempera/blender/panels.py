@@ -135,13 +135,15 @@ def draw_synthesis(box, settings):
         draw_light_path_settings(box, settings)
 
 
-def draw_light_path_settings(box, settings):
-    """The light-path methods' settings (StyLit's, which the coherent method shares) and the Temporal
-    Noise pass after them."""
+def draw_light_path_settings(box, settings, warm_start=True):
+    """The light-path methods' settings (StyLit's, which the coherent method shares but for the warm
+    start: its sweeps carry their own) and the Temporal Noise pass after them."""
     col = box.column()
     col.prop(settings, "quality")
     col.prop(settings, "usage")
     wide_prop(col, settings, "temporal_weight")
+    if warm_start:
+        col.prop(settings, "warm_start")
     col.prop(settings, "patch_size")
     col.prop(settings, "seed")
     noise_pass.draw(box, settings)

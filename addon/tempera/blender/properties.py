@@ -52,6 +52,12 @@ QUALITY_ITEMS = (
     ("preview", "Preview", "Fewer solver iterations: quick look at a frame"),
     ("final", "Final", "Full solver iterations"),
 )
+WARM_START_ITEMS = (
+    ("auto", "Auto", "Start each frame from the previous one's matches when Temporal Coherence is above 0 "
+                     "(about 3.5x faster, steadier)"),
+    ("on", "On", "Always start from the previous frame's matches: faster, and less boil at Temporal Coherence 0"),
+    ("off", "Off", "Solve every frame from scratch"),
+)
 FORMAT_ITEMS = (
     ("png", "PNG", "8-bit sRGB PNG frames"),
     ("exr", "OpenEXR", "32-bit float EXR frames (the painting's values, unclamped)"),
@@ -251,6 +257,9 @@ class TemperaSettings(PropertyGroup):
         min=limits.STYLIT_OPTIONS["temporal_weight"]["min"],
         soft_max=2.0,
     )
+    warm_start: EnumProperty(name="Warm Start", items=WARM_START_ITEMS,
+                             default=limits.STYLIT_OPTIONS["warm_start"]["default"],
+                             description=tooltip(limits.STYLIT_OPTIONS["warm_start"]))
     output_format: EnumProperty(name="Format", items=FORMAT_ITEMS, default="png",
                                 description="File format of the stylized frames")
     make_video: BoolProperty(name="Video (mp4)", default=True,

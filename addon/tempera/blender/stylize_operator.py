@@ -55,6 +55,7 @@ def stylize_options(settings):
     return {
         "weights": {guide: float(getattr(settings, prop)) for guide, prop in WEIGHT_PROPERTIES.items()},
         "temporal_weight": float(settings.temporal_weight),
+        "warm_start": settings.warm_start,
         "quality": settings.quality,
         "usage": settings.usage,
         "patch_size": limits.odd_patch_size(settings.patch_size),

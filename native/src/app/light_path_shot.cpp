@@ -1,7 +1,6 @@
 #include "tempera/app/light_path_shot.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 
@@ -39,22 +38,6 @@ Image fit_painting(Image painting, const std::string& path, int width, int heigh
   warnings.push_back(concat("the painting '", path, "' is ", painting.width(), "x", painting.height(),
                             "; resampled to the exemplar guides' ", width, "x", height));
   return resize_image(painting.view(), width, height);
-}
-
-// Temporary files (".<name>.tmp<pid>-<random>...") of writers killed with -9.
-// A live writer holds one for the seconds an image takes to write, so one
-// older than an hour is dead; it is never read, only removed here.
-void remove_stale_temporaries(const std::string& folder) {
-  std::error_code ec;
-  const auto now = fs::file_time_type::clock::now();
-  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
-    const std::string name = it->path().filename().string();
-    if (name.size() < 2 || name[0] != '.' || name.find(".tmp") == std::string::npos) continue;
-    std::error_code stat_ec;
-    const auto written = fs::last_write_time(it->path(), stat_ec);
-    if (!stat_ec && now - written > std::chrono::hours(1) && fs::is_regular_file(it->path(), stat_ec))
-      fs::remove(it->path(), stat_ec);
-  }
 }
 
 bool has_guide(const ImageFileInfo& info, const std::string& guide) {

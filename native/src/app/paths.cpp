@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -25,6 +26,19 @@ bool same_path(const std::string& a, const std::string& b) {
   const fs::path ca = fs::weakly_canonical(fs::absolute(a, ec), ec);
   const fs::path cb = fs::weakly_canonical(fs::absolute(b, ec), ec);
   return ca.lexically_normal() == cb.lexically_normal();
+}
+
+void remove_stale_temporaries(const std::string& folder) {
+  std::error_code ec;
+  const auto now = fs::file_time_type::clock::now();
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() < 2 || name[0] != '.' || name.find(".tmp") == std::string::npos) continue;
+    std::error_code stat_ec;
+    const auto written = fs::last_write_time(it->path(), stat_ec);
+    if (!stat_ec && now - written > std::chrono::hours(1) && fs::is_regular_file(it->path(), stat_ec))
+      fs::remove(it->path(), stat_ec);
+  }
 }
 
 void create_output_folder(const std::string& folder) {

@@ -87,6 +87,17 @@ struct Matcher {
 
 }  // namespace
 
+namespace {
+
+// Target i's random source (random_field's draw).
+std::int32_t random_source(const SearchConstraints& cons, std::size_t i, std::uint64_t seed) {
+  Rng rng(seed, i);
+  const auto& pool = cons.valid_by_segment[cons.segment_of_target(i)];
+  return pool[rng.below(int(pool.size()))];
+}
+
+}  // namespace
+
 void random_field(const PatchSpace& space, const SearchConstraints& cons, OffsetField& field, std::uint64_t seed,
                   int threads) {
   const int tw = space.target->width, th = space.target->height;
@@ -95,14 +106,26 @@ void random_field(const PatchSpace& space, const SearchConstraints& cons, Offset
     for (int tx = 0; tx < tw; ++tx) {
       const std::size_t i = field.index(tx, ty);
       if (!cons.target_active[i]) continue;
-      Rng rng(seed, i);
-      const auto& pool = cons.valid_by_segment[cons.segment_of_target(i)];
-      const std::int32_t s = pool[rng.below(int(pool.size()))];
+      const std::int32_t s = random_source(cons, i, seed);
       field.x[i] = s % space.source->width;
       field.y[i] = s / space.source->width;
       field.dist[i] = patch_distance(space, field.x[i], field.y[i], tx, ty, kInf);
     }
   });
+}
+
+void restart_pixels(const PatchSpace& space, const SearchConstraints& cons, OffsetField& field,
+                    const std::vector<std::uint8_t>& restart, std::uint64_t seed) {
+  if (restart.size() != field.x.size())
+    throw ValueError(concat("restart mask has ", restart.size(), " pixels, the field ", field.x.size()));
+  for (std::size_t i = 0; i < restart.size(); ++i) {
+    if (!restart[i] || !cons.target_active[i]) continue;
+    const std::int32_t s = random_source(cons, i, seed);
+    field.x[i] = s % space.source->width;
+    field.y[i] = s / space.source->width;
+    field.rx[i] = field.ry[i] = 0.0f;
+    field.dist[i] = kInf;
+  }
 }
 
 void refresh_distances(const PatchSpace& space, const SearchConstraints& cons, OffsetField& field, int threads) {

@@ -651,6 +651,14 @@ void Solver::fix_pixels(int l, const Level& level, const Image* given, OffsetFie
 
 // Coarsest-level start without a field: match on the guides alone, since B'
 // is unknown yet; with a reference, B' is the reference and the match uses it.
+void Solver::restart_masked(const Image& mask, const Level& level, OffsetField& field) const {
+  if (mask.width() != field.width || mask.height() != field.height || mask.channels() != 1)
+    throw ValueError(concat("a restart mask must be ", field.width, "x", field.height, " with 1 channel"));
+  std::vector<std::uint8_t> restart(field.x.size());
+  for (std::size_t i = 0; i < restart.size(); ++i) restart[i] = mask.data()[i] > 0.5f;
+  restart_pixels(level.space, level.constraints, field, restart, options_.seed);
+}
+
 OffsetField Solver::cold_start(int l, Level& level, Image& bprime) const {
   const Plan& p = *plan_;
   OffsetField field;
@@ -754,6 +762,7 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
     else
       field = *given;
     legalize_field(level.space, level.constraints, field);
+    if (start.restart_mask) restart_masked(*start.restart_mask, level, field);
   } else {
     field = cold_start(l, level, bprime);
   }

@@ -58,7 +58,7 @@ SynthesisResult synthesize(const SynthesisInput& in, const SynthesisOptions& opt
 
 SynthesisResult synthesize_warm(const SynthesisInput& in, const SynthesisOptions& opt,
                                 const OffsetField& previous_field, const ImageView& velocity_backward,
-                                const ProgressCallback& progress) {
+                                const ImageView& visible, const ProgressCallback& progress) {
   const auto t_start = std::chrono::steady_clock::now();
   const Solver solver(in, opt);
   if (previous_field.width != solver.target_width(0) || previous_field.height != solver.target_height(0))
@@ -68,6 +68,15 @@ SynthesisResult synthesize_warm(const SynthesisInput& in, const SynthesisOptions
   start.last_use = true;
   OffsetField advected = solver.advect(previous_field, 0, velocity_backward);
   start.take_field = &advected;
+  Image hidden;  // χ- below 0.5: restarted
+  if (!visible.empty()) {
+    if (visible.width != advected.width || visible.height != advected.height || visible.channels != 1)
+      throw ValueError(concat("the visibility must be ", advected.width, "x", advected.height, " with 1 channel, got ",
+                              visible.width, "x", visible.height, "x", visible.channels));
+    hidden = Image(visible.width, visible.height, 1);
+    for (std::size_t i = 0; i < hidden.pixel_count(); ++i) hidden.data()[i] = visible.data[i] < 0.5f ? 1.0f : 0.0f;
+    start.restart_mask = &hidden;
+  }
   LevelResult level = solver.solve_level(0, start, progress);
   SynthesisResult result;
   result.levels = {level.stats};

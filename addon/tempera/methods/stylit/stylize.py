@@ -48,6 +48,8 @@ class StylizeJob(SheetFrameJob):
                      the motion (0 = frames independent; None = the default,
                      settings.DEFAULT_TEMPORAL_WEIGHT)
     quality          "final" (engine defaults) or "preview" (fast, for interaction)
+    warm_start       "auto" (default: with the temporal guide), "on" or "off": frames after the
+                     first start from the previous frame's matches (out/tempera_stylize/field_*.exr)
     **engine         engine options (tempera.SynthesisOptions: usage, patch_size, seed, threads, ...)
     resume           skip frames whose output is current (see docs/cli.md)
 
@@ -79,7 +81,8 @@ def stylize_frame(style, exemplar: Mapping, target: Mapping, *, previous=None, v
     (FULL, LDE, ...) to linear (H, W, 3) arrays as in a guide cache (they are
     tone-mapped here). Give ``previous`` (the previous stylized frame) with the
     target's ``velocity_backward`` and ``occlusion_backward`` to add the
-    temporal guide; with ``warm_start=True``, give the previous frame's
+    temporal guide; when the frame warm-starts (``warm_start`` "on", or "auto"
+    with a temporal weight > 0), give the previous frame's
     ``stats["field"]`` as ``previous_field`` (and the motion) to start from its
     matches. Returns (image, stats); stats["field"] holds the final matches
     (H, W, 2 source positions)."""

@@ -25,6 +25,11 @@ void refuse_output_on_inputs(const std::string& output, const std::vector<std::s
 // `folder` if it cannot be made.
 void create_output_folder(const std::string& folder);
 
+// Removes the temporary files (".<name>.tmp<pid>-<random>...") of writers
+// killed with -9 from `folder`. A live writer holds one for the seconds an
+// image takes to write, so one older than an hour is dead; it is never read.
+void remove_stale_temporaries(const std::string& folder);
+
 // An exclusive advisory lock (flock) on `path`, held until destruction: a
 // folder is locked through itself, a file is created if missing. Blocks while another process holds it. IoError naming
 // the file if it cannot be opened.

@@ -72,6 +72,12 @@ struct PatchMatchParams {
 void random_field(const PatchSpace& space, const SearchConstraints& constraints, OffsetField& field,
                   std::uint64_t seed, int threads);
 
+// The same random sources as random_field(), only where `restart` (one
+// byte per target pixel) is set; distances there +inf (refresh them). A warm
+// start's disoccluded pixels, whose advected match is that of what hid them.
+void restart_pixels(const PatchSpace& space, const SearchConstraints& constraints, OffsetField& field,
+                    const std::vector<std::uint8_t>& restart, std::uint64_t seed);
+
 // Recomputes field.dist for the current features (e.g. after voting changed B').
 void refresh_distances(const PatchSpace& space, const SearchConstraints& constraints, OffsetField& field,
                        int threads);

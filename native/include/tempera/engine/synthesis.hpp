@@ -98,11 +98,13 @@ SynthesisResult synthesize(const SynthesisInput& input, const SynthesisOptions& 
 // A warm start along a shot (issue 32): the finest level alone, started from
 // the previous frame's final field advected along the target's V- (pixels,
 // x right, y down; Solver::advect), instead of coarse to fine from a cold
-// start. `previous_field` is the finest level's size. The finest level runs
-// the options' iterations for level 0. Reported like synthesize(), with one
-// level.
+// start. `previous_field` is the finest level's size. Where `visible` (χ-:
+// 1 channel, 1 = visible in the previous frame; empty = everywhere) is
+// below 0.5 the pixel starts from a random match instead: its advected match
+// belongs to what hid it. The finest level runs the options' iterations for
+// level 0. Reported like synthesize(), with one level.
 SynthesisResult synthesize_warm(const SynthesisInput& input, const SynthesisOptions& options,
                                 const OffsetField& previous_field, const ImageView& velocity_backward,
-                                const ProgressCallback& progress = {});
+                                const ImageView& visible = {}, const ProgressCallback& progress = {});
 
 }  // namespace tempera

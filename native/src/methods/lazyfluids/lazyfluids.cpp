@@ -261,7 +261,7 @@ FluidFrameResult stylize_fluid_frame(const FluidFrameInput& in, const LazyFluids
   if (warm) require_channels(in.flow_previous, 2, "previous flow");
   // Warm: the finest level from the previous frame's field advected along
   // F^{t-1} (the semi-Lagrangian stand-in for V-, as for the advected output).
-  result.synthesis = warm ? synthesize_warm(si, engine, *in.previous_field, in.flow_previous, progress)
+  result.synthesis = warm ? synthesize_warm(si, engine, *in.previous_field, in.flow_previous, {}, progress)
                           : synthesize(si, engine, progress);
   result.image = Image::copy_of(result.synthesis.image.view());
   clear_outside(result.image, target.labels);

@@ -32,6 +32,10 @@ std::vector<std::pair<std::string, float>> active_guides(const StylitOptions& op
   return out;
 }
 
+bool warm_starts(const StylitOptions& options) {
+  return options.warm_start == WarmStart::On || (options.warm_start == WarmStart::Auto && options.temporal_weight > 0);
+}
+
 SynthesisOptions engine_options(const StylitOptions& options) {
   SynthesisOptions opt = options.synthesis;
   // The temporal guide's occlusion weights keep the fixed-point features:
@@ -82,11 +86,13 @@ SynthesisResult stylize_frame(const ImageView& style, const GuideFrame& exemplar
     in.target_weight_maps.push_back(temporal->occlusion_backward);  // disoccluded: no pull
   }
   SynthesisOptions engine = engine_options(options);
-  if (!options.warm_start || !temporal || !temporal->previous_field) return synthesize(in, engine, progress);
+  if (!warm_starts(options) || !temporal || !temporal->previous_field) return synthesize(in, engine, progress);
   require_channels(temporal->velocity_backward, 2, "velocity_backward");
   engine.em_schedule.clear();
   engine.em_iterations = std::min(engine.em_iterations, kWarmEmIterations);
-  return synthesize_warm(in, engine, *temporal->previous_field, temporal->velocity_backward, progress);
+  require_channels(temporal->occlusion_backward, 1, "occlusion_backward");
+  return synthesize_warm(in, engine, *temporal->previous_field, temporal->velocity_backward,
+                         temporal->occlusion_backward, progress);
 }
 
 double flicker(const ImageView& previous, const ImageView& current, const ImageView& velocity_backward,

@@ -34,7 +34,7 @@ std::string settings_text(const StylizeJobConfig& c) {
   // Frames with the temporal guide are matched on fixed-point features since
   // 2026-12-05 (engine_options): those made before are made again.
   if (c.stylit.temporal_weight > 0 && o.fixed_point_weights) s << ";weights=fixed";
-  if (c.stylit.warm_start) s << ";warm_start";  // absent when off: the keys of cold frames stay as they were
+  if (warm_starts(c.stylit)) s << ";warm_start";  // absent when off: the keys of cold frames stay as they were
   return s.str();
 }
 
@@ -57,8 +57,11 @@ StylizeJob::StylizeJob(StylizeJobConfig config)
       shot_(checked_shot(config_, warnings_)) {
   check_temporal_guides();
   shot_.inputs().refuse_file(report_path());  // nothing may be written onto an input: refuse before anything is
-  if (config_.stylit.warm_start)
+  if (warm_starts(config_.stylit)) {
     for (int frame : config_.frames) shot_.inputs().refuse_file(field_path(frame));
+    const std::string fields = (fs::path(config_.out) / kFieldFolder).string();
+    if (fs::is_directory(fields)) remove_stale_temporaries(fields);  // of killed writers, as in the output folder
+  }
   shot_.prepare_output();
   settings_ = settings_text(config_);
   const std::string base = hash_hex(settings_ + "\n" + file_stamp(config_.exemplar) + "\n" + file_stamp(shot_.exemplar_path()));
@@ -73,7 +76,7 @@ StylizeJob::StylizeJob(StylizeJobConfig config)
 // frame that follows its predecessor (the light-path guides are checked by
 // the shot).
 void StylizeJob::check_temporal_guides() const {
-  if (config_.stylit.temporal_weight <= 0 && !config_.stylit.warm_start) return;
+  if (config_.stylit.temporal_weight <= 0 && !warm_starts(config_.stylit)) return;
   const char* what = config_.stylit.temporal_weight > 0 ? "the temporal guide" : "the warm start";
   for (std::size_t i = 0; i < config_.frames.size(); ++i)
     if (!shot_.has_motion(i) && has_temporal_predecessor(i))
@@ -106,7 +109,7 @@ FrameResult StylizeJob::run_frame(std::size_t index, const ProgressCallback& pro
     // so a truncated or overwritten output is made again.
     // A warm start's next frame reads this frame's matches: without them it is made again.
     const auto done = report_.current(result.frame, keys_[index], result.path, warnings_);
-    if (done && (!config_.stylit.warm_start || fs::is_regular_file(field_path(result.frame), ec))) {
+    if (done && (!warm_starts(config_.stylit) || fs::is_regular_file(field_path(result.frame), ec))) {
       result.status = "skipped";
       result.flicker = done->flicker;
       result.source_coverage = done->source_coverage;
@@ -127,7 +130,7 @@ FrameResult StylizeJob::run_frame(std::size_t index, const ProgressCallback& pro
     const std::string path = output_path(config_.frames[index - 1]);
     if (fs::is_regular_file(path, ec)) previous = read_image(path);
   }
-  if (chained && config_.stylit.warm_start) {
+  if (chained && warm_starts(config_.stylit)) {
     const std::string path = field_path(config_.frames[index - 1]);
     if (fs::is_regular_file(path, ec)) previous_field = field_from_positions(read_image(path).view());
   }
@@ -142,7 +145,7 @@ FrameResult StylizeJob::run_frame(std::size_t index, const ProgressCallback& pro
 
   SynthesisResult synth = stylize_frame(shot_.style().view(), shot_.exemplar(), target,
                                         has_temporal ? &temporal : nullptr, config_.stylit, progress);
-  if (config_.stylit.warm_start) {  // before the frame: a frame on disk always has its matches
+  if (warm_starts(config_.stylit)) {  // before the frame: a frame on disk always has its matches
     create_output_folder((fs::path(config_.out) / kFieldFolder).string());
     write_image(field_path(result.frame), field_positions(synth.field).view());
   }

@@ -89,7 +89,7 @@ CLASSES = (TemperaKeyframe, TemperaLayer, *keyframes.CLASSES, *layers.CLASSES)
 def draw(box, settings):
     """The keyframes and layers, then StyLit's settings, which the method shares."""
     draw_keyframes(box, settings)
-    draw_light_path_settings(box, settings)
+    draw_light_path_settings(box, settings, warm_start=False)
 
 
 def draw_list(box, settings, items, index, add, remove, rows):

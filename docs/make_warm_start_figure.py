@@ -1,0 +1,41 @@
+"""Makes docs/images/warm_start_user_shot.png from the frames that
+bench/bench_warm_start.py --save wrote: rows cold and warm, columns the
+given frames, and below each row |frame - previous frame| x 4 of its last
+frame (dark = changed).
+
+    PYTHONPATH=addon /usr/bin/python3 docs/make_warm_start_figure.py --frames DIR [--shown 2,12,24] \\
+        [--out docs/images/warm_start_user_shot.png]
+"""
+import argparse
+from pathlib import Path
+
+import numpy as np
+
+import tempera
+
+VARIANTS = ("cold", "warm")
+
+
+def frame(folder, variant, f):
+    return np.asarray(tempera.read_image(str(Path(folder) / f"{variant}_{f:04d}.png")), np.float32)[:, :, :3]
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--frames", required=True)
+    parser.add_argument("--shown", default="2,12,24")
+    parser.add_argument("--out", default=str(Path(__file__).resolve().parent / "images" / "warm_start_user_shot.png"))
+    args = parser.parse_args()
+    shown = [int(f) for f in args.shown.split(",")]
+    tiles = []
+    for variant in VARIANTS:
+        images = [frame(args.frames, variant, f) for f in shown]
+        change = np.abs(images[-1] - frame(args.frames, variant, shown[-1] - 1))
+        tiles += images + [np.clip(1.0 - 4.0 * change.mean(axis=2, keepdims=True).repeat(3, 2), 0, 1)]
+    sheet = tempera.contact_sheet([t[::2, ::2].astype(np.float32) for t in tiles], columns=len(shown) + 1, gap=4,
+                                  margin=4, background=1.0)
+    tempera.write_image(args.out, sheet.astype(np.float32))
+
+
+if __name__ == "__main__":
+    main()
