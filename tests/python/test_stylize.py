@@ -204,6 +204,8 @@ def test_warm_start_carries_the_matches_along_the_motion():
                             **common)
     _, cold = stylize_frame(style, first_guides, next_guides, warm_start="off", **common)
     assert held(warm["field"]) > 0.5 and held(warm["field"]) > held(cold["field"]) + 0.2
+    # The warm frame solves the finest level alone, for 2 EM iterations; the cold one the pyramid.
+    assert [(s.width, len(s.energy)) for s in warm["levels"]] == [(W, 2)] and len(cold["levels"]) > 1
     with pytest.raises(ValueError, match="field"):
         stylize_frame(style, first_guides, next_guides, previous_field=stats["field"][:-1], warm_start="on",
                       **common)
@@ -221,12 +223,12 @@ def test_warm_start_job_resumes_like_an_uninterrupted_run(inputs):
     [cold.run_frame(i) for i in range(3)]
     assert np.abs(tempera.read_image(cold.output_path(3)) - uninterrupted[2]).max() > 0.05  # the warm start counts
     assert not (inputs / "cold" / "tempera_stylize").exists()
-    # auto, the default, warm-starts only with the temporal guide.
-    for weight, warm in ((0.0, None), (0.0, "on")):
-        j = StylizeJob(inputs / "paint.png", inputs / "exemplar", inputs / "cache", [1, 2], inputs / f"t0{warm}",
-                       temporal_weight=weight, warm_start=warm, threads=2)
+    # auto warm-starts only with the temporal guide; off is the default.
+    for weight, warm in ((0.0, "auto"), (0.0, "on"), (0.5, None)):
+        j = StylizeJob(inputs / "paint.png", inputs / "exemplar", inputs / "cache", [1, 2],
+                       inputs / f"t{weight}{warm}", temporal_weight=weight, warm_start=warm, threads=2)
         [j.run_frame(i) for i in range(2)]
-        assert (inputs / f"t0{warm}" / "tempera_stylize").exists() == (warm == "on")
+        assert (inputs / f"t{weight}{warm}" / "tempera_stylize").exists() == (warm == "on"), (weight, warm)
 
     # Interrupted after frame 2 (frame 3 and its matches gone), then resumed.
     (inputs / "out" / "frame_0003.png").unlink()
@@ -238,6 +240,7 @@ def test_warm_start_job_resumes_like_an_uninterrupted_run(inputs):
     (fields / "field_0002.exr").unlink()
     again = job(inputs, temporal_weight=0.5, warm_start="on", threads=2)
     assert again.run_frame(1)["status"] == "stylized" and (fields / "field_0002.exr").exists()
-    # With the temporal guide the warm start is the default; switched off, the frames are made again, cold.
-    assert [job(inputs, temporal_weight=0.5, threads=2).run_frame(i)["status"] for i in range(3)] == ["skipped"] * 3
-    assert job(inputs, temporal_weight=0.5, warm_start="off", threads=2).run_frame(1)["status"] == "stylized"
+    # auto with the temporal guide is the same warm start; switched off, the frames are made again, cold.
+    auto = job(inputs, temporal_weight=0.5, warm_start="auto", threads=2)
+    assert [auto.run_frame(i)["status"] for i in range(3)] == ["skipped"] * 3
+    assert job(inputs, temporal_weight=0.5, threads=2).run_frame(1)["status"] == "stylized"

@@ -53,10 +53,10 @@ QUALITY_ITEMS = (
     ("final", "Final", "Full solver iterations"),
 )
 WARM_START_ITEMS = (
-    ("auto", "Auto", "Start each frame from the previous one's matches when Temporal Coherence is above 0 "
-                     "(about 3.5x faster, steadier)"),
+    ("off", "Off", "Solve every frame from scratch (the default: the strokes stay crisp over long shots)"),
+    ("auto", "Auto", "Start each frame from the previous one's matches when Temporal Coherence is above 0: "
+                     "about 3.5x faster and steadier, but the strokes soften along the shot (drafts)"),
     ("on", "On", "Always start from the previous frame's matches: faster, and less boil at Temporal Coherence 0"),
-    ("off", "Off", "Solve every frame from scratch"),
 )
 FORMAT_ITEMS = (
     ("png", "PNG", "8-bit sRGB PNG frames"),

@@ -99,6 +99,7 @@ py::tuple stylize_frame_py(const FloatArray& style, const py::dict& exemplar, co
   stats["final_energy"] = result.levels.empty() || result.levels.back().energy.empty()
                               ? 0.0
                               : double(result.levels.back().energy.back());
+  stats["levels"] = py::cast(result.levels);  // per level solved, coarsest first (LevelStats)
   // The final matches as source positions (H, W, 2): the next frame's `previous_field`.
   stats["field"] = py_bridge::to_numpy(field_positions(result.field));
   return py::make_tuple(py_bridge::to_numpy(std::move(result.image)), stats);

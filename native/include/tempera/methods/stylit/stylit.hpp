@@ -27,11 +27,11 @@ struct EnumNames<Quality> {
 };
 
 // Whether frames after the first start from the previous frame's matches
-// (synthesize_warm). auto: with the temporal guide (temporal weight > 0),
-// where it measured as good: 3.6x faster, energy within 0.5%, less flicker
-// (docs/benchmarks.md, issue 32). Without the guide a warm start took the
-// frames' boil away and ended 3.5% above the cold energy, so there it is
-// asked for with on.
+// (synthesize_warm). auto: with the temporal guide (temporal weight > 0):
+// 3.4-3.6x faster, energy within 0.5%, a quarter to a half less flicker,
+// but the strokes soften along the shot (detail -4% on average, -12% by the
+// demo's frame 12; docs/benchmarks.md, issue 32), so it is not the default
+// yet. on: also without the guide (the frames' boil goes, energy +3.5%).
 enum class WarmStart { Auto, On, Off };
 template <>
 struct EnumNames<WarmStart> {
@@ -50,7 +50,7 @@ struct StylitOptions {
   // Frames after the first start from the previous frame's matches advected
   // along the motion and solve the finest level alone (synthesize_warm):
   // needs the previous frame's field (TemporalInput::previous_field).
-  WarmStart warm_start = WarmStart::Auto;
+  WarmStart warm_start = WarmStart::Off;
   // Engine options. usage, patch_size, seed, threads (and anything else) are
   // taken as they are, except that the quality preset sets the iteration counts.
   SynthesisOptions synthesis;
@@ -71,8 +71,8 @@ inline const auto& stylit_option_table() {
             "solver effort per frame: preview is about 5x faster, for trying settings"),
       field(&S::warm_start, "warm_start", "warm-start",
             "frames after the first start from the previous frame's matches moved along the rendered motion and "
-            "solve only at full size, about 3.5x faster: auto does so with the temporal guide, on also without it "
-            "(less boil; chains the frames), off never"));
+            "solve only at full size, about 3.5x faster and steadier but the strokes soften along the shot: auto "
+            "does so with the temporal guide, on also without it (less boil; chains the frames), off never"));
   return table;
 }
 
