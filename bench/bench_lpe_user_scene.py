@@ -8,14 +8,11 @@ and set up for StyLit the way Creative Flow+ sets scenes up (issue 35).
         --blend lpe_render_a.blend [...]
 
 The blend: dcharata/StyLit's Blender/blend_scenes/lpe_render_a.blend (a sphere
-on a floor before a backdrop; not redistributed here). The script lights and
-paints it as Creative Flow+'s StyLit set-up does (creativefloworg/creativeflow,
-blender/stylit_util.py; re-written here, not copied): the scene's lights are
-replaced by one point light between the camera and the sphere, to the
-camera's right, of radius 0.3 d and power 800 d W (d: the camera's distance to
-the sphere) whose own Max Bounces is 0; the sphere gets a Mix Shader of a red
-Diffuse and a red Glossy; the backdrop objects lose their materials (Cycles'
-default surface). The blend's dark world stays.
+on a floor before a backdrop; not redistributed here), lit and painted as
+Creative Flow+'s StyLit set-up does (scenes/stylit_setup.py: one soft point
+light whose own Max Bounces is 0, a red Diffuse and Glossy mix on the
+sphere, the backdrop with Cycles' default surface). The blend's dark world
+stays.
 
 Cycles renders it with the guide cache's settings and the tracer traces it,
 as blender_tests/test_lpe_gallery.py compares the gallery: FULL, LDE, LSE and

@@ -649,8 +649,6 @@ void Solver::fix_pixels(int l, const Level& level, const Image* given, OffsetFie
   }
 }
 
-// Coarsest-level start without a field: match on the guides alone, since B'
-// is unknown yet; with a reference, B' is the reference and the match uses it.
 void Solver::restart_masked(const Image& mask, const Level& level, OffsetField& field) const {
   if (mask.width() != field.width || mask.height() != field.height || mask.channels() != 1)
     throw ValueError(concat("a restart mask must be ", field.width, "x", field.height, " with 1 channel"));
@@ -659,6 +657,8 @@ void Solver::restart_masked(const Image& mask, const Level& level, OffsetField& 
   restart_pixels(level.space, level.constraints, field, restart, options_.seed);
 }
 
+// Coarsest-level start without a field: match on the guides alone, since B'
+// is unknown yet; with a reference, B' is the reference and the match uses it.
 OffsetField Solver::cold_start(int l, Level& level, Image& bprime) const {
   const Plan& p = *plan_;
   OffsetField field;

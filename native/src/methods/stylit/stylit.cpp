@@ -88,9 +88,9 @@ SynthesisResult stylize_frame(const ImageView& style, const GuideFrame& exemplar
   SynthesisOptions engine = engine_options(options);
   if (!warm_starts(options) || !temporal || !temporal->previous_field) return synthesize(in, engine, progress);
   require_channels(temporal->velocity_backward, 2, "velocity_backward");
+  require_channels(temporal->occlusion_backward, 1, "occlusion_backward");
   engine.em_schedule.clear();
   engine.em_iterations = std::min(engine.em_iterations, kWarmEmIterations);
-  require_channels(temporal->occlusion_backward, 1, "occlusion_backward");
   return synthesize_warm(in, engine, *temporal->previous_field, temporal->velocity_backward,
                          temporal->occlusion_backward, progress);
 }

@@ -59,8 +59,7 @@ StylizeJob::StylizeJob(StylizeJobConfig config)
   shot_.inputs().refuse_file(report_path());  // nothing may be written onto an input: refuse before anything is
   if (warm_starts(config_.stylit)) {
     for (int frame : config_.frames) shot_.inputs().refuse_file(field_path(frame));
-    const std::string fields = (fs::path(config_.out) / kFieldFolder).string();
-    if (fs::is_directory(fields)) remove_stale_temporaries(fields);  // of killed writers, as in the output folder
+    if (fs::is_directory(field_folder())) remove_stale_temporaries(field_folder());  // of killed writers, as in OUT
   }
   shot_.prepare_output();
   settings_ = settings_text(config_);
@@ -86,8 +85,10 @@ void StylizeJob::check_temporal_guides() const {
 
 std::string StylizeJob::report_path() const { return report_.path(); }
 
+std::string StylizeJob::field_folder() const { return (fs::path(config_.out) / kFieldFolder).string(); }
+
 std::string StylizeJob::field_path(int frame) const {
-  return (fs::path(config_.out) / kFieldFolder / frame_file("field_", frame, "exr")).string();
+  return (fs::path(field_folder()) / frame_file("field_", frame, "exr")).string();
 }
 
 // Velocities of frame f point to frame f - 1, so only that frame can be chained.
@@ -146,7 +147,7 @@ FrameResult StylizeJob::run_frame(std::size_t index, const ProgressCallback& pro
   SynthesisResult synth = stylize_frame(shot_.style().view(), shot_.exemplar(), target,
                                         has_temporal ? &temporal : nullptr, config_.stylit, progress);
   if (warm_starts(config_.stylit)) {  // before the frame: a frame on disk always has its matches
-    create_output_folder((fs::path(config_.out) / kFieldFolder).string());
+    create_output_folder(field_folder());
     write_image(field_path(result.frame), field_positions(synth.field).view());
   }
   write_image(result.path, synth.image.view());

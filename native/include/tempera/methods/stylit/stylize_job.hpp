@@ -53,6 +53,7 @@ class StylizeJob : public FrameJob {
 
  private:
   bool has_temporal_predecessor(std::size_t index) const;
+  std::string field_folder() const;  // OUT/tempera_stylize
   void check_temporal_guides() const;
 
   StylizeJobConfig config_;
