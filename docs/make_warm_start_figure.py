@@ -1,10 +1,11 @@
 """Makes docs/images/warm_start_user_shot.png from the frames that
 bench/bench_warm_start.py --save wrote: rows cold and warm, columns the
-given frames, and below each row |frame - previous frame| x 4 of its last
-frame (dark = changed).
+given frames, and at the end of each row |frame - previous frame| x 4 of its
+last frame (dark = changed). --rows DIR:VARIANT,... puts other runs' frames
+in the rows (e.g. an earlier revision's beside this one's).
 
     PYTHONPATH=addon /usr/bin/python3 docs/make_warm_start_figure.py --frames DIR [--shown 2,12,24] \\
-        [--out docs/images/warm_start_user_shot.png]
+        [--rows DIR:cold,DIR2:cold] [--out docs/images/warm_start_user_shot.png]
 """
 import argparse
 from pathlib import Path
@@ -22,15 +23,22 @@ def frame(folder, variant, f):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--frames", required=True)
+    parser.add_argument("--frames", help="the folder of the cold and warm rows")
+    parser.add_argument("--rows", help="DIR:VARIANT,... instead of --frames' cold and warm")
     parser.add_argument("--shown", default="2,12,24")
     parser.add_argument("--out", default=str(Path(__file__).resolve().parent / "images" / "warm_start_user_shot.png"))
     args = parser.parse_args()
     shown = [int(f) for f in args.shown.split(",")]
+    if args.rows:
+        rows = [tuple(row.rsplit(":", 1)) for row in args.rows.split(",")]
+    elif args.frames:
+        rows = [(args.frames, variant) for variant in VARIANTS]
+    else:
+        parser.error("give --frames or --rows")
     tiles = []
-    for variant in VARIANTS:
-        images = [frame(args.frames, variant, f) for f in shown]
-        change = np.abs(images[-1] - frame(args.frames, variant, shown[-1] - 1))
+    for folder, variant in rows:
+        images = [frame(folder, variant, f) for f in shown]
+        change = np.abs(images[-1] - frame(folder, variant, shown[-1] - 1))
         tiles += images + [np.clip(1.0 - 4.0 * change.mean(axis=2, keepdims=True).repeat(3, 2), 0, 1)]
     sheet = tempera.contact_sheet([t[::2, ::2].astype(np.float32) for t in tiles], columns=len(shown) + 1, gap=4,
                                   margin=4, background=1.0)

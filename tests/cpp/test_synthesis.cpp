@@ -314,6 +314,16 @@ TEST(ErrorKnee, FindsAStepBetweenGoodAndForcedMatches) {
   EXPECT_LE(knee, 310u);
 }
 
+TEST(ErrorKnee, ARiseAtTheStartIsNotAKnee) {
+  // A few exact matches (1%), then the hyperbola of the first test: the knee
+  // is the hyperbola's, not the jump from the exact matches to the rest.
+  std::vector<float> errors(20, 0.0f);
+  const int n = 2000;
+  for (int i = 0; i < n; ++i) errors.push_back(float(1.0 / (1.05 - double(i) / (n - 1))));
+  const double knee = double(error_knee(errors)) / double(errors.size());
+  EXPECT_NEAR(knee, 1.05 - std::sqrt(0.05), 0.04);
+}
+
 TEST(PatchSpace, AxialRotationTakesTheSmallestAngle) {
   FeatureImage src(4, 4, 1), tgt(4, 4, 1);
   std::vector<float> a_src(16, 0.1f), a_tgt(16, 0.1f + 3 * kPi / 2);

@@ -183,8 +183,9 @@ def test_stylit_options_are_a_typed_class():
 def test_warm_start_carries_the_matches_along_the_motion():
     """A warm frame starts from the previous frame's matches moved along the
     motion: most of its matches are those, where a cold frame finds its own.
-    Flat guides leave every placement of the painting equally good, so only
-    the start decides."""
+    Flat guides and no temporal guide leave every placement of the painting
+    equally good, so only the start decides. (With the temporal guide a cold
+    frame finds most of them too: 84% here.)"""
     rng = np.random.default_rng(1)
     style = rng.random((H, W, 3), dtype=np.float32)
     first_guides = next_guides = {k: np.full((H, W, 3), 0.5, np.float32) for k in light_paths(W / 2)}
@@ -198,12 +199,12 @@ def test_warm_start_carries_the_matches_along_the_motion():
     def held(field):  # interior matches within a pixel of the advected ones
         return float((np.abs(field - advected).max(axis=2) <= 1.0)[4:-4, 8:-8].mean())
 
-    common = dict(previous=image, velocity_backward=velocity, occlusion_backward=visible, temporal_weight=0.5,
+    common = dict(previous=image, velocity_backward=velocity, occlusion_backward=visible, temporal_weight=0.0,
                   threads=2)
     _, warm = stylize_frame(style, first_guides, next_guides, previous_field=stats["field"], warm_start="on",
                             **common)
     _, cold = stylize_frame(style, first_guides, next_guides, warm_start="off", **common)
-    assert held(warm["field"]) > 0.5 and held(warm["field"]) > held(cold["field"]) + 0.2
+    assert held(warm["field"]) > 0.9 and held(cold["field"]) < 0.1
     # The warm frame solves the finest level alone, for 2 EM iterations; the cold one the pyramid.
     assert [(s.width, len(s.energy)) for s in warm["levels"]] == [(W, 2)] and len(cold["levels"]) > 1
     with pytest.raises(ValueError, match="field"):

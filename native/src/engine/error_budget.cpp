@@ -66,12 +66,18 @@ std::size_t error_knee(const std::vector<float>& sorted) {
   if (b > 1e-9) knee = std::clamp((a - std::sqrt(b)) / b, 0.0, 1.0);
   // A hyperbola cannot follow a step (two populations of errors, e.g. good
   // matches and forced ones): there the fit flattens and its knee slides to the
-  // end. The first point where the smoothed empirical slope reaches 1 catches
-  // the step; a true hyperbola crosses slope 1 at the same place.
+  // end. The first point where the smoothed empirical slope rises through 1
+  // catches the step; a true hyperbola crosses slope 1 at the same place. A
+  // rise at the very start (a few exact matches, then the rest) is not a knee:
+  // taken as one, it retired 99% of the sources in one EM iteration and none
+  // in the next, so frames flipped between two energies.
   const std::size_t w = std::max<std::size_t>(2, m / 64);
+  bool below = false;
   for (std::size_t i = 0; i + w < m; ++i) {
     const double slope = (ys[i + w] - ys[i]) / (xs[i + w] - xs[i]);
-    if (slope >= 1.0) {
+    if (slope < 1.0) {
+      below = true;
+    } else if (below) {
       knee = std::min(knee, xs[i + w / 2]);
       break;
     }
