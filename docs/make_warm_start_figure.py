@@ -2,10 +2,12 @@
 bench/bench_warm_start.py --save wrote: rows cold and warm, columns the
 given frames, and at the end of each row |frame - previous frame| x 4 of its
 last frame (dark = changed). --rows DIR:VARIANT,... puts other runs' frames
-in the rows (e.g. an earlier revision's beside this one's).
+in the rows (e.g. an earlier revision's beside this one's); --crop X0,Y0,X1,Y1
+shows that part of each frame at twice its size instead of the whole frame at
+half.
 
     PYTHONPATH=addon /usr/bin/python3 docs/make_warm_start_figure.py --frames DIR [--shown 2,12,24] \\
-        [--rows DIR:cold,DIR2:cold] [--out docs/images/warm_start_user_shot.png]
+        [--rows DIR:cold,DIR2:cold] [--crop 130,60,290,180] [--out docs/images/warm_start_user_shot.png]
 """
 import argparse
 from pathlib import Path
@@ -26,6 +28,7 @@ def main():
     parser.add_argument("--frames", help="the folder of the cold and warm rows")
     parser.add_argument("--rows", help="DIR:VARIANT,... instead of --frames' cold and warm")
     parser.add_argument("--shown", default="2,12,24")
+    parser.add_argument("--crop", help="X0,Y0,X1,Y1: that part of each frame, at twice its size")
     parser.add_argument("--out", default=str(Path(__file__).resolve().parent / "images" / "warm_start_user_shot.png"))
     args = parser.parse_args()
     shown = [int(f) for f in args.shown.split(",")]
@@ -40,8 +43,13 @@ def main():
         images = [frame(folder, variant, f) for f in shown]
         change = np.abs(images[-1] - frame(folder, variant, shown[-1] - 1))
         tiles += images + [np.clip(1.0 - 4.0 * change.mean(axis=2, keepdims=True).repeat(3, 2), 0, 1)]
-    sheet = tempera.contact_sheet([t[::2, ::2].astype(np.float32) for t in tiles], columns=len(shown) + 1, gap=4,
-                                  margin=4, background=1.0)
+    if args.crop:
+        x0, y0, x1, y1 = (int(v) for v in args.crop.split(","))
+        tiles = [t[y0:y1, x0:x1].repeat(2, 0).repeat(2, 1) for t in tiles]
+    else:
+        tiles = [t[::2, ::2] for t in tiles]
+    sheet = tempera.contact_sheet([np.ascontiguousarray(t, np.float32) for t in tiles], columns=len(shown) + 1,
+                                  gap=4, margin=4, background=1.0)
     tempera.write_image(args.out, sheet.astype(np.float32))
 
 
