@@ -84,28 +84,27 @@ def main():
     exemplar = {name: shrink(v, k) for name, v in exemplar_from_pngs(args.exemplar_pngs).items()}
     for name, file in EBSYNTH_PNGS.items():  # ebsynth's exemplar guides: the same pixels Tempera matches
         write_png(work / file, tonemap(exemplar[name]))
-    previous = {}
+    last = {}  # run -> its previous frame's image and matches (ebsynth: no matches)
     rows = []
     print("| frame | run | seconds | warp error | detail |")
     print("| ---: | --- | ---: | ---: | ---: |")
     for frame in parse_frames(args.frames):
         target = guide_cache.read_frame(args.guides, frame, GUIDES + MOTION)
         motion = (target["velocity_backward"], target["occlusion_backward"])
-        results = {"ebsynth": ebsynth_frame(args.ebsynth, work, style_png, target, frame, args.threads)}
+        seconds, image = ebsynth_frame(args.ebsynth, work, style_png, target, frame, args.threads)
+        results = {"ebsynth": (seconds, image, None)}
         for run, options in TEMPERA_RUNS.items():
             chained = {}
-            if run in previous and (options["temporal_weight"] > 0 or options["warm_start"] == "on"):
-                chained = dict(previous=previous[run]["image"], previous_field=previous[run]["field"],
+            if run in last and (options["temporal_weight"] > 0 or options["warm_start"] == "on"):
+                chained = dict(previous=last[run]["image"], previous_field=last[run]["field"],
                                velocity_backward=motion[0], occlusion_backward=motion[1])
             started = time.monotonic()
             image, stats = stylize_frame(style, exemplar, {g: target[g] for g in GUIDES}, threads=args.threads,
                                          **options, **chained)
-            results[run] = (time.monotonic() - started, image)
-            previous[run] = {"image": image, "field": stats["field"]}
-        for run, (seconds, image) in results.items():
-            before = previous.get(("frame", run))
-            warp = temporal.flicker(before, image, *motion) if before is not None else float("nan")
-            previous[("frame", run)] = image
+            results[run] = (time.monotonic() - started, image, stats["field"])
+        for run, (seconds, image, field) in results.items():
+            warp = temporal.flicker(last[run]["image"], image, *motion) if run in last else float("nan")
+            last[run] = {"image": image, "field": field}
             write_png(work / f"{run.replace(' ', '_')}_{frame:04d}.png", image)
             rows.append(dict(frame=frame, run=run, seconds=seconds, warp=warp, detail=detail(image)))
             print(f"| {frame} | {run} | {seconds:.2f} | {warp:.4f} | {detail(image):.4f} |", flush=True)

@@ -104,7 +104,7 @@ def test_the_medium_is_kept(inputs):
     8 frames. Measured (docs/noisy.md): 1.24, 1.22, 1.21, 1.21 at f = 1.3, 2.2, 3.1, 4.3; single
     frames at f = 4.3 spread from 0.88 to 1.34, so 2 frames were not enough
     to tell 4.3 from the bound. An unsolved finest level (1 EM x 1 PM) gives
-    1.44."""
+    1.43."""
     style, _ = inputs
     # Usage none: the error budget would spread S's patches at the cost of their fit.
     reference, _ = synthesis.synthesize(style, target_shape=(48, 64), patch_size=7, threads=2, seed=3, usage="none")
