@@ -151,6 +151,46 @@ TEST(Solver, WarmStartFromItsOwnFieldIsNoWorseInHalfTheTime) {
   EXPECT_LE(warm_seconds, 0.5 * cold_seconds);
 }
 
+// A warm start's restarted pixels (hidden in the previous frame) are matched
+// on the guides alone, as a cold start's coarsest level is, and not left at
+// random matches whose vote is noise: with no EM search at all, a band of
+// restarted pixels lands where the coordinate guide says (random matches:
+// about a third of the frame away); the held pixels keep their matches.
+TEST(Solver, WarmStartMatchesRestartedPixelsOnTheGuides) {
+  const int w = 80, h = 40;
+  const Image style = smooth_noise(w, h, 3, 7);
+  const Image guide = coordinate_guide(w, h);
+  SynthesisInput in;
+  in.style = style.view();
+  in.target_width = w;
+  in.target_height = h;
+  in.guides.add("coords", guide.view(), guide.view(), 2.0f);
+  SynthesisOptions opt = options(PatchUsage::None);
+  const SynthesisResult first = synthesize(in, opt);
+  opt.em_iterations = 1;
+  opt.pm_iterations = 0;
+  Image visible(w, h, 1, 1.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 30; x < 40; ++x) visible.at(x, y, 0) = 0.0f;
+  const Image still(w, h, 2, 0.0f);
+  const SynthesisResult warm = synthesize_warm(in, opt, first.field, still.view(), visible.view());
+  double off_guide = 0;
+  int restarted = 0;
+  for (int y = 4; y < h - 4; ++y)
+    for (int x = 30; x < 40; ++x, ++restarted) {
+      const std::size_t i = warm.field.index(x, y);
+      off_guide += std::abs(warm.field.position_x(i) - x) + std::abs(warm.field.position_y(i) - y);
+    }
+  EXPECT_LT(off_guide / restarted, 3.0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      if (x >= 30 && x < 40) continue;
+      const std::size_t i = warm.field.index(x, y);
+      ASSERT_EQ(warm.field.x[i], first.field.x[i]);
+      ASSERT_EQ(warm.field.y[i], first.field.y[i]);
+    }
+}
+
 // synthesize_warm (issue 32): the finest level alone, started from the
 // previous frame's field moved along the motion. With no search the output is
 // the previous frame's carried 3 px to the right; the field's size is checked.

@@ -649,12 +649,36 @@ void Solver::fix_pixels(int l, const Level& level, const Image* given, OffsetFie
   }
 }
 
-void Solver::restart_masked(const Image& mask, const Level& level, OffsetField& field) const {
+// A warm start's restarted pixels (LevelStart::restart_mask) are matched as
+// a cold start's coarsest level is, on the guides alone, since their B' is
+// unknown: from random matches, the first vote would show them the noise of
+// random paint, which two EM iterations at full size do not undo (a pale
+// ghost of what hid the surface; docs/benchmarks.md, issue 32). Only they
+// search; their held neighbours propagate into them.
+void Solver::restart_masked(int l, const Image& mask, const Level& level, OffsetField& field) const {
   if (mask.width() != field.width || mask.height() != field.height || mask.channels() != 1)
     throw ValueError(concat("a restart mask must be ", field.width, "x", field.height, " with 1 channel"));
   std::vector<std::uint8_t> restart(field.x.size());
   for (std::size_t i = 0; i < restart.size(); ++i) restart[i] = mask.data()[i] > 0.5f;
   restart_pixels(level.space, level.constraints, field, restart, options_.seed);
+  if (plan_->guide_channels.empty() || std::find(restart.begin(), restart.end(), 1) == restart.end()) return;
+  SearchConstraints restarted = level.constraints;
+  restarted.target_matched = level.constraints.matched();
+  for (std::size_t i = 0; i < restart.size(); ++i) restarted.target_active[i] &= restart[i];
+  match_on_guides(level, restarted, field, pm_iterations(l));
+}
+
+// PatchMatch of `field` on the guide channels alone (B' zeroed on both sides).
+void Solver::match_on_guides(const Level& level, const SearchConstraints& constraints, OffsetField& field,
+                             int iterations) const {
+  FeatureImage source = level.source, target = level.target;
+  for (FeatureImage* f : {&source, &target}) f->zero_channels(0, plan_->style_channels);
+  PatchSpace guide_space = level.space;
+  guide_space.source = &source;
+  guide_space.target = &target;
+  refresh_distances(guide_space, constraints, field, options_.threads);
+  PatchMatchParams pm{std::max(1, iterations), options_.seed, options_.threads};
+  patchmatch(guide_space, constraints, field, pm, 0);
 }
 
 // Coarsest-level start without a field: match on the guides alone, since B'
@@ -671,19 +695,8 @@ OffsetField Solver::cold_start(int l, Level& level, Image& bprime) const {
     patchmatch(level.space, level.constraints, field, pm, 0);
     return field;
   }
-  if (p.guide_channels.empty()) {
-    random_field(level.space, level.constraints, field, seed, options_.threads);
-    return field;
-  }
-  FeatureImage source = level.source, target = level.target;
-  for (FeatureImage* f : {&source, &target})  // the guide channels alone
-    f->zero_channels(0, p.style_channels);
-  PatchSpace guide_space = level.space;
-  guide_space.source = &source;
-  guide_space.target = &target;
-  random_field(guide_space, level.constraints, field, seed, options_.threads);
-  PatchMatchParams pm{std::max(1, pm_iterations(l)), seed, options_.threads};
-  patchmatch(guide_space, level.constraints, field, pm, 0);
+  random_field(level.space, level.constraints, field, seed, options_.threads);
+  if (!p.guide_channels.empty()) match_on_guides(level, level.constraints, field, pm_iterations(l));
   return field;
 }
 
@@ -762,7 +775,7 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
     else
       field = *given;
     legalize_field(level.space, level.constraints, field);
-    if (start.restart_mask) restart_masked(*start.restart_mask, level, field);
+    if (start.restart_mask) restart_masked(l, *start.restart_mask, level, field);
   } else {
     field = cold_start(l, level, bprime);
   }

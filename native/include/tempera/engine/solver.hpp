@@ -34,8 +34,8 @@ struct LevelStart {
   // `image` replace the B' voted from the field.
   const Image* image_mask = nullptr;
   // With `field` (or `take_field`): where this mask (level size, 1 channel)
-  // is > 0.5 the start field's match is replaced by a random one
-  // (restart_pixels), e.g. a warm start's disoccluded pixels.
+  // is > 0.5 the start field's match is replaced by one found on the guides
+  // alone (a random one without guides), e.g. a warm start's disoccluded pixels.
   const Image* restart_mask = nullptr;
   const CandidateList* candidates = nullptr;  // extra candidates (atlas positions at this level)
   // Hard constraints of this level alone (level size), instead of the
@@ -106,7 +106,9 @@ class Solver {
   // Patch space of `level` without features: for moving fields (angles, margins).
   PatchSpace geometry(int level, FeatureImage& source, FeatureImage& target) const;
   OffsetField cold_start(int level, Level& lv, Image& bprime) const;
-  void restart_masked(const Image& mask, const Level& lv, OffsetField& field) const;
+  void restart_masked(int level, const Image& mask, const Level& lv, OffsetField& field) const;
+  void match_on_guides(const Level& lv, const SearchConstraints& constraints, OffsetField& field,
+                       int iterations) const;
   void fix_pixels(int level, const Level& lv, const Image* values, OffsetField& field, Image& bprime) const;
   void set_target_style(Level& lv, const Image& bprime) const;
   void allocate_features(Level& lv, const std::vector<ChannelWrite>& source_writes,
