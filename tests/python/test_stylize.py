@@ -224,12 +224,13 @@ def test_warm_start_job_resumes_like_an_uninterrupted_run(inputs):
     [cold.run_frame(i) for i in range(3)]
     assert np.abs(tempera.read_image(cold.output_path(3)) - uninterrupted[2]).max() > 0.05  # the warm start counts
     assert not (inputs / "cold" / "tempera_stylize").exists()
-    # auto warm-starts only with the temporal guide; off is the default.
-    for weight, warm in ((0.0, "auto"), (0.0, "on"), (0.5, None)):
+    # auto, the default, warm-starts only with the temporal guide.
+    for weight, warm, warm_started in ((0.0, "auto", False), (0.0, "on", True), (0.5, None, True),
+                                       (0.0, None, False)):
         j = StylizeJob(inputs / "paint.png", inputs / "exemplar", inputs / "cache", [1, 2],
                        inputs / f"t{weight}{warm}", temporal_weight=weight, warm_start=warm, threads=2)
         [j.run_frame(i) for i in range(2)]
-        assert (inputs / f"t{weight}{warm}" / "tempera_stylize").exists() == (warm == "on"), (weight, warm)
+        assert (inputs / f"t{weight}{warm}" / "tempera_stylize").exists() == warm_started, (weight, warm)
 
     # Interrupted after frame 2 (frame 3 and its matches gone), then resumed.
     (inputs / "out" / "frame_0003.png").unlink()
@@ -241,7 +242,9 @@ def test_warm_start_job_resumes_like_an_uninterrupted_run(inputs):
     (fields / "field_0002.exr").unlink()
     again = job(inputs, temporal_weight=0.5, warm_start="on", threads=2)
     assert again.run_frame(1)["status"] == "stylized" and (fields / "field_0002.exr").exists()
-    # auto with the temporal guide is the same warm start; switched off, the frames are made again, cold.
-    auto = job(inputs, temporal_weight=0.5, warm_start="auto", threads=2)
-    assert [auto.run_frame(i)["status"] for i in range(3)] == ["skipped"] * 3
-    assert job(inputs, temporal_weight=0.5, threads=2).run_frame(1)["status"] == "stylized"
+    # auto (the default) with the temporal guide is the same warm start; switched off, the frames are made
+    # again, cold.
+    for warm in ("auto", None):
+        auto = job(inputs, temporal_weight=0.5, warm_start=warm, threads=2)
+        assert [auto.run_frame(i)["status"] for i in range(3)] == ["skipped"] * 3, warm
+    assert job(inputs, temporal_weight=0.5, warm_start="off", threads=2).run_frame(1)["status"] == "stylized"

@@ -53,9 +53,9 @@ QUALITY_ITEMS = (
     ("final", "Final", "Full solver iterations"),
 )
 WARM_START_ITEMS = (
-    ("off", "Off", "Solve every frame from scratch (the default: the strokes stay crisp over long shots)"),
-    ("auto", "Auto", "Start each frame from the previous one's matches when Temporal Coherence is above 0: "
-                     "about 3.5x faster and steadier, but the strokes soften along the shot (drafts)"),
+    ("off", "Off", "Solve every frame from scratch, coarse to fine (about 3x slower)"),
+    ("auto", "Auto", "Start each frame from the previous one's matches when Temporal Coherence is above 0 "
+                     "(the default): about 3x faster and steadier"),
     ("on", "On", "Always start from the previous frame's matches: faster, and less boil at Temporal Coherence 0"),
 )
 FORMAT_ITEMS = (

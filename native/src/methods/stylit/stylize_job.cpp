@@ -34,7 +34,9 @@ std::string settings_text(const StylizeJobConfig& c) {
   // Frames with the temporal guide are matched on fixed-point features since
   // 2026-12-05 (engine_options): those made before are made again.
   if (c.stylit.temporal_weight > 0 && o.fixed_point_weights) s << ";weights=fixed";
-  if (warm_starts(c.stylit)) s << ";warm_start";  // absent when off: the keys of cold frames stay as they were
+  // Absent when off: the keys of cold frames stay as they were. Warm frames
+  // restart disoccluded pixels on the guides since 2026-12-06: older ones are made again.
+  if (warm_starts(c.stylit)) s << ";warm_start=guides";
   return s.str();
 }
 

@@ -27,11 +27,12 @@ struct EnumNames<Quality> {
 };
 
 // Whether frames after the first start from the previous frame's matches
-// (synthesize_warm). auto: with the temporal guide (temporal weight > 0):
-// 3.4-3.6x faster, energy within 0.5%, a quarter to a half less flicker,
-// but the strokes soften along the shot (detail -4% on average, -12% by the
-// demo's frame 12; docs/benchmarks.md, issue 32), so it is not the default
-// yet. on: also without the guide (the frames' boil goes, energy +3.5%).
+// (synthesize_warm). auto, the default: with the temporal guide (temporal
+// weight > 0). Measured against cold frames (docs/benchmarks.md, issue 32,
+// step 6): on a shot made by others, 3.3x faster, energy -0.7%, flicker -8%,
+// detail +1.4%; on the demo, 3.5x, energy +1.8%, flicker -28%, detail -3.3%.
+// on: also without the guide (the frames' boil goes, energy +3.5%). off:
+// every frame coarse to fine.
 enum class WarmStart { Auto, On, Off };
 template <>
 struct EnumNames<WarmStart> {
@@ -50,7 +51,7 @@ struct StylitOptions {
   // Frames after the first start from the previous frame's matches advected
   // along the motion and solve the finest level alone (synthesize_warm):
   // needs the previous frame's field (TemporalInput::previous_field).
-  WarmStart warm_start = WarmStart::Off;
+  WarmStart warm_start = WarmStart::Auto;
   // Engine options. usage, patch_size, seed, threads (and anything else) are
   // taken as they are, except that the quality preset sets the iteration counts.
   SynthesisOptions synthesis;
@@ -71,8 +72,8 @@ inline const auto& stylit_option_table() {
             "solver effort per frame: preview is about 5x faster, for trying settings"),
       field(&S::warm_start, "warm_start", "warm-start",
             "frames after the first start from the previous frame's matches moved along the rendered motion and "
-            "solve only at full size, about 3.5x faster and steadier but the strokes soften along the shot: auto "
-            "does so with the temporal guide, on also without it (less boil; chains the frames), off never"));
+            "solve only at full size, about 3.3x faster and steadier: auto does so with the temporal guide, "
+            "on also without it (less boil; chains the frames), off never (each frame coarse to fine)"));
   return table;
 }
 
