@@ -5,8 +5,8 @@ ebsynth (jamriska/ebsynth, built for the CPU: build-linux-cpu_only.sh) reads
 PNGs, so its guides are Tempera's own tone map of the guide cache
 (tempera.engine.guides.tonemap, written as 8-bit PNGs) and its exemplar
 guides the PNGs as given. Tempera runs as an artist does: `--temporal 0.5`
-(cold frames, the default) and with `--warm-start on`, and with temporal 0
-(each frame on its own, the job ebsynth does). Within a frame the runs
+warm-started (the default since issue 32's step 6) and cold (`--warm-start
+off`), and with temporal 0 (each frame on its own, the job ebsynth does). Within a frame the runs
 alternate, so all see the same machine load.
 
     PYTHONPATH=addon /usr/bin/python3 bench/bench_ebsynth_shot.py --ebsynth ebsynth/bin/ebsynth \\
