@@ -6,8 +6,8 @@ PNGs, so its guides are Tempera's own tone map of the guide cache
 (tempera.engine.guides.tonemap, written as 8-bit PNGs) and its exemplar
 guides the PNGs as given. Tempera runs as an artist does: `--temporal 0.5`
 warm-started (the default since issue 32's step 6) and cold (`--warm-start
-off`), and with temporal 0 (each frame on its own, the job ebsynth does). Within a frame the runs
-alternate, so all see the same machine load.
+off`), and with temporal 0 (each frame on its own, the job ebsynth does).
+Within a frame the runs alternate, so all see the same machine load.
 
     PYTHONPATH=addon /usr/bin/python3 bench/bench_ebsynth_shot.py --ebsynth ebsynth/bin/ebsynth \\
         --guides GUIDE_CACHE --exemplar source_style.png --exemplar-pngs ebsynth/examples/stylit \\

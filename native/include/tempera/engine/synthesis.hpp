@@ -101,8 +101,9 @@ SynthesisResult synthesize(const SynthesisInput& input, const SynthesisOptions& 
 // start. `previous_field` is the finest level's size. Where `visible` (χ-:
 // 1 channel, 1 = visible in the previous frame; empty = everywhere) is
 // below 0.5 the pixel starts afresh instead, matched on the guides alone as
-// a cold start's coarsest level is: its advected match belongs to what hid it. The finest level runs the options' iterations for
-// level 0. Reported like synthesize(), with one level.
+// a cold start's coarsest level is: its advected match belongs to what hid
+// it. The finest level runs the options' iterations for level 0. Reported
+// like synthesize(), with one level.
 SynthesisResult synthesize_warm(const SynthesisInput& input, const SynthesisOptions& options,
                                 const OffsetField& previous_field, const ImageView& velocity_backward,
                                 const ImageView& visible = {}, const ProgressCallback& progress = {});
