@@ -86,8 +86,10 @@ std::size_t error_knee(const std::vector<float>& sorted) {
 }
 
 UsageStats retrieve_with_budget(const PatchSpace& space, const SearchConstraints& cons, OffsetField& nnf,
-                                            const ReversedRetrievalParams& params, std::uint64_t stream) {
+                                const ReversedRetrievalParams& params, std::uint64_t stream,
+                                const std::vector<std::int32_t>* earlier_sources) {
   ReversedRetrieval rr(space, cons, nnf, params, stream);
+  rr.set_earlier_sources(earlier_sources);
   rr.eligible() = cons.source_valid;
   UsageStats stats;
   std::vector<float> errors;  // kept across rounds with its scratch, to spare a million-entry allocation each
@@ -135,7 +137,7 @@ class ErrorBudget final : public EnergyTerm {
     rr.max_rounds = max_rounds_;
     rr.seed = c.seed;
     rr.threads = c.threads;
-    return retrieve_with_budget(*c.space, *c.constraints, field, rr, stream);
+    return retrieve_with_budget(*c.space, *c.constraints, field, rr, stream, c.sources_before_search);
   }
 
  private:

@@ -21,6 +21,11 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
+void source_indices(const OffsetField& field, int source_width, std::vector<std::int32_t>& out) {
+  out.resize(field.x.size());
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = field.y[i] * source_width + field.x[i];
+}
+
 // ---- inputs ----
 
 // The exemplars of the source set: `style` first, then `exemplars`, each with
@@ -799,8 +804,9 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
     for (std::size_t i = 0; i < bprime.pixel_count(); ++i)
       if (start.image_mask->data()[i] > 0.5f)
         std::copy_n(start.image->data() + i * p.style_channels, p.style_channels, bprime.data() + i * p.style_channels);
+  std::vector<std::int32_t> sources_before_search;
   const LevelContext context{l, &level.space, &level.constraints, &p.layout[std::size_t(l)], options_.seed,
-                             options_.threads};
+                             options_.threads, &sources_before_search};
   PatchMatchParams pm{pm_iters, options_.seed, options_.threads};
   pm.candidates = start.candidates;
   pm.context = &context;
@@ -827,6 +833,7 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
     set_target_style(level, bprime);
     refresh_distances(level.space, level.constraints, field, options_.threads);
     if (skip_converged) matches_before = match_fingerprints(field), moved.assign(matches_before.size(), 0);
+    source_indices(field, level.space.source->width, sources_before_search);
     // One search, split into single iterations when a term's costs follow the field.
     const int chunk = refresh_each_iteration ? 1 : pm_iters;
     for (int first = 0; first < pm_iters; first += chunk) {

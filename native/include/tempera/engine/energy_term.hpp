@@ -31,6 +31,10 @@ struct LevelContext {
   const SourceLayout* layout = nullptr;
   std::uint64_t seed = 1;
   int threads = 0;
+  // Per target, its source (atlas index, y * width + x) before this EM
+  // iteration's search: mostly where the previous reassignment put it, a
+  // seed for the next (null: none).
+  const std::vector<std::int32_t>* sources_before_search = nullptr;
 };
 
 struct UsageStats {

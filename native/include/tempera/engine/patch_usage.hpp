@@ -30,9 +30,12 @@ inline const char* patch_usage_name(PatchUsage usage) { return enum_name(usage);
 UsageStats retrieve_uniform(const PatchSpace& space, const SearchConstraints& constraints, OffsetField& field,
                             const ReversedRetrievalParams& params, std::uint64_t stream);
 
-// StyLit's error-budget assignment on top of the forward match in `field`.
+// StyLit's error-budget assignment on top of the forward match in `field`;
+// `earlier_sources` (per target, a source index; may be null) seed the
+// retrieval as the forward matches do.
 UsageStats retrieve_with_budget(const PatchSpace& space, const SearchConstraints& constraints, OffsetField& field,
-                                const ReversedRetrievalParams& params, std::uint64_t stream);
+                                const ReversedRetrievalParams& params, std::uint64_t stream,
+                                const std::vector<std::int32_t>* earlier_sources = nullptr);
 
 // Knee of ascending `sorted_errors`: fits f(x) = 1 / (a - b x) to the curve in
 // normalized axes and returns how many leading errors lie before f'(x) = 1.

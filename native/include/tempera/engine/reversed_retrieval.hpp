@@ -56,6 +56,12 @@ class ReversedRetrieval {
   }
 
   std::vector<std::uint8_t>& eligible() { return eligible_; }
+  // Per target, a source it was matched to before (atlas index; null: none):
+  // seeds like the forward match's.
+  void set_earlier_sources(const std::vector<std::int32_t>* earlier) {
+    earlier_ = earlier && earlier->size() == open_.size() ? earlier : nullptr;
+    if (earlier_) earlier_dist_.assign(open_.size(), kNoDistance);
+  }
   std::size_t active() const { return active_; }
   std::size_t assigned_count() const { return assigned_count_; }
   const std::vector<std::int32_t>& candidate() const { return candidate_; }
@@ -137,6 +143,7 @@ class ReversedRetrieval {
         }
       }
     }
+    if (earlier_) adopt_earlier();
     parallel_for(sh_, params_.threads, [&](int sy) {
       for (int sx = 0; sx < sw_; ++sx) {
         const std::size_t p = std::size_t(sy) * sw_ + sx;
@@ -151,6 +158,31 @@ class ReversedRetrieval {
       }
     });
     wide_searches_ += std::size_t(std::count(wide_search_.begin(), wide_search_.end(), std::uint8_t(1)));
+  }
+
+  // Each eligible source adopts the best open target that was matched to it
+  // before. Where those matches came from the previous reassignment they
+  // spread over most sources, whereas the search since has pulled the forward
+  // matches back onto a few favourites: so most sources start near their best
+  // target and skip the wide search.
+  void adopt_earlier() {
+    const auto& earlier = *earlier_;
+    parallel_for(th_, params_.threads, [&](int qy) {
+      for (int qx = 0; qx < tw_; ++qx) {
+        const std::size_t q = std::size_t(qy) * tw_ + qx;
+        const std::int32_t p = earlier[q];
+        const bool usable = open_[q] && p >= 0 && p < std::int32_t(eligible_.size()) && eligible_[p] &&
+                            cons_.segment_of_source(std::size_t(p)) == cons_.segment_of_target(q);
+        earlier_dist_[q] = usable ? scaled_distance(p % sw_, p / sw_, qx, qy, kNoDistance) : kNoDistance;
+      }
+    });
+    for (std::size_t q = 0; q < earlier.size(); ++q) {
+      const std::int32_t p = earlier[q];
+      if (earlier_dist_[q] < kNoDistance && earlier_dist_[q] < candidate_dist_[p]) {
+        candidate_[p] = std::int32_t(q);
+        candidate_dist_[p] = earlier_dist_[q];
+      }
+    }
   }
 
   void prefetch_target(int qx, int qy) const {
@@ -289,6 +321,8 @@ class ReversedRetrieval {
   std::vector<std::int32_t> candidate_;
   std::vector<float> candidate_dist_;
   std::vector<std::vector<std::int32_t>> unassigned_;
+  const std::vector<std::int32_t>* earlier_ = nullptr;
+  std::vector<float> earlier_dist_;
   std::vector<std::atomic<std::uint64_t>> best_source_;  // resolve_collisions' per-target minimum, kept across rounds
   std::size_t active_ = 0, assigned_count_ = 0, wide_searches_ = 0;
 };
