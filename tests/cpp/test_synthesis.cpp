@@ -331,8 +331,8 @@ TEST(ErrorKnee, ARiseAtTheStartIsNotAKnee) {
 // sources): those sources skip the wide search. Here the target is the
 // source with a little noise, the earlier assignment the identity, and the
 // forward search has piled every target onto one source (the search's
-// favourites, in the extreme): the seeded budget does less than half the
-// wide searches and ends closer to the identity.
+// favourites, in the extreme): the seeded budget does about half the wide
+// searches and ends closer to the identity.
 TEST(ErrorBudget, EarlierAssignmentsSpareWideSearches) {
   const int w = 48, h = 40, channels = 3;
   std::mt19937 rng(11);
@@ -364,9 +364,55 @@ TEST(ErrorBudget, EarlierAssignmentsSpareWideSearches) {
   const UsageStats off = retrieve_with_budget(space, cons, unseeded, params, 1);
   const UsageStats on = retrieve_with_budget(space, cons, seeded, params, 1, &identity);
   const auto mean = [](const std::vector<float>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / double(v.size()); };
-  EXPECT_LT(on.wide_searches, off.wide_searches / 2);  // 0.44 of them when written
-  EXPECT_GE(on.covered, off.covered - 0.02);
+  // 0.44 of them when written, 0.51 since the sources that lost search
+  // locally (the unseeded budget gained more from that).
+  EXPECT_LT(on.wide_searches, 0.6 * double(off.wide_searches));
+  EXPECT_GT(on.covered, 0.85);  // 0.89 (unseeded 0.91)
   EXPECT_LT(mean(seeded.dist), 0.8 * mean(unseeded.dist));  // 0.59 when written
+}
+
+// A source whose candidate another source won searches around that target
+// in the next round (a few local radii), not over the whole frame from a
+// random one: the wide searches of round 2 are only the sources with no
+// candidate at all (the winners and those that found none). Same toy as
+// above; seeding every loser at random counted them too.
+TEST(ErrorBudget, SourcesThatLostSearchNearTheirTarget) {
+  const int w = 48, h = 40, channels = 3;
+  std::mt19937 rng(11);
+  FeatureImage source(w, h, channels), target(w, h, channels);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < channels; ++c) {
+        source.pixel(x, y)[c] = float(rng() % 1000) * 1e-3f;
+        target.pixel(x, y)[c] = source.pixel(x, y)[c] + float(rng() % 100) * 1e-3f;
+      }
+  PatchSpace space;
+  space.source = &source, space.target = &target;
+  SearchConstraints cons;
+  cons.source_valid.assign(std::size_t(w) * h, 0);
+  for (int y = 2; y < h - 2; ++y)
+    for (int x = 2; x < w - 2; ++x) cons.source_valid[std::size_t(y) * w + x] = 1;
+  cons.target_active.assign(std::size_t(w) * h, 1);
+  cons.finalize();
+  OffsetField field(w, h);
+  std::fill(field.x.begin(), field.x.end(), w / 2);
+  std::fill(field.y.begin(), field.y.end(), h / 2);
+  refresh_distances(space, cons, field, 2);
+  ReversedRetrievalParams params;
+  params.seed = 3, params.threads = 2;
+  ReversedRetrieval rr(space, cons, field, params, 1);
+  rr.eligible() = cons.source_valid;
+  for (const Assignment& a : rr.round(0)) rr.assign(a);
+  std::size_t losers = 0, without = 0;
+  for (std::size_t p = 0; p < rr.candidate().size(); ++p) {
+    if (!rr.eligible()[p]) continue;
+    losers += rr.candidate()[p] != kNoTarget;  // assign() cleared the winners'
+    without += rr.candidate()[p] == kNoTarget;
+  }
+  const std::size_t before = rr.wide_searches();
+  rr.round(1);
+  EXPECT_GT(losers, 100u);
+  EXPECT_LE(rr.wide_searches() - before, without);
 }
 
 TEST(PatchSpace, AxialRotationTakesTheSmallestAngle) {

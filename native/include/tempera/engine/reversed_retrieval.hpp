@@ -49,7 +49,7 @@ class ReversedRetrieval {
       : space_(space), cons_(cons), nnf_(nnf), params_(params), stream_(stream),
         sw_(space.source->width), sh_(space.source->height), tw_(nnf.width), th_(nnf.height),
         open_(cons.target_active), eligible_(std::size_t(sw_) * sh_, 0),
-        wide_search_(std::size_t(sw_) * sh_, 0),
+        search_(std::size_t(sw_) * sh_, kPropagate),
         candidate_(std::size_t(sw_) * sh_, kNoTarget), candidate_dist_(std::size_t(sw_) * sh_, kNoDistance),
         best_source_(std::size_t(tw_) * th_) {
     for (std::uint8_t a : open_) active_ += a != 0;
@@ -119,18 +119,22 @@ class ReversedRetrieval {
       if (open_[q]) unassigned_[cons_.segment_of_target(q)].push_back(std::int32_t(q));
   }
 
-  // Keeps still-open candidates, adopts targets whose forward match is this
-  // source (the forward NNF already knows good pairs), else picks at random.
-  // Only the random picks need the wide random search of the sweep; the
-  // others are refined by propagation alone (half the cost of a round).
+  // Keeps still-open candidates, adopts targets whose forward match (or
+  // earlier match) is this source (good pairs known), else picks at random.
+  // Only the random picks need the wide random search of the sweep; a source
+  // whose candidate another source won searches around that target (its
+  // best open one is most often near it), the others are refined by
+  // propagation alone.
   void seed_candidates(int round_index) {
     parallel_for(sh_, params_.threads, [&](int sy) {
       for (std::size_t p = std::size_t(sy) * sw_, end = p + sw_; p < end; ++p) {
-        if (!eligible_[p] || (candidate_[p] != kNoTarget && !open_[candidate_[p]])) {
+        if (!eligible_[p]) {
           candidate_[p] = kNoTarget;
           candidate_dist_[p] = kNoDistance;
+        } else if (candidate_[p] != kNoTarget && !open_[candidate_[p]]) {
+          candidate_dist_[p] = kNoDistance;  // lost: any open target is better
         }
-        wide_search_[p] = 0;
+        search_[p] = kPropagate;
       }
     });
     for (const auto& list : unassigned_) {
@@ -147,17 +151,21 @@ class ReversedRetrieval {
     parallel_for(sh_, params_.threads, [&](int sy) {
       for (int sx = 0; sx < sw_; ++sx) {
         const std::size_t p = std::size_t(sy) * sw_ + sx;
-        if (!eligible_[p] || candidate_[p] != kNoTarget) continue;
+        if (!eligible_[p] || (candidate_[p] != kNoTarget && open_[candidate_[p]])) continue;
+        if (candidate_[p] != kNoTarget) {  // lost, and adopted nothing
+          search_[p] = kLocal;
+          continue;
+        }
         const auto& list = unassigned_[cons_.segment_of_source(p)];
         if (list.empty()) continue;
         Rng rng(params_.seed, mix64(stream_ * 7919 + round_index) ^ p);
         const std::int32_t q = list[rng.below(int(list.size()))];
         candidate_[p] = q;
         candidate_dist_[p] = scaled_distance(sx, sy, q % tw_, q / tw_, kNoDistance);
-        wide_search_[p] = 1;
+        search_[p] = kWide;
       }
     });
-    wide_searches_ += std::size_t(std::count(wide_search_.begin(), wide_search_.end(), std::uint8_t(1)));
+    wide_searches_ += std::size_t(std::count(search_.begin(), search_.end(), kWide));
   }
 
   // Each eligible source adopts the best open target that was matched to it
@@ -236,7 +244,8 @@ class ReversedRetrieval {
           // and a random open target, whose list slot is then fetched while
           // propagation runs.
           int off[64], n = 0;
-          for (int r = wide_search_[p] ? max_radius : 0; r >= 1 && n < 64; r /= 2, n += 2) {
+          const int first_radius = search_[p] == kWide ? max_radius : search_[p] == kLocal ? kLocalRadius : 0;
+          for (int r = first_radius; r >= 1 && n < 64; r /= 2, n += 2) {
             off[n] = rng.between(-r, r);
             off[n + 1] = rng.between(-r, r);
           }
@@ -268,6 +277,7 @@ class ReversedRetrieval {
           for (int k = 0; k < n; k += 2) prefetch_target(bx + off[k], by + off[k + 1]);
           for (int k = 0; k < n; k += 2) try_target(sx, sy, bx + off[k], by + off[k + 1], segment, best, best_dist);
           if (open_pick) try_target(sx, sy, pick % tw_, pick / tw_, segment, best, best_dist);
+          if (best_dist == kNoDistance) best = kNoTarget;  // lost, and found nothing open
           candidate_[p] = best;
           candidate_dist_[p] = best_dist;
         }
@@ -317,7 +327,12 @@ class ReversedRetrieval {
   int sw_, sh_, tw_, th_;
   // open_: active and not yet assigned, one byte a target, so that testing a
   // random candidate costs one cache miss, not two.
-  std::vector<std::uint8_t> open_, eligible_, wide_search_;
+  std::vector<std::uint8_t> open_, eligible_;
+  // A source's random search in this round's sweep: none (propagation and a
+  // random open target only), around a lost target, or over the whole frame.
+  enum Search : std::uint8_t { kPropagate, kLocal, kWide };
+  static constexpr int kLocalRadius = 8;  // 8, 4, 2, 1: 4 offsets, against 10 for a 600-pixel frame
+  std::vector<Search> search_;
   std::vector<std::int32_t> candidate_;
   std::vector<float> candidate_dist_;
   std::vector<std::vector<std::int32_t>> unassigned_;
