@@ -326,43 +326,54 @@ TEST(ErrorKnee, ARiseAtTheStartIsNotAKnee) {
   EXPECT_NEAR(knee, 1.05 - std::sqrt(0.05), 0.04);
 }
 
+namespace {
+
+// Reversed retrieval's toy: the target is the source with a little noise (so
+// the identity is the best assignment), and the forward field has piled
+// every target onto one source (the search's favourites, in the extreme).
+struct PiledUpMatches {
+  static constexpr int w = 48, h = 40, channels = 3;
+  FeatureImage source{w, h, channels}, target{w, h, channels};
+  PatchSpace space;
+  SearchConstraints cons;
+  OffsetField forward{w, h};
+  ReversedRetrievalParams params;
+
+  PiledUpMatches() {
+    std::mt19937 rng(11);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int c = 0; c < channels; ++c) {
+          source.pixel(x, y)[c] = float(rng() % 1000) * 1e-3f;
+          target.pixel(x, y)[c] = source.pixel(x, y)[c] + float(rng() % 100) * 1e-3f;
+        }
+    space.source = &source, space.target = &target;
+    cons.source_valid.assign(std::size_t(w) * h, 0);
+    for (int y = 2; y < h - 2; ++y)
+      for (int x = 2; x < w - 2; ++x) cons.source_valid[std::size_t(y) * w + x] = 1;
+    cons.target_active.assign(std::size_t(w) * h, 1);
+    cons.finalize();
+    std::fill(forward.x.begin(), forward.x.end(), w / 2);
+    std::fill(forward.y.begin(), forward.y.end(), h / 2);
+    refresh_distances(space, cons, forward, 2);
+    params.seed = 3, params.threads = 2;
+  }
+};
+
+}  // namespace
+
 // The error budget of an EM iteration starts each source at the target the
 // previous iteration's budget gave it (retrieve_with_budget's earlier
-// sources): those sources skip the wide search. Here the target is the
-// source with a little noise, the earlier assignment the identity, and the
-// forward search has piled every target onto one source (the search's
-// favourites, in the extreme): the seeded budget does about half the wide
-// searches and ends closer to the identity.
+// sources): those sources skip the wide search. On the piled-up toy with
+// the identity as the earlier assignment, the seeded budget does about half
+// the wide searches and ends closer to the identity.
 TEST(ErrorBudget, EarlierAssignmentsSpareWideSearches) {
-  const int w = 48, h = 40, channels = 3;
-  std::mt19937 rng(11);
-  FeatureImage source(w, h, channels), target(w, h, channels);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      for (int c = 0; c < channels; ++c) {
-        source.pixel(x, y)[c] = float(rng() % 1000) * 1e-3f;
-        target.pixel(x, y)[c] = source.pixel(x, y)[c] + float(rng() % 100) * 1e-3f;
-      }
-  PatchSpace space;
-  space.source = &source, space.target = &target;
-  SearchConstraints cons;
-  cons.source_valid.assign(std::size_t(w) * h, 0);
-  for (int y = 2; y < h - 2; ++y)
-    for (int x = 2; x < w - 2; ++x) cons.source_valid[std::size_t(y) * w + x] = 1;
-  cons.target_active.assign(std::size_t(w) * h, 1);
-  cons.finalize();
-  OffsetField forward(w, h);
-  std::fill(forward.x.begin(), forward.x.end(), w / 2);
-  std::fill(forward.y.begin(), forward.y.end(), h / 2);
-  refresh_distances(space, cons, forward, 2);
-  std::vector<std::int32_t> identity(std::size_t(w) * h);
+  PiledUpMatches toy;
+  std::vector<std::int32_t> identity(toy.forward.x.size());
   std::iota(identity.begin(), identity.end(), 0);
-
-  ReversedRetrievalParams params;
-  params.seed = 3, params.threads = 2;
-  OffsetField unseeded = forward, seeded = forward;
-  const UsageStats off = retrieve_with_budget(space, cons, unseeded, params, 1);
-  const UsageStats on = retrieve_with_budget(space, cons, seeded, params, 1, &identity);
+  OffsetField unseeded = toy.forward, seeded = toy.forward;
+  const UsageStats off = retrieve_with_budget(toy.space, toy.cons, unseeded, toy.params, 1);
+  const UsageStats on = retrieve_with_budget(toy.space, toy.cons, seeded, toy.params, 1, &identity);
   const auto mean = [](const std::vector<float>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / double(v.size()); };
   // 0.44 of them when written, 0.51 since the sources that lost search
   // locally (the unseeded budget gained more from that).
@@ -374,34 +385,13 @@ TEST(ErrorBudget, EarlierAssignmentsSpareWideSearches) {
 // A source whose candidate another source won searches around that target
 // in the next round (a few local radii), not over the whole frame from a
 // random one: the wide searches of round 2 are only the sources with no
-// candidate at all (the winners and those that found none). Same toy as
-// above; seeding every loser at random counted them too.
+// candidate at all (the winners and those that found none). Seeding every
+// loser at random counted them too.
 TEST(ErrorBudget, SourcesThatLostSearchNearTheirTarget) {
-  const int w = 48, h = 40, channels = 3;
-  std::mt19937 rng(11);
-  FeatureImage source(w, h, channels), target(w, h, channels);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      for (int c = 0; c < channels; ++c) {
-        source.pixel(x, y)[c] = float(rng() % 1000) * 1e-3f;
-        target.pixel(x, y)[c] = source.pixel(x, y)[c] + float(rng() % 100) * 1e-3f;
-      }
-  PatchSpace space;
-  space.source = &source, space.target = &target;
-  SearchConstraints cons;
-  cons.source_valid.assign(std::size_t(w) * h, 0);
-  for (int y = 2; y < h - 2; ++y)
-    for (int x = 2; x < w - 2; ++x) cons.source_valid[std::size_t(y) * w + x] = 1;
-  cons.target_active.assign(std::size_t(w) * h, 1);
-  cons.finalize();
-  OffsetField field(w, h);
-  std::fill(field.x.begin(), field.x.end(), w / 2);
-  std::fill(field.y.begin(), field.y.end(), h / 2);
-  refresh_distances(space, cons, field, 2);
-  ReversedRetrievalParams params;
-  params.seed = 3, params.threads = 2;
-  ReversedRetrieval rr(space, cons, field, params, 1);
-  rr.eligible() = cons.source_valid;
+  PiledUpMatches toy;
+  OffsetField field = toy.forward;
+  ReversedRetrieval rr(toy.space, toy.cons, field, toy.params, 1);
+  rr.eligible() = toy.cons.source_valid;
   for (const Assignment& a : rr.round(0)) rr.assign(a);
   std::size_t losers = 0, without = 0;
   for (std::size_t p = 0; p < rr.candidate().size(); ++p) {
