@@ -382,27 +382,34 @@ TEST(ErrorBudget, EarlierAssignmentsSpareWideSearches) {
   EXPECT_LT(mean(seeded.dist), 0.8 * mean(unseeded.dist));  // 0.59 when written
 }
 
-// A source whose candidate another source won searches around that target
-// in the next round (a few local radii), not over the whole frame from a
-// random one: the wide searches of round 2 are only the sources with no
-// candidate at all (the winners and those that found none). Seeding every
-// loser at random counted them too.
-TEST(ErrorBudget, SourcesThatLostSearchNearTheirTarget) {
+// A source whose candidate was closed, by another source (it lost) or by
+// itself (it won), searches around that target in the next round (a few
+// local radii), not over the whole frame from a random one: the wide
+// searches of round 2 are only the sources that found no open target at
+// all. Seeding the losers at random counted them too, and the winners
+// until step 9 of issue 32 (they were about all of round 2's wide searches).
+TEST(ErrorBudget, SourcesWhoseTargetClosedSearchNearIt) {
   PiledUpMatches toy;
   OffsetField field = toy.forward;
   ReversedRetrieval rr(toy.space, toy.cons, field, toy.params, 1);
   rr.eligible() = toy.cons.source_valid;
-  for (const Assignment& a : rr.round(0)) rr.assign(a);
-  std::size_t losers = 0, without = 0;
+  const std::vector<Assignment> winners = rr.round(0);
+  for (const Assignment& a : winners) rr.assign(a);
+  std::size_t kept = 0, losers = 0, without = 0;
+  for (const Assignment& a : winners) kept += rr.candidate()[std::size_t(a.source)] == a.target;
   for (std::size_t p = 0; p < rr.candidate().size(); ++p) {
     if (!rr.eligible()[p]) continue;
-    losers += rr.candidate()[p] != kNoTarget;  // assign() cleared the winners'
+    losers += rr.candidate()[p] != kNoTarget;
     without += rr.candidate()[p] == kNoTarget;
   }
+  losers -= winners.size();
   const std::size_t before = rr.wide_searches();
   rr.round(1);
+  EXPECT_EQ(kept, winners.size());  // each winner keeps its (now closed) target as its centre
+  EXPECT_GT(winners.size(), 300u);
   EXPECT_GT(losers, 100u);
   EXPECT_LE(rr.wide_searches() - before, without);
+  EXPECT_LT(rr.wide_searches() - before, winners.size() / 4);
 }
 
 TEST(PatchSpace, AxialRotationTakesTheSmallestAngle) {

@@ -84,7 +84,9 @@ class ReversedRetrieval {
     nnf_.y[a.target] = a.source / sw_;
     nnf_.dist[a.target] = a.dist / border_scale(a.target % tw_, a.target / tw_);
     open_[a.target] = 0;
-    candidate_[a.source] = kNoTarget;
+    // The source keeps the target it won, now closed, as the centre of its
+    // next round's local search, like a source that lost its candidate: its
+    // best open target is most often next to the one it filled.
     candidate_dist_[a.source] = kNoDistance;
     ++assigned_count_;
   }
@@ -122,9 +124,9 @@ class ReversedRetrieval {
   // Keeps still-open candidates, adopts targets whose forward match (or
   // earlier match) is this source (good pairs known), else picks at random.
   // Only the random picks need the wide random search of the sweep; a source
-  // whose candidate another source won searches around that target (its
-  // best open one is most often near it), the others are refined by
-  // propagation alone.
+  // whose candidate was closed (won by another source, or by itself in an
+  // earlier round) searches around that target (its best open one is most
+  // often near it), the others are refined by propagation alone.
   void seed_candidates(int round_index) {
     parallel_for(sh_, params_.threads, [&](int sy) {
       for (std::size_t p = std::size_t(sy) * sw_, end = p + sw_; p < end; ++p) {
