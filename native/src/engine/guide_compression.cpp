@@ -51,26 +51,63 @@ void symmetric_eigen(std::vector<double> a, int n, std::vector<double>& values, 
   }
 }
 
-GuideProjection fit_guide_projection(const ImageView& source, const ImageView& target, double keep) {
-  if (source.channels != target.channels) throw ValueError("internal: guide channel counts differ");
-  const int n = source.channels;
+int WeightedGuides::channels() const {
+  int n = 0;
+  for (const auto& layer : layers) n += layer.channels;
+  return n;
+}
+
+void WeightedGuides::pixel(std::size_t i, float* out) const {
+  for (std::size_t k = 0; k < layers.size(); ++k) {
+    const ImageView& layer = layers[k];
+    for (int c = 0; c < layer.channels; ++c) *out++ = layer.data[i * std::size_t(layer.channels) + c] * scales[k];
+  }
+}
+
+namespace {
+
+// Calls fn(pixel) on a regular subsample of the images read as one (rows of
+// the first, then of the next, ...): a subsample is plenty for a covariance.
+template <class Fn>
+void visit_subsample(const std::vector<const WeightedGuides*>& images, int n, Fn&& fn) {
+  std::size_t total = 0;
+  for (const WeightedGuides* g : images) total += g->pixel_count();
+  const std::size_t step = std::max<std::size_t>(1, total / 65536);
+  std::vector<float> px(static_cast<std::size_t>(n));
+  std::size_t first = 0;  // index of the current image's first pixel in the whole
+  for (const WeightedGuides* g : images) {
+    for (std::size_t i = (step - first % step) % step; i < g->pixel_count(); i += step) {
+      g->pixel(i, px.data());
+      fn(px.data());
+    }
+    first += g->pixel_count();
+  }
+}
+
+}  // namespace
+
+GuideProjection fit_guide_projection(const std::vector<WeightedGuides>& sources, const WeightedGuides& target,
+                                     double keep) {
+  const int n = target.channels();
+  for (const auto& s : sources)
+    if (s.channels() != n) throw ValueError("internal: guide channel counts differ");
   GuideProjection proj;
   proj.input_channels = n;
-  // Mean and covariance over both images (a regular subsample is plenty).
+  // Mean and covariance over the sources and the target, each side
+  // subsampled on its own.
+  std::vector<const WeightedGuides*> source_images;
+  for (const auto& s : sources) source_images.push_back(&s);
+  const std::vector<const WeightedGuides*> sides[2] = {source_images, {&target}};
   std::vector<double> mean(n, 0.0), cov(std::size_t(n) * n, 0.0);
   std::size_t count = 0;
-  auto visit = [&](const ImageView& img, auto&& fn) {
-    const std::size_t step = std::max<std::size_t>(1, img.pixel_count() / 65536);
-    for (std::size_t i = 0; i < img.pixel_count(); i += step) fn(img.data + i * n);
-  };
-  for (const ImageView* img : {&source, &target})
-    visit(*img, [&](const float* px) {
+  for (const auto& side : sides)
+    visit_subsample(side, n, [&](const float* px) {
       for (int c = 0; c < n; ++c) mean[c] += px[c];
       ++count;
     });
   for (auto& m : mean) m /= double(count);
-  for (const ImageView* img : {&source, &target})
-    visit(*img, [&](const float* px) {
+  for (const auto& side : sides)
+    visit_subsample(side, n, [&](const float* px) {
       for (int i = 0; i < n; ++i)
         for (int j = i; j < n; ++j) cov[i * n + j] += (px[i] - mean[i]) * (px[j] - mean[j]);
     });
@@ -90,11 +127,13 @@ GuideProjection fit_guide_projection(const ImageView& source, const ImageView& t
   return proj;
 }
 
-Image GuideProjection::apply(const ImageView& guides) const {
+Image GuideProjection::apply(const WeightedGuides& guides) const {
   const int n = input_channels, k = output_channels();
-  Image out(guides.width, guides.height, k);
+  const ImageView& first = guides.layers.front();
+  Image out(first.width, first.height, k);
+  std::vector<float> px(static_cast<std::size_t>(n));
   for (std::size_t i = 0; i < guides.pixel_count(); ++i) {
-    const float* px = guides.data + i * n;
+    guides.pixel(i, px.data());
     float* o = out.data() + i * k;
     for (int r = 0; r < k; ++r) {
       float s = 0;

@@ -168,18 +168,6 @@ Image stack_channels(const std::vector<ImageView>& parts, const std::vector<floa
   return out;
 }
 
-Image stack_rows(const std::vector<Image>& parts) {
-  int h = 0;
-  for (const auto& p : parts) h += p.height();
-  Image out(parts.front().width(), h, parts.front().channels());
-  int y = 0;
-  for (const auto& p : parts) {
-    std::memcpy(out.pixel(0, y), p.data(), sizeof(float) * p.pixel_count() * p.channels());
-    y += p.height();
-  }
-  return out;
-}
-
 // Angles downsample as unit vectors (averaging raw angles breaks at the
 // wrap-around); axial angles as doubled-angle vectors, so a and a + pi agree.
 std::vector<Image> angle_pyramid(const ImageView& angles, int levels, double ratio, bool axial) {
@@ -311,29 +299,32 @@ Solver::Solver(const SynthesisInput& in, const SynthesisOptions& opt) : plan_(ne
   std::vector<Image> src_guides(ex.size());  // per exemplar, all layers stacked along channels
   Image tgt_guides;
   if (!layers.empty()) {
-    std::vector<float> scales;
-    std::vector<ImageView> targets;
+    std::vector<WeightedGuides> sources(ex.size());
+    WeightedGuides target;
     for (const auto& layer : layers) {
-      scales.push_back(std::sqrt(layer.weight));
-      targets.push_back(layer.target);
+      target.scales.push_back(std::sqrt(layer.weight));
+      target.layers.push_back(layer.target);
       p.guide_channels.push_back(layer.source.channels);
       p.guide_weights.push_back(layer.weight);
     }
-    for (std::size_t e = 0; e < ex.size(); ++e) src_guides[e] = stack_channels(ex[e].guides, scales);
-    tgt_guides = stack_channels(targets, scales);
+    for (std::size_t e = 0; e < ex.size(); ++e) sources[e] = {ex[e].guides, target.scales};
     const bool has_maps = std::any_of(in.target_weight_maps.begin(), in.target_weight_maps.end(),
                                       [](const ImageView& m) { return !m.empty(); });
-    if (opt.guide_variance < 1.0 && !has_maps && tgt_guides.channels() > 1) {
-      // One projection for the whole source set, fitted on all of it.
-      const Image all_sources = src_guides.size() == 1 ? Image() : stack_rows(src_guides);
-      const GuideProjection proj = fit_guide_projection(
-          src_guides.size() == 1 ? src_guides[0].view() : all_sources.view(), tgt_guides.view(), opt.guide_variance);
-      for (auto& g : src_guides) g = proj.apply(g.view());
-      tgt_guides = proj.apply(tgt_guides.view());
+    if (opt.guide_variance < 1.0 && !has_maps && target.channels() > 1) {
+      // One projection for the whole source set, fitted on all of it and
+      // applied to the layers in place (no stacked copy).
+      const GuideProjection proj = fit_guide_projection(sources, target, opt.guide_variance);
+      for (std::size_t e = 0; e < ex.size(); ++e) src_guides[e] = proj.apply(sources[e]);
+      tgt_guides = proj.apply(target);
       p.guide_channels = {proj.output_channels()};
       p.kept_variance = proj.kept_variance;
+    } else {
+      for (std::size_t e = 0; e < ex.size(); ++e) src_guides[e] = stack_channels(ex[e].guides, target.scales);
+      tgt_guides = stack_channels(target.layers, target.scales);
     }
   }
+  // The guide layers are not read past this point.
+  if (in.guides_read) in.guides_read();
 
   // The atlas of each level.
   std::vector<std::vector<std::pair<int, int>>> sizes;  // per exemplar, per level

@@ -54,6 +54,12 @@ struct SynthesisInput {
   FixedPixels fixed;
   // Method terms (energy_term.hpp) besides the usage term of the options.
   EnergyTerms terms;
+  // Optional: called once, as soon as the solver holds its own copy of the
+  // guide images (the layers of `guides` and the exemplars' guides) and
+  // before the pyramids are built. A caller that owns large guide images
+  // (the CLI's decoded files) frees them here, so that they do not add to
+  // the peak memory; their views are not read again.
+  std::function<void()> guides_read;
 };
 
 struct LevelStats {
