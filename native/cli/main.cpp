@@ -1,9 +1,6 @@
 // `tempera`: the batch command line. Runs the native solvers on files on disk,
 // with no Blender and no Python, so a render farm can split work by frames.
 #include <cstring>
-#if defined(__GLIBC__)
-#include <malloc.h>
-#endif
 #include <iostream>
 #include <string>
 #include <vector>
@@ -30,21 +27,7 @@ void print_help() {
 
 }  // namespace
 
-// Images and feature planes are allocated and freed whole, a level or an
-// input at a time. glibc maps allocations above its mmap threshold and
-// unmaps them when freed, but raises that threshold to the size of each
-// mapped block freed (up to 32 MB): after the first freed image every later
-// one comes from the heap, whose freed pages stay resident, so the process
-// held what the solve had freed. A fixed 1 MiB threshold hands every freed
-// image back at once.
-void return_freed_images_to_the_system() {
-#if defined(__GLIBC__)
-  mallopt(M_MMAP_THRESHOLD, 1 << 20);
-#endif
-}
-
 int main(int argc, char** argv) {
-  return_freed_images_to_the_system();
   Args args(argv + 1, argv + argc);
   if (args.empty() || args[0] == "--help" || args[0] == "-h") {
     print_help();
