@@ -85,6 +85,9 @@ SynthesisResult stylize_frame(const ImageView& style, const GuideFrame& exemplar
     in.target_weight_maps.assign(guides.size(), ImageView{});
     in.target_weight_maps.push_back(temporal->occlusion_backward);  // disoccluded: no pull
   }
+  // The copies are read once, into the solver's own guides: freed there, they
+  // do not add to the frame's peak (two per guide, at the frame's size).
+  in.guides_read = [&] { tonemapped = {}; };
   SynthesisOptions engine = engine_options(options);
   if (!warm_starts(options) || !temporal || !temporal->previous_field) return synthesize(in, engine, progress);
   require_channels(temporal->velocity_backward, 2, "velocity_backward");
