@@ -64,6 +64,13 @@ void WeightedGuides::pixel(std::size_t i, float* out) const {
   }
 }
 
+Image WeightedGuides::stacked() const {
+  const ImageView& first = layers.front();
+  Image out(first.width, first.height, channels());
+  for (std::size_t i = 0; i < out.pixel_count(); ++i) pixel(i, out.data() + i * std::size_t(out.channels()));
+  return out;
+}
+
 namespace {
 
 // Calls fn(pixel) on a regular subsample of the images read as one (rows of

@@ -146,23 +146,16 @@ void validate_input(const SynthesisInput& in) {
 
 // ---- pyramids ----
 
-// The channels of `parts` side by side, each part multiplied by its entry of
-// `scales` (empty = 1) while copied: no scaled copy of every guide first.
-Image stack_channels(const std::vector<ImageView>& parts, const std::vector<float>& scales = {}) {
+// The channels of `parts` side by side.
+Image stack_channels(const std::vector<ImageView>& parts) {
   int channels = 0;
   for (const auto& p : parts) channels += p.channels;
   Image out(parts.front().width, parts.front().height, channels);
   const std::size_t n = out.pixel_count();
   int first = 0;
-  for (std::size_t k = 0; k < parts.size(); ++k) {
-    const ImageView& p = parts[k];
-    if (scales.empty()) {
-      for (std::size_t i = 0; i < n; ++i)
-        std::memcpy(out.data() + i * channels + first, p.data + i * p.channels, sizeof(float) * p.channels);
-    } else {
-      for (std::size_t i = 0; i < n; ++i)
-        for (int c = 0; c < p.channels; ++c) out.data()[i * channels + first + c] = p.data[i * p.channels + c] * scales[k];
-    }
+  for (const ImageView& p : parts) {
+    for (std::size_t i = 0; i < n; ++i)
+      std::memcpy(out.data() + i * channels + first, p.data + i * p.channels, sizeof(float) * p.channels);
     first += p.channels;
   }
   return out;
@@ -319,8 +312,8 @@ Solver::Solver(const SynthesisInput& in, const SynthesisOptions& opt) : plan_(ne
       p.guide_channels = {proj.output_channels()};
       p.kept_variance = proj.kept_variance;
     } else {
-      for (std::size_t e = 0; e < ex.size(); ++e) src_guides[e] = stack_channels(ex[e].guides, target.scales);
-      tgt_guides = stack_channels(target.layers, target.scales);
+      for (std::size_t e = 0; e < ex.size(); ++e) src_guides[e] = sources[e].stacked();
+      tgt_guides = target.stacked();
     }
   }
   // The guide layers are not read past this point.

@@ -25,6 +25,8 @@ struct WeightedGuides {
   std::size_t pixel_count() const { return layers.empty() ? 0 : layers.front().pixel_count(); }
   // The stacked, scaled channels of pixel i (channels() values).
   void pixel(std::size_t i, float* out) const;
+  // All pixels so: the stack itself, for guides matched uncompressed.
+  Image stacked() const;
 };
 
 struct GuideProjection {
