@@ -10,7 +10,6 @@ import signal
 import subprocess
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -155,7 +154,13 @@ def test_blender_does_not_outlive_the_command(cli_path, tmp_path, command, signa
     cli = subprocess.Popen([str(cli_path), command, str(scene), *args],
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
     try:
-        assert _wait(lambda: pid_file.is_file() and pid_file.read_text()), "Blender was never started"
+        started = lambda: pid_file.is_file() and pid_file.read_text()
+        # Until Blender starts or the CLI ends: a CLI that failed first says why.
+        _wait(lambda: started() or cli.poll() is not None, seconds=90)
+        if not started():
+            cli.kill()
+            out, err = cli.communicate()
+            pytest.fail(f"Blender was never started; the CLI ended with {cli.returncode}: {err.decode()}{out.decode()}")
         child = int(pid_file.read_text())
         cli.send_signal(getattr(signal, signal_name))
         status = cli.wait(timeout=20)
