@@ -115,7 +115,7 @@ int run_synth(const Args& args) {
     refuse_output_on_inputs(output_path, inputs, "--output");
   }
 
-  const Image style = read_input(style_path);
+  Image style = read_input(style_path);
   std::vector<Image> sources, targets;
   for (const auto& g : guides) {
     sources.push_back(read_input(g.source));
@@ -140,6 +140,8 @@ int run_synth(const Args& args) {
   if (!reference_path.empty()) input.reference = (reference = read_input(reference_path)).view();
   if (!source_mask_path.empty()) input.source_mask = (source_mask = read_mask(source_mask_path)).view();
   if (!target_mask_path.empty()) input.target_mask = (target_mask = read_mask(target_mask_path)).view();
+  // And the rest once the solver has its pyramids (the style: 13 MB of the still's peak).
+  input.inputs_read = [&] { style = source_mask = target_mask = reference = Image(); };
 
   int last_percent = -1;
   const SynthesisResult result = synthesize(input, opt, [&](double f) {

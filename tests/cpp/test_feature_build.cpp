@@ -50,7 +50,7 @@ std::vector<float> scales(int n, float s) { return std::vector<float>(std::size_
 // values must then not widen the range), slots no write reaches, a target
 // range that starts after the style slots, and both storage widths.
 TEST(FeatureBuild, FixedPointFromWritesEqualsQuantizedFloat) {
-  const int w = 37, h = 23, channels = 11;  // stride 16: five padding slots
+  const int w = 37, h = 23, channels = 11;
   const Image all = random_image(w, h, 9, 1, -3.0f, 5.0f);     // slots 0..8
   const Image style = random_image(w, h, 3, 2, 0.0f, 1.0f);    // replaces slots 0..2
   const Image wide = random_image(w, h, 2, 3, -40.0f, 40.0f);  // slots 3..4, replaced below
@@ -69,7 +69,7 @@ TEST(FeatureBuild, FixedPointFromWritesEqualsQuantizedFloat) {
     std::vector<float> offset_float, offset_writes;
     float step_float = 0, step_writes = 0;
     fixed_point_range(fs, ft, 3, max_value, offset_float, step_float);
-    fixed_point_range(source, target, FeatureImage::padded(channels), 3, max_value, offset_writes, step_writes);
+    fixed_point_range(source, target, channels, 3, max_value, offset_writes, step_writes);
     ASSERT_EQ(offset_writes, offset_float);
     ASSERT_EQ(step_writes, step_float);
     fs.quantize(offset_float, step_float, max_value);
@@ -102,7 +102,7 @@ TEST(FeatureBuild, LevelBuildAllocatesNoFloatFeatureImage) {
   for (int y = 0; y < s; ++y)
     for (int x = 0; x < s; ++x)
       field.set_position(std::size_t(y) * s + x, float(std::clamp(x, 2, s - 3)), float(std::clamp(y, 2, s - 3)));
-  const std::size_t float_features = std::size_t(s) * s * FeatureImage::padded(5) * sizeof(float);
+  const std::size_t float_features = std::size_t(s) * s * 5 * sizeof(float);
   auto largest_during_energy = [&](FeaturePrecision precision, double& energy) {
     SynthesisOptions opt;
     opt.feature_precision = precision;

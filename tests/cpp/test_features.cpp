@@ -81,7 +81,8 @@ int check_patch_kernels(int max_value) {
   std::mt19937 rng(9);
   std::uniform_int_distribution<int> value(0, max_value);
   int checked = 0;
-  for (int n : {8, 16, 24, 40, 56, 72, 96, 104, 120, 128, 136, 248}) {  // kShortRow = 128
+  // kShortRow = 128; rows of unpadded pixels (9 channels: 45 values a 5-pixel row) and clipped ones (< 8)
+  for (int n : {3, 5, 8, 9, 13, 16, 24, 40, 45, 56, 63, 72, 96, 104, 120, 127, 128, 136, 248}) {
     const int rows = 7;
     const std::size_t pitch_a = std::size_t(n) + 24, pitch_b = std::size_t(n) + 8;
     std::vector<T> a(pitch_a * rows), b(pitch_b * rows);
@@ -144,7 +145,7 @@ TEST(FixedFeatures, QuantizedDistanceMatchesFloatWithinRounding) {
     qt.quantize(offset, step, max_value);
     EXPECT_TRUE(qs.data.empty());  // the floats are freed
     ASSERT_TRUE(qs.quantized());
-    EXPECT_EQ(qs.bytes_per_pixel(), max_value == FeatureImage::kFixed8 ? 8 : 16);
+    EXPECT_EQ(qs.bytes_per_pixel(), max_value == FeatureImage::kFixed8 ? 7 : 14);  // unpadded
     PatchSpace qspace;
     qspace.source = &qs, qspace.target = &qt;
     std::mt19937 rng(3);

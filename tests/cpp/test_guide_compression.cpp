@@ -115,3 +115,25 @@ TEST(GuideCompression, GuidesAreNotReadAfterTheCallerIsToldSo) {
     tg1 = noise_texture(56, 36, 3, 24), tg2 = noise_texture(56, 36, 2, 25);
   }
 }
+
+// Nor is the style, the other large input, once the solver has its pyramids.
+TEST(GuideCompression, InputsAreNotReadAfterTheCallerIsToldSo) {
+  Image style = noise_texture(48, 40, 3, 31);
+  const Image sg = noise_texture(48, 40, 3, 32), tg = noise_texture(56, 36, 3, 33);
+  SynthesisOptions opt;
+  opt.em_iterations = 2;
+  opt.threads = 2;
+  SynthesisInput in;
+  in.style = style.view();
+  in.guides.add("a", sg.view(), tg.view());
+  const SynthesisResult plain = synthesize(in, opt);
+  int calls = 0;
+  in.inputs_read = [&] {
+    ++calls;
+    std::fill(style.data(), style.data() + style.pixel_count() * style.channels(),
+              std::numeric_limits<float>::quiet_NaN());
+  };
+  const SynthesisResult freed = synthesize(in, opt);
+  EXPECT_EQ(calls, 1);
+  EXPECT_TRUE(same(plain.image, freed.image));
+}

@@ -92,11 +92,14 @@ UsageStats retrieve_with_budget(const PatchSpace& space, const SearchConstraints
   rr.set_earlier_sources(earlier_sources);
   rr.eligible() = cons.source_valid;
   UsageStats stats;
-  std::vector<float> errors;  // kept across rounds with its scratch, to spare a million-entry allocation each
+  // Kept across rounds with its scratch, to spare a million-entry allocation
+  // each; sized once, as a growing vector holds its old and new buffers.
+  std::vector<float> errors;
+  errors.reserve(rr.candidate().size());
   std::vector<std::uint32_t> sort_scratch;
   while (stats.rounds < params.max_rounds &&
          double(rr.assigned_count()) < params.coverage_goal * double(rr.active())) {
-    const auto winners = rr.round(stats.rounds++);
+    rr.search(stats.rounds++);
     // The knee of this round's sorted candidate errors.
     errors.clear();
     for (std::size_t p = 0; p < rr.candidate().size(); ++p)
@@ -113,11 +116,11 @@ UsageStats retrieve_with_budget(const PatchSpace& space, const SearchConstraints
     // winners below the knee are a subset of those candidates, so taking all of
     // them keeps the total under T (thesis eq. 8.4).
     std::size_t taken = 0;
-    for (const auto& a : winners) {
-      if (a.dist > knee_error) continue;
+    rr.for_each_winner([&](const Assignment& a) {
+      if (a.dist > knee_error) return;
       rr.assign(a);
       ++taken;
-    }
+    });
     if (taken == 0) break;
   }
   stats.covered = double(rr.assigned_count()) / double(std::max<std::size_t>(1, rr.active()));

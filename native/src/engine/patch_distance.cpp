@@ -12,12 +12,12 @@
 namespace tempera {
 
 FeatureImage::FeatureImage(int w, int h, int channels)
-    : width(w), height(h), stride(padded(channels)), data(std::size_t(w) * h * padded(channels), 0.0f) {}
+    : width(w), height(h), stride(channels), data(std::size_t(w) * h * channels, 0.0f) {}
 
 FeatureImage FeatureImage::fixed_point(int w, int h, int channels, const std::vector<float>& channel_offset,
                                        float quant_step, int max_value) {
   FeatureImage f;
-  f.width = w, f.height = h, f.stride = padded(channels);
+  f.width = w, f.height = h, f.stride = channels;
   f.use_fixed_point(channel_offset, quant_step, max_value);
   return f;
 }
@@ -278,8 +278,8 @@ using FixedSsd = std::int64_t (*)(const T*, const T*, int);
 // summed row by row until the sum reaches `limit` (the early exit). One call
 // a candidate, not one a row: a candidate costs a few rows, and the call and
 // the 64-bit reduction per row were as dear as the arithmetic. A row of up to
-// kShortRow values (a 5x5 patch of 8 channels is 40; StyLit's four guides and
-// its temporal guide, 24 padded channels, 120) is reduced in 32 bits: its
+// kShortRow values (a 5x5 patch row of StyLit's 9 channels, style and 6
+// guide components, is 45) is reduced in 32 bits: its
 // sum, and so every partial sum of its lanes, is at most
 // 128 * 4095^2 < 2^31. Longer rows go through the blocked row kernels.
 constexpr int kShortRow = 128;
@@ -340,20 +340,36 @@ template <class T>
   return _mm_cvtepu8_epi16(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)));
 }
 
+// Lanes [8 - r, 8) set, r in 1..7: the last r values of an 8-value load.
+[[gnu::target("avx2")]] inline __m128i last_lanes(int r) {
+  static const std::int16_t kLanes[16] = {0, 0, 0, 0, 0, 0, 0, 0, -1, -1, -1, -1, -1, -1, -1, -1};
+  return _mm_loadu_si128(reinterpret_cast<const __m128i*>(kLanes + r));
+}
+
 template <class T>
 [[gnu::target("avx2")]] std::int64_t patch_ssd_avx2(const T* a, std::size_t pa, const T* b, std::size_t pb,
                                                     int rows, int n, std::int64_t limit) {
   if (n > kShortRow) return patch_rows<T, fixed_ssd_avx2>(a, pa, b, pb, rows, n, limit);
+  if (n < 8) return patch_rows<T, fixed_ssd_scalar<T>>(a, pa, b, pb, rows, n, limit);
+  // Pixels are not padded, so a row need not be a multiple of 8 values: its
+  // last r values are loaded with the 8 that end the row (nothing past the
+  // row is read) and the lanes summed already are masked off.
+  const int tail = n % 8, body = n - tail;
+  const __m128i keep = tail ? last_lanes(tail) : _mm_setzero_si128();
   std::int64_t sum = 0;
   for (int k = 0; k < rows && sum < limit; ++k, a += pa, b += pb) {
     __m256i acc = _mm256_setzero_si256();
     int i = 0;
-    for (; i + 16 <= n; i += 16) {
+    for (; i + 16 <= body; i += 16) {
       const __m256i d = _mm256_sub_epi16(load16(a + i), load16(b + i));
       acc = _mm256_add_epi32(acc, _mm256_madd_epi16(d, d));
     }
-    if (i < n) {  // rows are whole pixels, a multiple of 8 values
+    if (i < body) {
       const __m128i d = _mm_sub_epi16(load8(a + i), load8(b + i));
+      acc = _mm256_add_epi32(acc, _mm256_zextsi128_si256(_mm_madd_epi16(d, d)));
+    }
+    if (tail) {
+      const __m128i d = _mm_and_si128(_mm_sub_epi16(load8(a + n - 8), load8(b + n - 8)), keep);
       acc = _mm256_add_epi32(acc, _mm256_zextsi128_si256(_mm_madd_epi16(d, d)));
     }
     sum += hsum32(acc);

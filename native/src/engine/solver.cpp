@@ -406,6 +406,7 @@ Solver::Solver(const SynthesisInput& in, const SynthesisOptions& opt) : plan_(ne
   if (opt.window_sigma > 0) p.window = gaussian_window(opt.patch_size / 2, opt.window_sigma);
   terms_ = in.terms;
   if (auto usage = make_usage_term(opt)) terms_.insert(terms_.begin(), usage);
+  if (in.inputs_read) in.inputs_read();
 }
 
 Solver::~Solver() = default;
@@ -585,8 +586,7 @@ void Solver::allocate_features(Level& level, const std::vector<ChannelWrite>& so
       options_.feature_precision == FeaturePrecision::Int8 ? FeatureImage::kFixed8 : FeatureImage::kFixed12;
   std::vector<float> offset;
   float step = 0.0f;
-  fixed_point_range(source_writes, target_writes, FeatureImage::padded(total), plan_->style_channels, max_value,
-                    offset, step);
+  fixed_point_range(source_writes, target_writes, total, plan_->style_channels, max_value, offset, step);
   level.source = FeatureImage::fixed_point(sw, sh, total, offset, step, max_value);
   level.target = FeatureImage::fixed_point(tw, th, total, offset, step, max_value);
 }

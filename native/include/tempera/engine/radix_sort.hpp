@@ -26,19 +26,27 @@ inline float float_from_order_key(std::uint32_t key) {
   return v;
 }
 
-// Sorts `values` ascending; `scratch` (keys and their copy) is reused between
-// calls to spare the allocation.
+// Sorts `values` ascending. The keys pass back and forth between `scratch`
+// and `values` itself (its floats then hold key bits, copied with memcpy and
+// never read as numbers), so the sort needs n keys of scratch, not 2n: the
+// error budget's sort was part of the peak memory. `scratch` is reused
+// between calls to spare the allocation.
 inline void radix_sort(std::vector<float>& values, std::vector<std::uint32_t>& scratch) {
   constexpr int kBits = 11, kPasses = 3;  // 3 x 11 bits cover the 32-bit key
   constexpr std::uint32_t kBuckets = 1u << kBits;
   const std::size_t n = values.size();
-  scratch.resize(2 * n);
-  std::uint32_t* from = scratch.data();
-  std::uint32_t* to = from + n;
+  scratch.resize(n);
+  float* v = values.data();
+  std::uint32_t* keys = scratch.data();
+  const auto key_in_values = [v](std::size_t i) {
+    std::uint32_t key;
+    std::memcpy(&key, v + i, sizeof key);
+    return key;
+  };
   std::array<std::array<std::size_t, kBuckets>, kPasses> count{};
   for (std::size_t i = 0; i < n; ++i) {
-    from[i] = float_order_key(values[i]);
-    for (int pass = 0; pass < kPasses; ++pass) ++count[pass][(from[i] >> (pass * kBits)) & (kBuckets - 1)];
+    keys[i] = float_order_key(v[i]);
+    for (int pass = 0; pass < kPasses; ++pass) ++count[pass][(keys[i] >> (pass * kBits)) & (kBuckets - 1)];
   }
   for (int pass = 0; pass < kPasses; ++pass) {
     std::size_t start = 0;
@@ -47,10 +55,17 @@ inline void radix_sort(std::vector<float>& values, std::vector<std::uint32_t>& s
       c = start;
       start += size;
     }
-    for (std::size_t i = 0; i < n; ++i) to[count[pass][(from[i] >> (pass * kBits)) & (kBuckets - 1)]++] = from[i];
-    std::swap(from, to);
+    const auto bucket = [&](std::uint32_t key) { return count[pass][(key >> (pass * kBits)) & (kBuckets - 1)]++; };
+    if (pass % 2 == 0)  // scratch -> values
+      for (std::size_t i = 0; i < n; ++i) std::memcpy(v + bucket(keys[i]), &keys[i], sizeof keys[i]);
+    else  // values -> scratch
+      for (std::size_t i = 0; i < n; ++i) {
+        const std::uint32_t key = key_in_values(i);
+        keys[bucket(key)] = key;
+      }
   }
-  for (std::size_t i = 0; i < n; ++i) values[i] = float_from_order_key(from[i]);
+  static_assert(kPasses % 2 == 1, "the sorted keys end in `values`");
+  for (std::size_t i = 0; i < n; ++i) v[i] = float_from_order_key(key_in_values(i));
 }
 
 }  // namespace tempera

@@ -70,13 +70,37 @@ class ReversedRetrieval {
   // frame: the costly part of a round).
   std::size_t wide_searches() const { return wide_searches_; }
 
-  // One round of retrieval: fills candidates for eligible sources and returns
-  // the collision-free (best source per target) assignments, in target order.
-  std::vector<Assignment> round(int round_index) {
+  // One round of retrieval: fills candidates for eligible sources and picks
+  // the best source of each target they reach (the round's winners).
+  void search(int round_index) {
     collect_unassigned();
     seed_candidates(round_index);
     for (int it = 0; it < params_.pm_iterations; ++it) sweep(round_index, it);
-    return resolve_collisions();
+    resolve_collisions();
+  }
+
+  // The last search's winners, collision-free (one source per target), in
+  // target order; f may assign() them. Read in place: a list of a round's
+  // winners was up to 12 bytes a target at the peak of the solve.
+  template <class F>
+  void for_each_winner(F&& f) const {
+    for (std::size_t q = 0; q < best_source_.size(); ++q) {
+      const std::uint64_t key = best_source_[q].load(std::memory_order_relaxed);
+      if (key == ~0ull) continue;
+      const std::int32_t p = std::int32_t(key & 0xFFFFFFFFull);
+      f(Assignment{candidate_dist_[p], std::int32_t(q), p});
+    }
+  }
+
+  // search(), then its winners as a list (to sort them).
+  std::vector<Assignment> round(int round_index) {
+    search(round_index);
+    std::vector<Assignment> out;
+    out.reserve(std::size_t(std::count_if(best_source_.begin(), best_source_.end(), [](const auto& b) {
+      return b.load(std::memory_order_relaxed) != ~0ull;
+    })));
+    for_each_winner([&](const Assignment& a) { out.push_back(a); });
+    return out;
   }
 
   void assign(const Assignment& a) {
@@ -289,7 +313,7 @@ class ReversedRetrieval {
 
   // Best source per target, in parallel: an atomic minimum over (distance
   // bits, source index), so the winner does not depend on thread timing.
-  std::vector<Assignment> resolve_collisions() {
+  void resolve_collisions() {
     auto& best = best_source_;
     parallel_for(th_, params_.threads, [&](int qy) {
       for (std::size_t q = std::size_t(qy) * tw_, end = q + tw_; q < end; ++q) best[q].store(~0ull, std::memory_order_relaxed);
@@ -306,19 +330,6 @@ class ReversedRetrieval {
         }
       }
     });
-    // Sized once: a growing vector holds its old and new buffers at once,
-    // and a round's winners are up to 12 bytes per target.
-    std::vector<Assignment> out;
-    out.reserve(std::size_t(std::count_if(best.begin(), best.end(), [](const auto& b) {
-      return b.load(std::memory_order_relaxed) != ~0ull;
-    })));
-    for (std::size_t q = 0; q < best.size(); ++q) {
-      const std::uint64_t key = best[q].load(std::memory_order_relaxed);
-      if (key == ~0ull) continue;
-      const std::int32_t p = std::int32_t(key & 0xFFFFFFFFull);
-      out.push_back({candidate_dist_[p], std::int32_t(q), p});
-    }
-    return out;
   }
 
   const PatchSpace& space_;
