@@ -131,11 +131,9 @@ int run_synth(const Args& args) {
     input.guides.add(guides[i].source, sources[i].view(), targets[i].view(), guides[i].weight);
   }
   // The decoded guides (floats, 8 of the still's 9 input images) are freed
-  // as soon as the solver has projected them.
-  input.guides_read = [&] {
-    sources.clear();
-    targets.clear();
-  };
+  // as soon as the solver has projected them, the exemplar's first.
+  input.exemplar_guides_read = [&] { sources.clear(); };
+  input.guides_read = [&] { targets.clear(); };
   Image source_mask, target_mask, reference;
   if (!reference_path.empty()) input.reference = (reference = read_input(reference_path)).view();
   if (!source_mask_path.empty()) input.source_mask = (source_mask = read_mask(source_mask_path)).view();

@@ -102,13 +102,21 @@ TEST(GuideCompression, GuidesAreNotReadAfterTheCallerIsToldSo) {
     opt.guide_variance = variance;
     const SynthesisResult plain = synthesize(input(), opt);
     SynthesisInput told = input();
-    int calls = 0;
-    told.guides_read = [&] {
-      ++calls;
-      for (Image* g : {&sg1, &sg2, &tg1, &tg2})
+    int exemplar_calls = 0, calls = 0;
+    const auto poison = [](std::initializer_list<Image*> images) {
+      for (Image* g : images)
         std::fill(g->data(), g->data() + g->pixel_count() * g->channels(), std::numeric_limits<float>::quiet_NaN());
     };
+    told.exemplar_guides_read = [&] {  // the exemplar's first, the target's still read after
+      ++exemplar_calls;
+      poison({&sg1, &sg2});
+    };
+    told.guides_read = [&] {
+      ++calls;
+      poison({&tg1, &tg2});
+    };
     const SynthesisResult freed = synthesize(told, opt);
+    EXPECT_EQ(exemplar_calls, 1) << "variance " << variance;
     EXPECT_EQ(calls, 1) << "variance " << variance;
     EXPECT_TRUE(same(plain.image, freed.image)) << "variance " << variance;
     sg1 = noise_texture(48, 40, 3, 22), sg2 = noise_texture(48, 40, 2, 23);

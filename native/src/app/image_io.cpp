@@ -121,6 +121,30 @@ bool is_8bit_format(const std::string& path) {
   return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".gif";
 }
 
+// Reads the current subimage `sub` of `input` as float, all its channels, in
+// bands of rows, handing each to use(first_row, rows, pixels). Memory stays a
+// band: a whole-image read held the image in float twice more at once (this
+// buffer and OpenImageIO's conversion buffer), the peak of `tempera synth`
+// while it decoded its last input. Tiled files are read whole.
+template <class Use>
+bool read_bands(OIIO::ImageInput& input, int sub, Use&& use) {
+  const OIIO::ImageSpec spec = input.spec();
+  const int band_rows = spec.tile_width > 0 ? spec.height : std::min(64, spec.height);
+  std::vector<float> band(std::size_t(spec.width) * spec.nchannels * std::size_t(band_rows));
+  if (spec.tile_width > 0) {
+    if (!input.read_image(sub, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, band.data())) return false;
+    use(0, spec.height, band.data());
+    return true;
+  }
+  for (int y = spec.y; y < spec.y + spec.height; y += band_rows) {
+    const int end = std::min(y + band_rows, spec.y + spec.height);
+    if (!input.read_scanlines(sub, 0, y, end, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, band.data()))
+      return false;
+    use(y - spec.y, end - y, band.data());
+  }
+  return true;
+}
+
 }  // namespace
 
 std::int64_t max_image_pixels() { return pixel_cap().load(); }
@@ -169,23 +193,25 @@ Image read_image(const std::string& path, const std::vector<std::string>& channe
   }
   Image out(spec0.width, spec0.height, int(wanted.size()));
   out.channel_names = names;
-  // Read whole subimages once, then scatter the wanted channels.
-  std::vector<float> buffer;
+  // Each subimage with wanted channels is read once, band by band, and the
+  // wanted channels scattered.
   for (int sub = 0; input->seek_subimage(sub, 0); ++sub) {
     const auto& spec = input->spec();
     bool needed = std::any_of(wanted.begin(), wanted.end(), [&](auto& w) { return w.subimage == sub; });
     if (!needed) continue;
     if (spec.width != spec0.width || spec.height != spec0.height)
       throw IoError(concat("image '", path, "': part ", sub, " has another size than part 0"));
-    buffer.resize(std::size_t(spec.width) * spec.height * spec.nchannels);
-    if (!input->read_image(sub, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, buffer.data()))
+    const std::size_t channels = std::size_t(spec.nchannels);
+    const auto scatter = [&](int first_row, int rows, const float* band) {
+      const std::size_t first = std::size_t(first_row) * spec.width, n = std::size_t(rows) * spec.width;
+      for (std::size_t w = 0; w < wanted.size(); ++w) {
+        if (wanted[w].subimage != sub) continue;
+        const int c = wanted[w].index;
+        for (std::size_t i = 0; i < n; ++i) out.data()[(first + i) * wanted.size() + w] = band[i * channels + c];
+      }
+    };
+    if (!read_bands(*input, sub, scatter))
       throw IoError(concat("cannot read pixels of '", path, "': ", input->geterror()));
-    const std::size_t n = out.pixel_count();
-    for (std::size_t w = 0; w < wanted.size(); ++w) {
-      if (wanted[w].subimage != sub) continue;
-      const int c = wanted[w].index;
-      for (std::size_t i = 0; i < n; ++i) out.data()[i * wanted.size() + w] = buffer[i * spec.nchannels + c];
-    }
   }
   return out;
 }
@@ -211,7 +237,6 @@ namespace {
 
 // A written file that does not read back whole (a full disk or a file size
 // limit that the format's writer did not report) is never moved into place.
-// Read in bands of rows: memory stays a small part of the image.
 std::string unreadable_reason(const fs::path& file, const OIIO::ImageSpec& written) {
   auto input = OIIO::ImageInput::open(file.string());
   if (!input) {
@@ -221,13 +246,8 @@ std::string unreadable_reason(const fs::path& file, const OIIO::ImageSpec& writt
   const OIIO::ImageSpec& spec = input->spec();
   if (spec.width != written.width || spec.height != written.height || spec.nchannels != written.nchannels)
     return "its header does not match what was written";
-  constexpr int kBand = 64;
-  std::vector<float> band(std::size_t(spec.width) * spec.nchannels * kBand);
-  for (int y = spec.y; y < spec.y + spec.height; y += kBand) {
-    const int end = std::min(y + kBand, spec.y + spec.height);
-    if (!input->read_scanlines(0, 0, y, end, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, band.data()))
-      return concat("it does not read back: ", input->geterror());
-  }
+  if (!read_bands(*input, 0, [](int, int, const float*) {}))
+    return concat("it does not read back: ", input->geterror());
   return "";
 }
 

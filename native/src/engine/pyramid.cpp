@@ -134,13 +134,16 @@ Image box_blur(const ImageView& image, float width) {
 
 std::vector<Image> build_pyramid(const ImageView& image, int levels, double ratio,
                                  const std::vector<float>& box_widths) {
+  return build_pyramid(Image::copy_of(image), levels, ratio, box_widths);
+}
+
+std::vector<Image> build_pyramid(Image&& image, int levels, double ratio, const std::vector<float>& box_widths) {
+  const auto sizes = level_sizes(image.width(), image.height(), levels, ratio);
   std::vector<Image> pyramid;
-  if (ratio == 0.5) {
-    pyramid = build_pyramid(image, levels);
-  } else {
-    for (const auto& [w, h] : level_sizes(image.width, image.height, levels, ratio))
-      pyramid.push_back(pyramid.empty() ? Image::copy_of(image) : resize_area(image, w, h));
-  }
+  pyramid.push_back(std::move(image));
+  for (std::size_t l = 1; l < sizes.size(); ++l)
+    pyramid.push_back(ratio == 0.5 ? downsample_half(pyramid.back().view())
+                                   : resize_area(pyramid.front().view(), sizes[l].first, sizes[l].second));
   for (std::size_t l = 0; l < pyramid.size() && l < box_widths.size(); ++l)
     if (box_widths[l] > 1.0f) pyramid[l] = box_blur(pyramid[l].view(), box_widths[l]);
   return pyramid;

@@ -308,11 +308,13 @@ Solver::Solver(const SynthesisInput& in, const SynthesisOptions& opt) : plan_(ne
       // applied to the layers in place (no stacked copy).
       const GuideProjection proj = fit_guide_projection(sources, target, opt.guide_variance);
       for (std::size_t e = 0; e < ex.size(); ++e) src_guides[e] = proj.apply(sources[e]);
+      if (in.exemplar_guides_read) in.exemplar_guides_read();
       tgt_guides = proj.apply(target);
       p.guide_channels = {proj.output_channels()};
       p.kept_variance = proj.kept_variance;
     } else {
       for (std::size_t e = 0; e < ex.size(); ++e) src_guides[e] = sources[e].stacked();
+      if (in.exemplar_guides_read) in.exemplar_guides_read();
       tgt_guides = target.stacked();
     }
   }
@@ -335,9 +337,13 @@ Solver::Solver(const SynthesisInput& in, const SynthesisOptions& opt) : plan_(ne
   {
     std::vector<std::vector<Image>> per;
     for (std::size_t e = 0; e < ex.size(); ++e) {
-      const Image stacked = src_guides[e].empty() ? Image() : stack_channels({ex[e].style, src_guides[e].view()});
-      per.push_back(build_pyramid(stacked.empty() ? ex[e].style : stacked.view(), p.levels, p.ratio, opt.level_box_widths));
+      if (src_guides[e].empty()) {
+        per.push_back(build_pyramid(ex[e].style, p.levels, p.ratio, opt.level_box_widths));
+        continue;
+      }
+      Image stacked = stack_channels({ex[e].style, src_guides[e].view()});
       src_guides[e] = Image();
+      per.push_back(build_pyramid(std::move(stacked), p.levels, p.ratio, opt.level_box_widths));
     }
     for (int l = 0; l < p.levels; ++l) {
       std::vector<Image> parts;
@@ -346,7 +352,7 @@ Solver::Solver(const SynthesisInput& in, const SynthesisOptions& opt) : plan_(ne
     }
   }
   if (!tgt_guides.empty()) {
-    p.target = build_pyramid(tgt_guides.view(), p.levels, p.ratio, opt.level_box_widths);
+    p.target = build_pyramid(std::move(tgt_guides), p.levels, p.ratio, opt.level_box_widths);
   } else {
     for (const auto& [w, h] : level_sizes(tw, th, p.levels, p.ratio)) p.target.emplace_back(w, h, 1);
   }
@@ -489,6 +495,10 @@ void Solver::build_level(int l, Level& level, const LevelStart* start) const {
   level.source.set_channels(source_writes);  // source_writes dangle from here on
   lab = Image();
   if (release) p.source[l] = Image();
+  // The target's features are allocated only now, once the plan's exemplar
+  // level is freed: the two were not held at once (20 MB of the still's peak).
+  const auto [target_w, target_h] = p.target_size[std::size_t(l)];
+  level.target = level.source.like(target_w, target_h);
   level.target.set_channels(target_writes);
   if (release) p.target[l] = Image();
   const int sw = level.source.width, sh = level.source.height, tw = level.target.width, th = level.target.height;
@@ -570,16 +580,17 @@ void Solver::mark_weighted_patches(Level& level) const {
 // Fixed-point features where the patch distance has a fixed-point path:
 // axis-aligned patches with no window; per-pixel weights are corrected for
 // the patches that meet them (mark_weighted_patches), unless `in_float`. Their offsets
-// and step are read off the writes, so the level's features are never held
-// in float as well (that copy was twice their size, and the peak at 1 Mpix).
+// and step are read off the writes (the target's too), so the level's
+// features are never held in float as well (that copy was twice their size,
+// and the peak at 1 Mpix). Allocates the exemplar's; the target's are made
+// like them (FeatureImage::like).
 void Solver::allocate_features(Level& level, const std::vector<ChannelWrite>& source_writes,
                                const std::vector<ChannelWrite>& target_writes, bool in_float) const {
   const int total = source_writes.front().image.channels;
-  const int sw = level.source.width, sh = level.source.height, tw = level.target.width, th = level.target.height;
+  const int sw = level.source.width, sh = level.source.height;
   const PatchSpace& s = level.space;
   if (in_float || options_.feature_precision == FeaturePrecision::Float || s.rotated() || s.window) {
     level.source = FeatureImage(sw, sh, total);
-    level.target = FeatureImage(tw, th, total);
     return;
   }
   const int max_value =
@@ -588,7 +599,6 @@ void Solver::allocate_features(Level& level, const std::vector<ChannelWrite>& so
   float step = 0.0f;
   fixed_point_range(source_writes, target_writes, total, plan_->style_channels, max_value, offset, step);
   level.source = FeatureImage::fixed_point(sw, sh, total, offset, step, max_value);
-  level.target = FeatureImage::fixed_point(tw, th, total, offset, step, max_value);
 }
 
 // Per-level guide targets (LevelStart::guide_targets) as writes over the

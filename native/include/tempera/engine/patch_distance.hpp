@@ -56,6 +56,11 @@ struct FeatureImage {
   // the float copy (twice their size) ever being held.
   static FeatureImage fixed_point(int w, int h, int channels, const std::vector<float>& channel_offset,
                                   float quant_step, int max_value);
+  // A w x h feature image stored like this one (float, or fixed point with
+  // its offsets and step), every slot holding 0.
+  FeatureImage like(int w, int h) const {
+    return quantized() ? fixed_point(w, h, stride, offset, step, fixed_max) : FeatureImage(w, h, stride);
+  }
   bool quantized() const { return fixed_max > 0; }
   bool bytes() const { return fixed_max == kFixed8; }
   float* pixel(int x, int y) { return data.data() + index(x, y); }

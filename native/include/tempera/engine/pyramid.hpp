@@ -36,5 +36,8 @@ Image box_blur(const ImageView& image, float width);
 // each level after resampling.
 std::vector<Image> build_pyramid(const ImageView& image, int levels, double ratio,
                                  const std::vector<float>& box_widths);
+// The same, level 0 being `image` itself (moved in, not copied: the solver's
+// stacked exemplar and target guides are the largest images it builds).
+std::vector<Image> build_pyramid(Image&& image, int levels, double ratio, const std::vector<float>& box_widths);
 
 }  // namespace tempera

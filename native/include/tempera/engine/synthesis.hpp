@@ -60,6 +60,10 @@ struct SynthesisInput {
   // (the CLI's decoded files) frees them here, so that they do not add to
   // the peak memory; their views are not read again.
   std::function<void()> guides_read;
+  // Optional: called once before that, when the exemplars' guides (the
+  // layers' sources) are read and the target's not yet: freed here, they
+  // are not held while the target's are projected.
+  std::function<void()> exemplar_guides_read;
   // Optional: called once the solver has built its pyramids, after which it
   // reads nothing of this input. The CLI frees its decoded style here, which
   // it held through the solve.
