@@ -32,14 +32,21 @@ std::vector<std::uint8_t> dilate(const std::vector<std::uint8_t>& set, int w, in
 
 }  // namespace
 
+std::uint32_t match_fingerprint(const OffsetField& field, std::size_t i) {
+  const std::uint64_t position = (std::uint64_t(std::uint32_t(field.x[i])) << 32) | std::uint32_t(field.y[i]);
+  const std::uint64_t remainder = (std::uint64_t(bits(field.rx[i])) << 32) | bits(field.ry[i]);
+  return std::uint32_t(mix64(position ^ mix64(remainder)));
+}
+
 std::vector<std::uint32_t> match_fingerprints(const OffsetField& field) {
-  std::vector<std::uint32_t> out(field.x.size());
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    const std::uint64_t position = (std::uint64_t(std::uint32_t(field.x[i])) << 32) | std::uint32_t(field.y[i]);
-    const std::uint64_t remainder = (std::uint64_t(bits(field.rx[i])) << 32) | bits(field.ry[i]);
-    out[i] = std::uint32_t(mix64(position ^ mix64(remainder)));
-  }
+  std::vector<std::uint32_t> out;
+  match_fingerprints(field, out);
   return out;
+}
+
+void match_fingerprints(const OffsetField& field, std::vector<std::uint32_t>& out) {
+  out.resize(field.x.size());
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = match_fingerprint(field, i);
 }
 
 std::vector<std::uint8_t> changed_pixels(const ImageView& before, const ImageView& after) {
@@ -53,9 +60,8 @@ std::vector<std::uint8_t> changed_pixels(const ImageView& before, const ImageVie
 }
 
 void mark_moved(const OffsetField& field, const std::vector<std::uint32_t>& before, std::vector<std::uint8_t>& moved) {
-  const std::vector<std::uint32_t> now = match_fingerprints(field);
-  moved.resize(now.size(), 0);
-  for (std::size_t i = 0; i < now.size(); ++i) moved[i] |= now[i] != before[i];
+  moved.resize(before.size(), 0);
+  for (std::size_t i = 0; i < before.size(); ++i) moved[i] |= match_fingerprint(field, i) != before[i];
 }
 
 std::vector<std::uint8_t> pixels_to_search(int w, int h, const std::vector<std::uint8_t>& moved,

@@ -14,10 +14,6 @@ void SearchConstraints::finalize() {
   for (int s : source_segment) segments = std::max(segments, s + 1);
   for (int s : target_segment) segments = std::max(segments, s + 1);
   valid_by_segment.assign(segments, {});
-  std::vector<std::size_t> count(segments, 0);  // sized once: grown, the lists took up to twice their size
-  for (std::size_t i = 0; i < source_valid.size(); ++i)
-    if (source_valid[i]) ++count[segment_of_source(i)];
-  for (int s = 0; s < segments; ++s) valid_by_segment[s].reserve(count[s]);
   for (std::size_t i = 0; i < source_valid.size(); ++i)
     if (source_valid[i]) valid_by_segment[segment_of_source(i)].push_back(std::int32_t(i));
   std::vector<std::uint8_t> used(segments, 0);

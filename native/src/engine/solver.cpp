@@ -826,7 +826,7 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
     t0 = Clock::now();
     set_target_style(level, bprime);
     refresh_distances(level.space, level.constraints, field, options_.threads);
-    if (skip_converged) matches_before = match_fingerprints(field), moved.assign(matches_before.size(), 0);
+    if (skip_converged) match_fingerprints(field, matches_before), moved.assign(matches_before.size(), 0);
     source_indices(field, level.space.source->width, sources_before_search);
     // One search, split into single iterations when a term's costs follow the field.
     const int chunk = refresh_each_iteration ? 1 : pm_iters;

@@ -25,6 +25,9 @@ constexpr float kConvergedChange = 1.0f / 255.0f;
 // remainder) changes; equal numbers mean an unchanged match (a collision,
 // 2^-32 per pixel, at worst skips one pixel's search once).
 std::vector<std::uint32_t> match_fingerprints(const OffsetField& field);
+// The same into `out` (its buffer reused: the EM loop takes them each iteration).
+void match_fingerprints(const OffsetField& field, std::vector<std::uint32_t>& out);
+std::uint32_t match_fingerprint(const OffsetField& field, std::size_t i);
 
 // Per pixel: some channel of `after` differs from `before` by kConvergedChange or more.
 std::vector<std::uint8_t> changed_pixels(const ImageView& before, const ImageView& after);

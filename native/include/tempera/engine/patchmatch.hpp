@@ -5,6 +5,7 @@
 // bands of rows; pixels outside a band are read from a snapshot taken at the
 // start of each iteration, so the result depends on the seed only, never on
 // the thread count or schedule.
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -13,6 +14,32 @@
 #include "tempera/engine/patch_distance.hpp"
 
 namespace tempera {
+
+// Source indices in ascending order, stored as runs of consecutive indices:
+// the valid sources of a segment are whole rows of an exemplar but its
+// margins (or a mask's spans), a few thousand runs where a list of every
+// index took 4 bytes a source pixel (4 MB at 1 Mpix, all through the solve).
+class SourceIndexRuns {
+ public:
+  void push_back(std::int32_t index) {  // ascending
+    if (run_first_.empty() || index != run_first_.back() + std::int32_t(size_ - run_start_.back()))
+      run_first_.push_back(index), run_start_.push_back(size_);
+    ++size_;
+  }
+  std::size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  // The k-th index (k < size()).
+  std::int32_t operator[](std::size_t k) const {
+    const auto after = std::upper_bound(run_start_.begin(), run_start_.end(), k);
+    const std::size_t run = std::size_t(after - run_start_.begin()) - 1;
+    return run_first_[run] + std::int32_t(k - run_start_[run]);
+  }
+
+ private:
+  std::vector<std::int32_t> run_first_;  // per run: its first index
+  std::vector<std::size_t> run_start_;   // per run: how many indices come before it
+  std::size_t size_ = 0;
+};
 
 // Which matches are allowed.
 struct SearchConstraints {
@@ -27,7 +54,7 @@ struct SearchConstraints {
   // Extra cost per source center (usage terms); empty = none.
   std::vector<float> source_cost;
   // Valid source centers (indices), per segment label; filled by finalize().
-  std::vector<std::vector<std::int32_t>> valid_by_segment;
+  std::vector<SourceIndexRuns> valid_by_segment;
   const SourceLayout* layout = nullptr;  // for the frame links of video exemplars
 
   // Builds valid_by_segment; throws ValueError if a target segment has no source.

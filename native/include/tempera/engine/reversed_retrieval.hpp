@@ -85,10 +85,8 @@ class ReversedRetrieval {
   template <class F>
   void for_each_winner(F&& f) const {
     for (std::size_t q = 0; q < best_source_.size(); ++q) {
-      const std::uint64_t key = best_source_[q].load(std::memory_order_relaxed);
-      if (key == ~0ull) continue;
-      const std::int32_t p = std::int32_t(key & 0xFFFFFFFFull);
-      f(Assignment{candidate_dist_[p], std::int32_t(q), p});
+      const std::uint32_t p = best_source_[q].load(std::memory_order_relaxed);
+      if (p != kNoSource) f(Assignment{candidate_dist_[p], std::int32_t(q), std::int32_t(p)});
     }
   }
 
@@ -97,7 +95,7 @@ class ReversedRetrieval {
     search(round_index);
     std::vector<Assignment> out;
     out.reserve(std::size_t(std::count_if(best_source_.begin(), best_source_.end(), [](const auto& b) {
-      return b.load(std::memory_order_relaxed) != ~0ull;
+      return b.load(std::memory_order_relaxed) != kNoSource;
     })));
     for_each_winner([&](const Assignment& a) { out.push_back(a); });
     return out;
@@ -311,25 +309,31 @@ class ReversedRetrieval {
     });
   }
 
-  // Best source per target, in parallel: an atomic minimum over (distance
-  // bits, source index), so the winner does not depend on thread timing.
+  // Best source per target, in parallel: an atomic minimum in the order of
+  // (distance, source index), so the winner does not depend on thread timing.
+  // The atomic holds the source alone (4 bytes a target, not 8 with the
+  // distance): candidate distances do not change while collisions resolve.
   void resolve_collisions() {
     auto& best = best_source_;
     parallel_for(th_, params_.threads, [&](int qy) {
-      for (std::size_t q = std::size_t(qy) * tw_, end = q + tw_; q < end; ++q) best[q].store(~0ull, std::memory_order_relaxed);
+      for (std::size_t q = std::size_t(qy) * tw_, end = q + tw_; q < end; ++q)
+        best[q].store(kNoSource, std::memory_order_relaxed);
     });
     parallel_for(sh_, params_.threads, [&](int sy) {
       for (std::size_t p = std::size_t(sy) * sw_, end = p + sw_; p < end; ++p) {
         const std::int32_t q = candidate_[p];
         if (!eligible_[p] || q == kNoTarget || !open_[q]) continue;
-        std::uint32_t bits;
-        std::memcpy(&bits, &candidate_dist_[p], sizeof bits);  // >= 0: bits order like values
-        const std::uint64_t key = (std::uint64_t(bits) << 32) | std::uint64_t(p);
-        std::uint64_t cur = best[q].load(std::memory_order_relaxed);
-        while (key < cur && !best[q].compare_exchange_weak(cur, key, std::memory_order_relaxed)) {
+        std::uint32_t cur = best[q].load(std::memory_order_relaxed);
+        while (beats(p, cur) && !best[q].compare_exchange_weak(cur, std::uint32_t(p), std::memory_order_relaxed)) {
         }
       }
     });
+  }
+
+  bool beats(std::size_t p, std::uint32_t holder) const {
+    if (holder == kNoSource) return true;
+    const float d = candidate_dist_[p], h = candidate_dist_[holder];
+    return d < h || (d == h && p < holder);
   }
 
   const PatchSpace& space_;
@@ -351,7 +355,8 @@ class ReversedRetrieval {
   std::vector<std::vector<std::int32_t>> unassigned_;
   const std::vector<std::int32_t>* earlier_ = nullptr;
   std::vector<float> earlier_dist_;
-  std::vector<std::atomic<std::uint64_t>> best_source_;  // resolve_collisions' per-target minimum, kept across rounds
+  static constexpr std::uint32_t kNoSource = ~0u;
+  std::vector<std::atomic<std::uint32_t>> best_source_;  // resolve_collisions' per-target minimum, kept across rounds
   std::size_t active_ = 0, assigned_count_ = 0, wide_searches_ = 0;
 };
 
