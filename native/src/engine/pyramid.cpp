@@ -22,13 +22,6 @@ Image downsample_half(const ImageView& image) {
   return out;
 }
 
-std::vector<Image> build_pyramid(const ImageView& image, int levels) {
-  std::vector<Image> pyramid;
-  pyramid.push_back(Image::copy_of(image));
-  for (int i = 1; i < levels; ++i) pyramid.push_back(downsample_half(pyramid.back().view()));
-  return pyramid;
-}
-
 int pyramid_levels_for(int width, int height, int min_side, int max_levels, double ratio) {
   int levels = 1;
   if (ratio == 0.5) {  // the integer rule of the 2x pyramid

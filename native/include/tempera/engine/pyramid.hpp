@@ -12,9 +12,6 @@ namespace tempera {
 // Half-size image by 2x2 box filtering (odd edges take the last row/column).
 Image downsample_half(const ImageView& image);
 
-// Level 0 is the full-resolution image; each next level is half the size.
-std::vector<Image> build_pyramid(const ImageView& image, int levels);
-
 // Number of levels so that the smallest side at the coarsest level stays at
 // least `min_side` pixels (and at most `max_levels`), at `ratio` per level.
 int pyramid_levels_for(int width, int height, int min_side, int max_levels = 12, double ratio = 0.5);
@@ -31,9 +28,10 @@ Image resize_area(const ImageView& image, int width, int height);
 // pixels by the remainder), clamped at the borders. width <= 1: a copy.
 Image box_blur(const ImageView& image, float width);
 
-// A pyramid at any ratio: ratio 0.5 is build_pyramid; others resample level 0
-// to each level's size. box_widths (finest first, may be shorter) low-pass
-// each level after resampling.
+// Level 0 is the full-resolution image, each next level `ratio` of the
+// previous' size: at 0.5 each is the previous halved (downsample_half);
+// other ratios resample level 0 to each level's size. box_widths (finest
+// first, may be shorter) low-pass each level after resampling.
 std::vector<Image> build_pyramid(const ImageView& image, int levels, double ratio,
                                  const std::vector<float>& box_widths);
 // The same, level 0 being `image` itself (moved in, not copied: the solver's
