@@ -103,7 +103,7 @@ def test_methods_and_their_options_in_the_panel(media_scene):
 # and a changed value reaches the method's job (the registry's make_job)
 # under its command-line flag.
 PANEL_CHANGES = {"LAZYFLUIDS": {"lf_eta": ("alpha_guide_weight", 1.25), "lf_alpha_weight": ("alpha_weight", 2.5),
-                                "lf_warm_start": ("warm_start", True)},
+                                "lf_warm_start": ("warm_start", False)},
                  "FLUIDYMATION": {"fm_boundary_weight": ("boundary_weight", 1.5),
                                   "fm_direction_weight": ("direction_weight", 0.5),
                                   "fm_extent_weight": ("extent_weight", 0.75),

@@ -356,6 +356,7 @@ TEST(LazyFluids, WarmStartKeepsTransportUsageAndCoherence) {
   const std::vector<ImageView> s(std::size_t(n), still.view()), f(std::size_t(n), flow.view());
   const std::vector<Image> alphas(std::size_t(n), still);
   LazyFluidsOptions o = test_options();
+  o.warm_start = false;
   const auto cold = stylize_fluid_sequence({exemplar.view()}, s, f, o);
   o.warm_start = true;
   const auto warm = stylize_fluid_sequence({exemplar.view()}, s, f, o);
@@ -377,6 +378,34 @@ TEST(LazyFluids, WarmStartKeepsTransportUsageAndCoherence) {
   const FluidFrameResult r = stylize_fluid_frame(in, o);
   ASSERT_EQ(r.synthesis.levels.size(), 1u);  // the finest level only
   for (const UsageCheck& c : check_usage(exemplar, r, 2)) EXPECT_TRUE(c.counts_ok && c.remainder_ok);
+}
+
+// Where the advected previous output holds no material nothing carried a
+// match: those pixels start afresh. A frame whose material is all new (the
+// previous output transparent) is then the same whatever the previous field
+// held; carried matches would make the two differ.
+TEST(LazyFluids, WarmStartRestartsWhereNothingWasCarried) {
+  const Image exemplar = smoke_exemplar(24, 4);
+  const Image flow = constant_flow(72, 40, 2, 0), alpha = disc(72, 40, 35.5f, 19.5f, 17);
+  const Image empty(72, 40, 4, 0.0f);
+  LazyFluidsOptions o = test_options();
+  FluidFrameInput in;
+  in.style = in.previous_style = exemplar.view();
+  in.target_alpha = alpha.view();
+  const OffsetField one = stylize_fluid_frame(in, o).synthesis.field;
+  o.synthesis.seed += 1;
+  const OffsetField two = stylize_fluid_frame(in, o).synthesis.field;
+  o.synthesis.seed -= 1;
+  ASSERT_NE(one.x, two.x);
+  in.advected = empty.view();
+  in.flow_previous = flow.view();
+  in.previous_field = &one;
+  const FluidFrameResult from_one = stylize_fluid_frame(in, o);
+  in.previous_field = &two;
+  const FluidFrameResult from_two = stylize_fluid_frame(in, o);
+  ASSERT_EQ(from_one.synthesis.levels.size(), 1u);  // warm: the finest level only
+  for (std::size_t i = 0; i < from_one.image.pixel_count() * 4; ++i)
+    ASSERT_EQ(from_one.image.data()[i], from_two.image.data()[i]) << i;
 }
 
 TEST(LazyFluids, RejectsBadInputWithClearErrors) {

@@ -59,6 +59,29 @@ def test_sequence_on_arrays_is_transparent_outside_and_deterministic():
     assert all(np.array_equal(a, b) for a, b in zip(out, again))
 
 
+@pytest.mark.parametrize("warm_start,temporal_weight", [(False, 0.2), (True, 0.2), (True, 0.0)])
+def test_frames_chained_one_by_one_are_the_sequence(warm_start, temporal_weight):
+    """stylize_frame (what benches chain) gives the sequence driver's frames bit for bit;
+    a warm frame solves the finest level alone, and only with a temporal term (λ > 0)."""
+    alphas = [disc(16), disc(18), disc(20)]
+    values = dict(FAST, warm_start=warm_start, temporal_weight=temporal_weight, levels=2)
+    sequence = lazyfluids.stylize_sequence(smoke(), alphas, [flow()] * 3, **values)
+    previous = field = None
+    for t, alpha in enumerate(alphas):
+        chained = {} if t == 0 else dict(previous=previous, previous_field=field, flow_previous=flow())
+        image, stats = lazyfluids.stylize_frame(smoke(), alpha, **values, **chained)
+        np.testing.assert_array_equal(image, sequence[t])
+        assert stats["final_energy"] > 0 and stats["field"].shape == (H, W, 2)
+        if t == 0:
+            cold_levels = len(stats["levels"])
+        warm = warm_start and temporal_weight > 0 and t > 0
+        assert len(stats["levels"]) == (1 if warm else cold_levels)
+        previous, field = image, stats["field"]
+    assert cold_levels == 2
+    with pytest.raises(ValueError, match="flow_previous"):
+        lazyfluids.stylize_frame(smoke(), alphas[1], previous=previous, **values)
+
+
 def test_temporal_weights_are_equation_5_6():
     rng = np.random.default_rng(2)
     target, advected = rng.random((5, 6)).astype(np.float32), rng.random((5, 6, 4)).astype(np.float32)

@@ -59,6 +59,41 @@ def stylize_sequence(exemplar, alphas, flows, *, progress=None, **values) -> lis
     return _native.stylize_fluid_sequence(_exemplar_frames(exemplar), a, f, options(**values), report)
 
 
+def stylize_frame(style, target_alpha, *, previous_style=None, previous=None, flow_previous=None,
+                  previous_field=None, progress=None, **values):
+    """One frame of a fluid sequence: returns (image (H, W, 4), stats).
+
+    style           Z^t, (h, w, 4) RGBA
+    target_alpha    X_a^t, (H, W) or (H, W, 1)
+    previous_style  z^{t-1} (default: style)
+    previous        the previous frame's output (RGBA, before motion blur),
+                    advected along ``flow_previous`` (F^{t-1}) for the
+                    temporal term; None on the first frame
+    previous_field  the previous frame's ``stats["field"]``: with
+                    ``warm_start=True`` the frame starts from it, advected
+    **values        options (tempera.methods.lazyfluids.lazyfluids.options)
+
+    stats: seconds, final_energy (the finest level's mean patch distance),
+    levels, source_coverage, field (the final matches, H x W x 2)."""
+    style = _image(style, 4, "style (RGBA)")
+    alpha = _image(target_alpha, 1, "target alpha")
+    if (previous is not None or previous_field is not None) and flow_previous is None:
+        raise ValueError("previous and previous_field need flow_previous (F^{t-1})")
+    flow = None if flow_previous is None else _image(flow_previous, 2, "flow_previous")
+    advected = None if previous is None else advect_output(previous, flow)
+    # A frame with nothing to synthesize has no matches: the next one starts cold.
+    field = None if previous_field is None or np.size(previous_field) == 0 else _image(previous_field, 2,
+                                                                                     "previous_field")
+    before = style if previous_style is None else _image(previous_style, 4, "previous style (RGBA)")
+    report = None if progress is None else (lambda x: progress(x) is not False)
+    return _native.stylize_fluid_frame(style, before, alpha, advected, field, flow, options(**values), report)
+
+
+def advect_output(previous, flow_previous):
+    """X̂^{t-1}: the previous output (any channels) at p − F^{t-1}(p), bilinear, 0 outside the frame."""
+    return _native.lazyfluids_advect_output(_image(previous), _image(flow_previous, 2, "flow_previous"))
+
+
 def temporal_weights(target_alpha, advected, lam: float):
     """λ_q = (1 − max(0, X_a − X̂_a)) λ (eq. 5.6), (H, W, 1); `advected` is
     the advected previous output, RGBA (alpha = channel 3) or alpha."""

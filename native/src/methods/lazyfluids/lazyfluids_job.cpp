@@ -153,7 +153,7 @@ std::string LazyFluidsJob::frame_key(std::size_t index) const {
   if (index > 0) {
     const FileDigest previous = file_digest(state_path(f - 1));
     text += concat("\n", file_stamp(guide_path(f - 1)), "\nprevious ", previous.size, " ", previous.checksum);
-    if (config_.options.warm_start) {
+    if (warm_starts(config_.options)) {
       const FileDigest field = file_digest(field_path(f - 1));
       text += concat("\nprevious field ", field.size, " ", field.checksum);
     }
@@ -195,7 +195,7 @@ FrameResult LazyFluidsJob::make_frame(std::size_t index, const ProgressCallback&
   if (index > 0) in.advected = advected.view();
   OffsetField previous_field;
   std::error_code ec;
-  if (index > 0 && config_.options.warm_start && fs::is_regular_file(field_path(f - 1), ec)) {
+  if (index > 0 && warm_starts(config_.options) && fs::is_regular_file(field_path(f - 1), ec)) {
     previous_field = field_from_positions(read_image(field_path(f - 1)).view());
     in.previous_field = &previous_field;
     in.flow_previous = flow_previous.view();
@@ -215,7 +215,7 @@ void LazyFluidsJob::write_frame(std::size_t index, const FluidFrameResult& frame
   const Image& state = frame.image;
   create_output_folder((fs::path(config_.out) / kStateFolder).string());
   std::error_code ec;
-  if (config_.options.warm_start && !frame.synthesis.field.x.empty())
+  if (warm_starts(config_.options) && !frame.synthesis.field.x.empty())
     write_image(field_path(f), field_positions(frame.synthesis.field).view());
   else
     fs::remove(field_path(f), ec);  // an empty frame: the next one starts cold

@@ -10,6 +10,7 @@
 
 #include "bind_method.hpp"
 #include "bind_frame_job.hpp"
+#include "bind_frame_stats.hpp"
 #include "bind_job_config.hpp"
 #include "bind_options.hpp"
 #include "numpy_bridge.hpp"
@@ -91,17 +92,7 @@ py::tuple stylize_frame_py(const FloatArray& style, const py::dict& exemplar, co
     py::gil_scoped_release release;
     result = stylize_frame(style_view, ex, tg, has_temporal ? &t : nullptr, opt, callback);
   }
-  py::dict stats;
-  stats["seconds"] = result.seconds;
-  stats["source_coverage"] = result.source_coverage;
-  stats["guide_channels"] = result.guide_channels;
-  // The finest level's energy after its last iteration (the solver's objective, for comparisons).
-  stats["final_energy"] = result.levels.empty() || result.levels.back().energy.empty()
-                              ? 0.0
-                              : double(result.levels.back().energy.back());
-  stats["levels"] = py::cast(result.levels);  // per level solved, coarsest first (LevelStats)
-  // The final matches as source positions (H, W, 2): the next frame's `previous_field`.
-  stats["field"] = py_bridge::to_numpy(field_positions(result.field));
+  py::dict stats = py_bridge::frame_stats(result);
   return py::make_tuple(py_bridge::to_numpy(std::move(result.image)), stats);
 }
 
