@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "tempera/engine/guide_compression.hpp"
+#include "tempera/engine/solver.hpp"
 #include "tempera/engine/synthesis.hpp"
 #include "test_inputs.hpp"
 
@@ -144,4 +145,39 @@ TEST(GuideCompression, InputsAreNotReadAfterTheCallerIsToldSo) {
   const SynthesisResult freed = synthesize(in, opt);
   EXPECT_EQ(calls, 1);
   EXPECT_TRUE(same(plain.image, freed.image));
+}
+
+// A shot's frame: the light-path layers (no weight map) are merged by PCA,
+// the temporal guide after them keeps its channels, and its map weighs it
+// alone: under a zero map its target is not matched at all, under a map of
+// ones it is. Per-level guide targets still name the input's layers.
+TEST(GuideCompression, LayersBeforeAWeightMapAreMergedAndTheMappedOneKept) {
+  const Image style = noise_texture(48, 40, 3, 31), sg = noise_texture(48, 40, 3, 32);
+  const Image tg = noise_texture(56, 36, 3, 33), t1 = noise_texture(56, 36, 3, 34), t2 = noise_texture(56, 36, 3, 35);
+  const Image zeros(56, 36, 1, 0.0f), ones(56, 36, 1, 1.0f);
+  SynthesisOptions opt;
+  opt.em_iterations = 2;
+  opt.threads = 2;
+  opt.guide_variance = 0.999;
+  auto input = [&](const Image& temporal_target, const Image& map) {
+    SynthesisInput in;
+    in.style = style.view();
+    in.guides.add("FULL", sg.view(), tg.view(), 1.0f);
+    in.guides.add("LDE", sg.view(), tg.view(), 1.0f);  // repeats FULL: merged, it adds no channel
+    in.guides.add("temporal", style.view(), temporal_target.view(), 0.5f);
+    in.target_weight_maps = {ImageView{}, ImageView{}, map.view()};
+    return in;
+  };
+  const Solver solver(input(t1, ones), opt);
+  EXPECT_LE(solver.guide_channels(), 3 + 3);  // all 9 kept before
+  EXPECT_TRUE(same(synthesize(input(t1, zeros), opt).image, synthesize(input(t2, zeros), opt).image));
+  EXPECT_FALSE(same(synthesize(input(t1, ones), opt).image, synthesize(input(t2, ones), opt).image));
+
+  const int l = solver.levels() - 1;
+  const Image level_target(solver.target_width(l), solver.target_height(l), 3, 0.5f);
+  LevelStart start;
+  start.guide_targets = {{2, &level_target}};
+  EXPECT_NO_THROW(solver.solve_level(l, start));
+  start.guide_targets = {{0, &level_target}};
+  EXPECT_THROW(solver.solve_level(l, start), ValueError);  // merged: its channels are gone
 }

@@ -234,6 +234,18 @@ Image gaussian_window(int radius, float sigma) {
   return w;
 }
 
+// a's channels, then b's (b empty: a itself).
+Image beside(Image a, const Image& b) {
+  if (b.empty()) return a;
+  Image out(a.width(), a.height(), a.channels() + b.channels());
+  for (std::size_t i = 0; i < out.pixel_count(); ++i) {
+    std::copy_n(a.data() + i * std::size_t(a.channels()), a.channels(), out.data() + i * std::size_t(out.channels()));
+    std::copy_n(b.data() + i * std::size_t(b.channels()), b.channels(),
+                out.data() + i * std::size_t(out.channels()) + a.channels());
+  }
+  return out;
+}
+
 }  // namespace
 
 // Everything the engine derives from the inputs once, for all levels.
@@ -241,8 +253,11 @@ struct Solver::Plan {
   int levels = 0;
   double ratio = 0.5;
   int style_channels = 0;
-  std::vector<int> guide_channels;  // per guide layer (one merged layer after PCA)
+  std::vector<int> guide_channels;  // per guide layer of the plan: the input's, or the PCA-merged ones as one
   std::vector<float> guide_weights;  // per guide layer of the input
+  int merged_layers = 0;  // the input's leading layers merged into the plan's layer 0 by PCA (0: none)
+  // The plan's layer of an input layer past the merged ones.
+  int plan_layer(int input_layer) const { return merged_layers ? input_layer - merged_layers + 1 : input_layer; }
   double kept_variance = 1.0;
   std::vector<SourceLayout> layout;   // per level
   std::vector<Image> source, target;  // source: style + guides (atlas); target: guides
@@ -301,16 +316,33 @@ Solver::Solver(const SynthesisInput& in, const SynthesisOptions& opt) : plan_(ne
       p.guide_weights.push_back(layer.weight);
     }
     for (std::size_t e = 0; e < ex.size(); ++e) sources[e] = {ex[e].guides, target.scales};
-    const bool has_maps = std::any_of(in.target_weight_maps.begin(), in.target_weight_maps.end(),
-                                      [](const ImageView& m) { return !m.empty(); });
-    if (opt.guide_variance < 1.0 && !has_maps && target.channels() > 1) {
+    // The leading layers without a weight map are merged by PCA; a layer
+    // with a map (and every one after it) keeps its channels, so that its
+    // map weighs them alone (StyLit's temporal guide, weighed by χ-).
+    std::size_t merged = 0;
+    while (merged < layers.size() && (merged >= in.target_weight_maps.size() || in.target_weight_maps[merged].empty()))
+      ++merged;
+    const auto leading = [merged](const WeightedGuides& g) {
+      return WeightedGuides{{g.layers.begin(), g.layers.begin() + std::ptrdiff_t(merged)},
+                            {g.scales.begin(), g.scales.begin() + std::ptrdiff_t(merged)}};
+    };
+    const auto rest = [merged](const WeightedGuides& g) {
+      return WeightedGuides{{g.layers.begin() + std::ptrdiff_t(merged), g.layers.end()},
+                            {g.scales.begin() + std::ptrdiff_t(merged), g.scales.end()}};
+    };
+    if (opt.guide_variance < 1.0 && merged > 0 && leading(target).channels() > 1) {
       // One projection for the whole source set, fitted on all of it and
       // applied to the layers in place (no stacked copy).
-      const GuideProjection proj = fit_guide_projection(sources, target, opt.guide_variance);
-      for (std::size_t e = 0; e < ex.size(); ++e) src_guides[e] = proj.apply(sources[e]);
+      std::vector<WeightedGuides> lead(ex.size());
+      for (std::size_t e = 0; e < ex.size(); ++e) lead[e] = leading(sources[e]);
+      const GuideProjection proj = fit_guide_projection(lead, leading(target), opt.guide_variance);
+      for (std::size_t e = 0; e < ex.size(); ++e)
+        src_guides[e] = beside(proj.apply(lead[e]), merged < layers.size() ? rest(sources[e]).stacked() : Image());
       if (in.exemplar_guides_read) in.exemplar_guides_read();
-      tgt_guides = proj.apply(target);
-      p.guide_channels = {proj.output_channels()};
+      tgt_guides = beside(proj.apply(leading(target)), merged < layers.size() ? rest(target).stacked() : Image());
+      p.guide_channels.erase(p.guide_channels.begin(), p.guide_channels.begin() + std::ptrdiff_t(merged));
+      p.guide_channels.insert(p.guide_channels.begin(), proj.output_channels());
+      p.merged_layers = int(merged);
       p.kept_variance = proj.kept_variance;
     } else {
       for (std::size_t e = 0; e < ex.size(); ++e) src_guides[e] = sources[e].stacked();
@@ -382,7 +414,12 @@ Solver::Solver(const SynthesisInput& in, const SynthesisOptions& opt) : plan_(ne
   if (!in.target_mask.empty()) p.target_mask = plain(in.target_mask);
   if (!in.target_orientation.empty()) p.target_angle = angle_pyramid(in.target_orientation, L, r, opt.axial_orientation);
   if (!in.target_segments.empty()) p.target_label = label_pyramid(in.target_segments, L, r);
-  for (const auto& map : in.target_weight_maps) p.weight_maps.push_back(map.empty() ? std::vector<Image>{} : plain(map));
+  // Per plan layer: the merged layers have none.
+  for (std::size_t i = std::size_t(p.merged_layers); i < in.target_weight_maps.size(); ++i) {
+    const ImageView& map = in.target_weight_maps[i];
+    if (p.merged_layers && p.weight_maps.empty()) p.weight_maps.emplace_back();
+    p.weight_maps.push_back(map.empty() ? std::vector<Image>{} : plain(map));
+  }
   if (!in.reference.empty()) p.reference = build_pyramid(in.reference, L, r, opt.level_box_widths);
   if (!in.fixed.empty()) {
     p.fixed_mask = plain(in.fixed.mask);
@@ -607,16 +644,17 @@ void Solver::add_guide_target_writes(int l, const LevelStart& start, std::vector
   const Plan& p = *plan_;
   const auto [tw, th] = p.target_size[std::size_t(l)];
   for (const auto& [layer, image] : start.guide_targets) {
-    if (p.guide_channels.size() != p.guide_weights.size())
-      throw ValueError("per-level guide targets need uncompressed guides (guide_variance 1)");
     if (layer < 0 || layer >= int(p.guide_weights.size()))
       throw ValueError(concat("guide layer ", layer, " does not exist (there are ", p.guide_weights.size(), ")"));
-    const int channels = p.guide_channels[std::size_t(layer)];
+    if (layer < p.merged_layers)
+      throw ValueError(concat("guide layer ", layer, " is merged by PCA: per-level guide targets need its channels "
+                              "(guide_variance 1, or a weight map on it)"));
+    const int plan_layer = p.plan_layer(layer), channels = p.guide_channels[std::size_t(plan_layer)];
     if (image->width() != tw || image->height() != th || image->channels() != channels)
       throw ValueError(concat("guide target of layer ", layer, " at level ", l, " must be ", tw, "x", th, " with ",
                               channels, " channels"));
     int first = p.style_channels;
-    for (int k = 0; k < layer; ++k) first += p.guide_channels[std::size_t(k)];
+    for (int k = 0; k < plan_layer; ++k) first += p.guide_channels[std::size_t(k)];
     writes.push_back({first, image->view(),
                       std::vector<float>(std::size_t(channels), std::sqrt(p.guide_weights[std::size_t(layer)]))});
   }
