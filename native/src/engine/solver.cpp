@@ -234,18 +234,6 @@ Image gaussian_window(int radius, float sigma) {
   return w;
 }
 
-// a's channels, then b's (b empty: a itself).
-Image beside(Image a, const Image& b) {
-  if (b.empty()) return a;
-  Image out(a.width(), a.height(), a.channels() + b.channels());
-  for (std::size_t i = 0; i < out.pixel_count(); ++i) {
-    std::copy_n(a.data() + i * std::size_t(a.channels()), a.channels(), out.data() + i * std::size_t(out.channels()));
-    std::copy_n(b.data() + i * std::size_t(b.channels()), b.channels(),
-                out.data() + i * std::size_t(out.channels()) + a.channels());
-  }
-  return out;
-}
-
 }  // namespace
 
 // Everything the engine derives from the inputs once, for all levels.
@@ -326,9 +314,12 @@ Solver::Solver(const SynthesisInput& in, const SynthesisOptions& opt) : plan_(ne
       return WeightedGuides{{g.layers.begin(), g.layers.begin() + std::ptrdiff_t(merged)},
                             {g.scales.begin(), g.scales.begin() + std::ptrdiff_t(merged)}};
     };
-    const auto rest = [merged](const WeightedGuides& g) {
-      return WeightedGuides{{g.layers.begin() + std::ptrdiff_t(merged), g.layers.end()},
-                            {g.scales.begin() + std::ptrdiff_t(merged), g.scales.end()}};
+    // The projected channels, then the stacked channels of the layers after the merged ones.
+    const auto with_rest = [merged, &layers](Image projected, const WeightedGuides& g) {
+      if (merged == layers.size()) return projected;
+      const WeightedGuides rest{{g.layers.begin() + std::ptrdiff_t(merged), g.layers.end()},
+                                {g.scales.begin() + std::ptrdiff_t(merged), g.scales.end()}};
+      return stack_channels({projected.view(), rest.stacked().view()});
     };
     if (opt.guide_variance < 1.0 && merged > 0 && leading(target).channels() > 1) {
       // One projection for the whole source set, fitted on all of it and
@@ -336,10 +327,9 @@ Solver::Solver(const SynthesisInput& in, const SynthesisOptions& opt) : plan_(ne
       std::vector<WeightedGuides> lead(ex.size());
       for (std::size_t e = 0; e < ex.size(); ++e) lead[e] = leading(sources[e]);
       const GuideProjection proj = fit_guide_projection(lead, leading(target), opt.guide_variance);
-      for (std::size_t e = 0; e < ex.size(); ++e)
-        src_guides[e] = beside(proj.apply(lead[e]), merged < layers.size() ? rest(sources[e]).stacked() : Image());
+      for (std::size_t e = 0; e < ex.size(); ++e) src_guides[e] = with_rest(proj.apply(lead[e]), sources[e]);
       if (in.exemplar_guides_read) in.exemplar_guides_read();
-      tgt_guides = beside(proj.apply(leading(target)), merged < layers.size() ? rest(target).stacked() : Image());
+      tgt_guides = with_rest(proj.apply(leading(target)), target);
       p.guide_channels.erase(p.guide_channels.begin(), p.guide_channels.begin() + std::ptrdiff_t(merged));
       p.guide_channels.insert(p.guide_channels.begin(), proj.output_channels());
       p.merged_layers = int(merged);
@@ -414,12 +404,10 @@ Solver::Solver(const SynthesisInput& in, const SynthesisOptions& opt) : plan_(ne
   if (!in.target_mask.empty()) p.target_mask = plain(in.target_mask);
   if (!in.target_orientation.empty()) p.target_angle = angle_pyramid(in.target_orientation, L, r, opt.axial_orientation);
   if (!in.target_segments.empty()) p.target_label = label_pyramid(in.target_segments, L, r);
-  // Per plan layer: the merged layers have none.
-  for (std::size_t i = std::size_t(p.merged_layers); i < in.target_weight_maps.size(); ++i) {
-    const ImageView& map = in.target_weight_maps[i];
-    if (p.merged_layers && p.weight_maps.empty()) p.weight_maps.emplace_back();
-    p.weight_maps.push_back(map.empty() ? std::vector<Image>{} : plain(map));
-  }
+  // Per plan layer: the merged layers, the plan's layer 0, have none.
+  if (p.merged_layers) p.weight_maps.emplace_back();
+  for (std::size_t i = std::size_t(p.merged_layers); i < in.target_weight_maps.size(); ++i)
+    p.weight_maps.push_back(in.target_weight_maps[i].empty() ? std::vector<Image>{} : plain(in.target_weight_maps[i]));
   if (!in.reference.empty()) p.reference = build_pyramid(in.reference, L, r, opt.level_box_widths);
   if (!in.fixed.empty()) {
     p.fixed_mask = plain(in.fixed.mask);
