@@ -15,6 +15,17 @@ backward sweep per level, 4 PatchMatch iterations per visit).
 With `--layers N` the frame is also solved as N layers (vertical strips,
 tempera.methods.tcia.tcia.stylize_layers: motion and guides extended past each strip, one
 solve per layer) in the same run, beside the one-layer solve.
+
+A rendered shot instead of the synthetic one (a guide cache and a painting
+with its guides, as bench_warm_start.py reads them; no keys):
+
+    PYTHONPATH=addon /usr/bin/python3 bench/bench_tcia.py --guides GUIDE_CACHE --frames 1-8 \
+        --exemplar PAINTING --exemplar-pngs DIR [--exemplar-shrink 2] [--save DIR]
+
+reports, besides the seconds, the warp error (mean colour change along the
+motion where visible: the flicker) and the detail (mean gradient magnitude)
+over the frames, and with --save writes them (frame_NNNN.png) to compare
+revisions.
 """
 import argparse
 import json
@@ -47,22 +58,70 @@ def panning_shot(side, frames, speed):
     return hatching_style(src[0]), list(zip(names, src, weights)), shot
 
 
+def rendered_shot(args):
+    """(style, guides, frames, motion) of a guide cache and a painting with its guides."""
+    from tempera import read_image
+    from tempera.app import guide_cache
+    from tempera.app.frames import parse_frames
+    from bench_warm_start import GUIDES, exemplar_from_pngs, shrink
+
+    weights = dict(FULL=1.0, LDE=2.0, LSE=1.0, LDDE=0.5)  # light_path_guides.hpp's defaults
+    style = np.asarray(read_image(args.exemplar), np.float32)[:, :, :3]
+    exemplar = exemplar_from_pngs(args.exemplar_pngs)
+    if args.exemplar_shrink > 1:
+        style = shrink(style, args.exemplar_shrink)
+        exemplar = {k: shrink(v, args.exemplar_shrink) for k, v in exemplar.items()}
+    motion = ["velocity_backward", "occlusion_backward", "velocity_forward", "occlusion_forward"]
+    frames, numbers = [], parse_frames(args.frames)
+    for f in numbers:
+        g = guide_cache.read_frame(args.guides, f, GUIDES + motion)
+        frames.append(dict(guides=[g[n] for n in GUIDES], **{k: g[k] for k in motion}))
+    return style, [(n, exemplar[n], weights[n]) for n in GUIDES], frames, numbers
+
+
+def shot_quality(out, frames):
+    """Mean warp error (frames after the first) and detail of the stylized frames."""
+    from tempera.engine import temporal
+    from bench_warm_start import detail
+
+    warp = [temporal.flicker(out[t - 1], out[t], frames[t]["velocity_backward"], frames[t]["occlusion_backward"])
+            for t in range(1, len(out))]
+    return dict(warp_error=round(float(np.mean(warp)), 5), detail=round(float(np.mean([detail(o) for o in out])), 5))
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--mpix", type=float, default=0.25, help="frame size in megapixels (square)")
-    parser.add_argument("--frames", type=int, default=4)
+    parser.add_argument("--frames", default="4", help="how many (synthetic shot) or which (--guides: 1-8)")
     parser.add_argument("--speed", type=int, default=3, help="pan in pixels per frame")
     parser.add_argument("--threads", type=int, default=0)
     parser.add_argument("--layers", type=int, default=0, help="also solve as this many layers (strips)")
     parser.add_argument("--json", help="also write the figures here")
+    parser.add_argument("--guides", help="a rendered shot's guide cache instead of the synthetic shot")
+    parser.add_argument("--exemplar", help="with --guides: the painting")
+    parser.add_argument("--exemplar-pngs", help="with --guides: the painting's guides, ebsynth's PNGs")
+    parser.add_argument("--exemplar-shrink", type=int, default=1, help="box-downsample the exemplar k x k")
+    parser.add_argument("--save", help="with --guides: write the frames here")
     args = parser.parse_args()
-    side = int(round((args.mpix * 1e6) ** 0.5))
-    style, guides, frames = panning_shot(side, args.frames, args.speed)
+    if args.guides:
+        style, guides, frames, numbers = rendered_shot(args)
+        side = int(round((frames[0]["guides"][0].shape[0] * frames[0]["guides"][0].shape[1]) ** 0.5))
+        args.frames = len(frames)
+    else:
+        side, args.frames = int(round((args.mpix * 1e6) ** 0.5)), int(args.frames)
+        style, guides, frames = panning_shot(side, args.frames, args.speed)
     started, cpu = time.monotonic(), time.process_time()
     out = tcia.stylize_shot(style, guides, frames, threads=args.threads)
     wall, cpu = time.monotonic() - started, time.process_time() - cpu
     assert len(out) == args.frames
-    result = dict(side=side, mpix=side * side / 1e6, frames=args.frames, wall_s=round(wall, 2), cpu_s=round(cpu, 2),
+    quality = shot_quality(out, frames) if args.guides else {}
+    if args.save:
+        from pathlib import Path
+        from tempera import write_image
+        Path(args.save).mkdir(parents=True, exist_ok=True)
+        for f, image in zip(numbers, out):
+            write_image(str(Path(args.save) / f"frame_{f:04d}.png"), image)
+    result = dict(**quality, side=side, mpix=side * side / 1e6, frames=args.frames, wall_s=round(wall, 2), cpu_s=round(cpu, 2),
                   s_per_frame=round(wall / args.frames, 2),
                   peak_rss_mb=round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024),
                   machine=f"{platform.system()} {platform.machine()}, {__import__('os').cpu_count()} cores")

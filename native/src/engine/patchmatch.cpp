@@ -50,9 +50,13 @@ struct Matcher {
       : space(s), cons(c), params(p), snapshot(snap), sw(s.source->width), sh(s.source->height),
         margin(s.source_margin()) {}
 
-  float field_cost(int tx, int ty, int sx, int sy) const {
+  // The field terms' cost, or infinity once it reaches `limit`.
+  float field_cost(int tx, int ty, int sx, int sy, float limit = kInf) const {
     float sum = 0.0f;
-    for (const EnergyTerm* t : params.field_terms) sum += t->pair_cost(*params.context, *snapshot, tx, ty, sx, sy);
+    for (const EnergyTerm* t : params.field_terms) {
+      sum += t->pair_cost(*params.context, *snapshot, tx, ty, sx, sy, limit - sum);
+      if (sum >= limit) return kInf;
+    }
     return sum;
   }
 
@@ -74,7 +78,9 @@ struct Matcher {
     const std::size_t si = std::size_t(cy) * sw + cx;
     if (!cons.allowed(si, segment)) return;
     float extra = cons.cost(si);
-    if (!params.field_terms.empty()) extra += field_cost(tx, ty, cx, cy);
+    if (extra >= b.cost) return;
+    // The field terms stop once they alone reach what is left of b.cost.
+    if (!params.field_terms.empty()) extra += field_cost(tx, ty, cx, cy, b.cost - extra);
     if (extra >= b.cost) return;
     // patch_distance may stop once its partial sum reaches the cutoff, so a
     // result >= cutoff is not the full distance: reject it whatever the

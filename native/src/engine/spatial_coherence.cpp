@@ -2,7 +2,12 @@
 // over the patch window with its weights. C(p, d) is where the candidate's
 // patch puts the neighbour p + d; neighbours whose own match agrees make the
 // candidate cheaper, so the field prefers large coherent pieces.
+#include "tempera/engine/spatial_coherence.hpp"
+
+#include <immintrin.h>
+
 #include <algorithm>
+#include <cstring>
 
 #include "tempera/engine/energy_term.hpp"
 #include "tempera/engine/patchmatch.hpp"
@@ -10,12 +15,105 @@
 namespace tempera {
 namespace {
 
+constexpr int kLanes = 8;
+
+// The matched flags of up to 8 neighbours of a row (n of them), as bytes,
+// built in a register: a short copy through memory stalled the load after it.
+inline std::uint64_t matched_bytes(const std::uint8_t* m, int n) {
+  std::uint64_t bytes = 0;
+  if (n == kLanes) {
+    std::memcpy(&bytes, m, kLanes);
+    return bytes;
+  }
+  for (int j = 0; j < n; ++j) bytes |= std::uint64_t(m[j]) << (8 * j);
+  return bytes;
+}
+
+// Lane j of the 8 accumulators, added as _mm256 lanes are: (0+4, 1+5, 2+6,
+// 3+7), then (0+2, 1+3), then the two.
+inline float lane_sum(const float* a) {
+  const float s0 = a[0] + a[4], s1 = a[1] + a[5], s2 = a[2] + a[6], s3 = a[3] + a[7];
+  return (s0 + s2) + (s1 + s3);
+}
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+float patch_sum_scalar(const CoherencePatch& p, float limit) {
+  const int side = 2 * p.radius + 1;
+  float acc[kLanes] = {};
+  for (int row = 0; row < side; ++row) {
+    const std::size_t at = p.first + std::size_t(row) * p.pitch;
+    const int y = p.source_y - p.radius + row;
+    for (int i = 0; i < side; i += kLanes) {
+      const int n = std::min(kLanes, side - i);
+      for (int j = 0; j < n; ++j) {
+        const int k = i + j;
+        if (!p.matched[at + k] || (row == p.radius && k == p.radius)) continue;
+        const float ex = float(p.x[at + k] - (p.source_x - p.radius + k)), ey = float(p.y[at + k] - y);
+        const float product = p.window[row * side + k] * std::min(ex * ex + ey * ey, p.r_max2);
+        acc[j] = acc[j] + product;
+      }
+    }
+    if (lane_sum(acc) >= limit) return kInf;
+  }
+  return lane_sum(acc);
+}
+
+[[gnu::target("avx2")]] float patch_sum_avx2(const CoherencePatch& p, float limit) {
+  alignas(32) float lanes[kLanes];
+  const int side = 2 * p.radius + 1;
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m256 r_max2 = _mm256_set1_ps(p.r_max2);
+  __m256 acc = _mm256_setzero_ps();
+  for (int row = 0; row < side; ++row) {
+    const std::size_t at = p.first + std::size_t(row) * p.pitch;
+    const __m256i y = _mm256_set1_epi32(p.source_y - p.radius + row);
+    for (int i = 0; i < side; i += kLanes) {
+      const int n = std::min(kLanes, side - i);
+      const __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32(n), lane);
+      const __m256i mx = _mm256_maskload_epi32(p.x + at + i, live);
+      const __m256i my = _mm256_maskload_epi32(p.y + at + i, live);
+      const __m256 window = _mm256_maskload_ps(p.window + row * side + i, live);
+      const __m256i flags = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(std::int64_t(matched_bytes(p.matched + at + i, n))));
+      __m256i keep = _mm256_cmpgt_epi32(flags, _mm256_setzero_si256());
+      if (row == p.radius)  // the centre is not its own neighbour
+        keep = _mm256_andnot_si256(_mm256_cmpeq_epi32(lane, _mm256_set1_epi32(p.radius - i)), keep);
+      const __m256i cx = _mm256_add_epi32(_mm256_set1_epi32(p.source_x - p.radius + i), lane);
+      const __m256 ex = _mm256_cvtepi32_ps(_mm256_sub_epi32(mx, cx));
+      const __m256 ey = _mm256_cvtepi32_ps(_mm256_sub_epi32(my, y));
+      const __m256 d2 = _mm256_min_ps(_mm256_add_ps(_mm256_mul_ps(ex, ex), _mm256_mul_ps(ey, ey)), r_max2);
+      acc = _mm256_add_ps(acc, _mm256_mul_ps(_mm256_and_ps(window, _mm256_castsi256_ps(keep)), d2));
+    }
+    if (limit < kInf) {
+      _mm256_store_ps(lanes, acc);
+      if (lane_sum(lanes) >= limit) return kInf;
+    }
+  }
+  _mm256_store_ps(lanes, acc);
+  return lane_sum(lanes);
+}
+
 class SpatialCoherence final : public EnergyTerm {
  public:
   SpatialCoherence(float weight, float r_max) : weight_(weight), r_max2_(r_max * r_max) {}
   const char* name() const override { return "spatial_coherence"; }
   bool reads_field() const override { return true; }
-  float pair_cost(const LevelContext& c, const OffsetField& field, int tx, int ty, int sx, int sy) const override {
+  float pair_cost(const LevelContext& c, const OffsetField& field, int tx, int ty, int sx, int sy,
+                  float limit) const override {
+    const PatchSpace& s = *c.space;
+    const int r = s.radius;
+    if (s.window && !s.rotated() && tx >= r && ty >= r && tx + r < field.width && ty + r < field.height) {
+      const CoherencePatch patch{field.x.data(), field.y.data(), c.constraints->matched().data(),
+                                 std::size_t(field.width), field.index(tx - r, ty - r), s.window, r, sx, sy,
+                                 r_max2_};
+      return weight_ * coherence_patch_sum(patch, limit / weight_);
+    }
+    return weight_ * clipped_sum(c, field, tx, ty, sx, sy);
+  }
+
+ private:
+  // Patches over the field's border or rotated, one neighbour at a time.
+  float clipped_sum(const LevelContext& c, const OffsetField& field, int tx, int ty, int sx, int sy) const {
     const PatchSpace& s = *c.space;
     const int r = s.radius, side = 2 * r + 1;
     const float phi = s.rotated() ? s.rotation(sx, sy, tx, ty) : 0.0f;
@@ -35,14 +133,19 @@ class SpatialCoherence final : public EnergyTerm {
         sum += w * std::min(ex * ex + ey * ey, r_max2_);
       }
     }
-    return weight_ * sum;
+    return sum;
   }
 
- private:
   float weight_, r_max2_;
 };
 
 }  // namespace
+
+float coherence_patch_sum(const CoherencePatch& patch, float limit, FixedKernel kernel) {
+  static const bool avx2 = fixed_kernel_supported(FixedKernel::Avx2);
+  if (kernel == FixedKernel::Avx2 || (kernel == FixedKernel::Best && avx2)) return patch_sum_avx2(patch, limit);
+  return patch_sum_scalar(patch, limit);
+}
 
 std::shared_ptr<const EnergyTerm> make_spatial_coherence(float weight, float r_max) {
   return std::make_shared<SpatialCoherence>(weight, r_max);

@@ -64,9 +64,10 @@ class EnergyTerm {
   // Whether pair_cost() is used.
   virtual bool reads_field() const { return false; }
   // Extra cost of matching target (tx, ty) to source (sx, sy), given the
-  // field at the start of the sweep.
-  virtual float pair_cost(const LevelContext&, const OffsetField&, int /*tx*/, int /*ty*/, int /*sx*/,
-                          int /*sy*/) const {
+  // field at the start of the sweep. A term may stop once the cost reaches
+  // `limit` (the candidate is rejected then) and return infinity instead.
+  virtual float pair_cost(const LevelContext&, const OffsetField&, int /*tx*/, int /*ty*/, int /*sx*/, int /*sy*/,
+                          float /*limit*/) const {
     return 0.0f;
   }
   // May rewrite matches after a search.

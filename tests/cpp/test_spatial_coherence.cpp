@@ -1,0 +1,89 @@
+// The spatial coherence term's neighbour sum (Bénard et al. 2013, eq. 5):
+// the AVX2 kernel equals the scalar one to the bit, both equal the sum
+// written out neighbour by neighbour, and both stop only once it reaches the
+// limit.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "tempera/engine/spatial_coherence.hpp"
+
+namespace tempera {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+struct Field {
+  int width, height;
+  std::vector<std::int32_t> x, y;
+  std::vector<std::uint8_t> matched;
+};
+
+Field random_field(int w, int h, unsigned seed) {
+  Field f{w, h, std::vector<std::int32_t>(std::size_t(w) * h), std::vector<std::int32_t>(std::size_t(w) * h),
+          std::vector<std::uint8_t>(std::size_t(w) * h)};
+  std::mt19937 rng(seed);
+  for (int py = 0; py < h; ++py)
+    for (int px = 0; px < w; ++px) {
+      const std::size_t i = std::size_t(py) * w + px;
+      // Mostly one coherent piece (source = target + (7, 3)), some pixels off
+      // by a little or a lot, some not matched.
+      const int kind = int(rng() % 10);
+      f.x[i] = px + 7 + (kind == 0 ? int(rng() % 5) - 2 : kind == 1 ? int(rng() % 200) : 0);
+      f.y[i] = py + 3 + (kind == 0 ? int(rng() % 5) - 2 : 0);
+      f.matched[i] = kind != 2;
+    }
+  return f;
+}
+
+std::vector<float> gaussian_window(int r) {
+  std::vector<float> w;
+  for (int dy = -r; dy <= r; ++dy)
+    for (int dx = -r; dx <= r; ++dx) w.push_back(std::exp(-0.5f * float(dx * dx + dy * dy) / float(r * r)));
+  return w;
+}
+
+double written_out(const Field& f, const std::vector<float>& window, int r, float r_max2, int tx, int ty, int sx,
+                   int sy) {
+  double sum = 0.0;
+  for (int dy = -r; dy <= r; ++dy)
+    for (int dx = -r; dx <= r; ++dx) {
+      const std::size_t i = std::size_t(ty + dy) * f.width + tx + dx;
+      if ((dx == 0 && dy == 0) || !f.matched[i]) continue;
+      const double ex = f.x[i] - (sx + dx), ey = f.y[i] - (sy + dy);
+      sum += window[std::size_t((dy + r) * (2 * r + 1) + dx + r)] * std::min(ex * ex + ey * ey, double(r_max2));
+    }
+  return sum;
+}
+
+TEST(SpatialCoherence, KernelsAgreeToTheBitAndWithTheSumWrittenOut) {
+  const Field f = random_field(40, 30, 5);
+  for (int r : {1, 2, 4, 5}) {  // rows of 3, 5, 9 and 11 neighbours: one or two lane groups
+    const std::vector<float> window = gaussian_window(r);
+    int compared = 0;
+    for (int ty = r; ty + r < f.height; ty += 3)
+      for (int tx = r; tx + r < f.width; tx += 2)
+        for (const auto [sx, sy] : {std::pair{tx + 7, ty + 3}, std::pair{tx + 8, ty + 3}, std::pair{tx + 90, ty}}) {
+          const CoherencePatch p{f.x.data(), f.y.data(), f.matched.data(), std::size_t(f.width),
+                                 std::size_t(ty - r) * f.width + (tx - r), window.data(), r, sx, sy, 9.0f};
+          const float scalar = coherence_patch_sum(p, kInf, FixedKernel::Scalar);
+          ASSERT_NEAR(scalar, written_out(f, window, r, 9.0f, tx, ty, sx, sy), 1e-4 * (1.0 + scalar));
+          for (const FixedKernel k : {FixedKernel::Scalar, FixedKernel::Avx2}) {
+            if (!fixed_kernel_supported(k)) continue;
+            ASSERT_EQ(scalar, coherence_patch_sum(p, kInf, k)) << r << " " << tx << " " << ty;
+            // A limit above the sum: the whole sum; at or below it: infinity.
+            ASSERT_EQ(scalar, coherence_patch_sum(p, scalar * 1.001f + 1e-3f, k));
+            if (scalar > 0) ASSERT_EQ(kInf, coherence_patch_sum(p, scalar, k));
+            if (scalar > 0) ASSERT_EQ(kInf, coherence_patch_sum(p, scalar * 0.5f, k));
+          }
+          ++compared;
+        }
+    EXPECT_GT(compared, 50);
+  }
+}
+
+}  // namespace
+}  // namespace tempera
