@@ -93,6 +93,8 @@ TEST(EarlyExit, DecidesAsTheFullSumForWeightedWindowedAndRotatedPatches) {
   weighted.target = windowed.target = rotated.target = &t;
   weighted.target_weights = &weights;
   windowed.window = window.data();
+  const std::vector<float> window_channels = expand_window(window.data(), r, channels);
+  windowed.window_channels = window_channels.data();
   rotated.source_angle = angle_s.data(), rotated.target_angle = angle_t.data(), rotated.window = window.data();
   int early = 0;
   check_decisions(weighted, 8, early);
@@ -101,4 +103,32 @@ TEST(EarlyExit, DecidesAsTheFullSumForWeightedWindowedAndRotatedPatches) {
   EXPECT_GT(early, 100);
   check_decisions(rotated, 10, early);
   EXPECT_GT(early, 100);
+}
+
+TEST(WindowedDistance, RowsUnderTheExpandedWindowSumAsPixelByPixel) {
+  // The windowed patch rows (window_channels) against the same window applied
+  // pixel by pixel (the rotated patches' loop, at no rotation), with and
+  // without per-pixel channel weights, targets over the border included.
+  const int w = 30, h = 24, channels = 15, r = 4, side = 2 * r + 1;
+  const FeatureImage s = random_features(w, h, channels, 11, false), t = random_features(w, h, channels, 12, false);
+  const FeatureImage weights = random_features(w, h, channels, 13, false);
+  std::vector<float> window(side * side);
+  std::mt19937 rng(14);
+  for (float& v : window) v = 0.2f + float(rng() % 100) * 0.016f;
+  const std::vector<float> window_channels = expand_window(window.data(), r, channels);
+  for (bool weighted : {false, true}) {
+    PatchSpace rows, pixels;
+    rows.source = pixels.source = &s;
+    rows.target = pixels.target = &t;
+    rows.radius = pixels.radius = r;
+    rows.window = pixels.window = window.data();
+    rows.window_channels = window_channels.data();
+    if (weighted) rows.target_weights = pixels.target_weights = &weights;
+    for (int k = 0; k < 300; ++k) {
+      const int sx = r + int(rng() % unsigned(w - 2 * r)), sy = r + int(rng() % unsigned(h - 2 * r));
+      const int tx = int(rng() % unsigned(w)), ty = int(rng() % unsigned(h));
+      const float a = patch_distance(rows, sx, sy, tx, ty, kInf), b = patch_distance(pixels, sx, sy, tx, ty, kInf);
+      ASSERT_NEAR(a, b, 1e-5f * b) << weighted << " " << tx << " " << ty;
+    }
+  }
 }

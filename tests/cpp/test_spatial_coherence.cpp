@@ -4,6 +4,7 @@
 // limit.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -51,6 +52,7 @@ double written_out(const Field& f, const std::vector<float>& window, int r, floa
   double sum = 0.0;
   for (int dy = -r; dy <= r; ++dy)
     for (int dx = -r; dx <= r; ++dx) {
+      if (tx + dx < 0 || ty + dy < 0 || tx + dx >= f.width || ty + dy >= f.height) continue;
       const std::size_t i = std::size_t(ty + dy) * f.width + tx + dx;
       if ((dx == 0 && dy == 0) || !f.matched[i]) continue;
       const double ex = f.x[i] - (sx + dx), ey = f.y[i] - (sy + dy);
@@ -61,14 +63,17 @@ double written_out(const Field& f, const std::vector<float>& window, int r, floa
 
 TEST(SpatialCoherence, KernelsAgreeToTheBitAndWithTheSumWrittenOut) {
   const Field f = random_field(40, 30, 5);
-  for (int r : {1, 2, 4, 5}) {  // rows of 3, 5, 9 and 11 neighbours: one or two lane groups
+  for (int r : {1, 2, 4, 5}) {  // rows of up to 3, 5, 9 and 11 neighbours: one or two lane groups
     const std::vector<float> window = gaussian_window(r);
     int compared = 0;
-    for (int ty = r; ty + r < f.height; ty += 3)
-      for (int tx = r; tx + r < f.width; tx += 2)
+    for (int ty = 0; ty < f.height; ty += 3)  // patches inside the field and clipped by its border
+      for (int tx = 0; tx < f.width; tx += 2)
         for (const auto [sx, sy] : {std::pair{tx + 7, ty + 3}, std::pair{tx + 8, ty + 3}, std::pair{tx + 90, ty}}) {
-          const CoherencePatch p{f.x.data(), f.y.data(), f.matched.data(), std::size_t(f.width),
-                                 std::size_t(ty - r) * f.width + (tx - r), window.data(), r, sx, sy, 9.0f};
+          CoherencePatch p{f.x.data(), f.y.data(), f.matched.data(), std::size_t(f.width)};
+          p.row0 = std::max(0, r - ty), p.row1 = std::min(2 * r, r + f.height - 1 - ty);
+          p.col0 = std::max(0, r - tx), p.col1 = std::min(2 * r, r + f.width - 1 - tx);
+          p.first = std::size_t(ty - r + p.row0) * f.width + std::size_t(tx - r + p.col0);
+          p.window = window.data(), p.radius = r, p.source_x = sx, p.source_y = sy, p.r_max2 = 9.0f;
           const float scalar = coherence_patch_sum(p, kInf, FixedKernel::Scalar);
           ASSERT_NEAR(scalar, written_out(f, window, r, 9.0f, tx, ty, sx, sy), 1e-4 * (1.0 + scalar));
           for (const FixedKernel k : {FixedKernel::Scalar, FixedKernel::Avx2}) {

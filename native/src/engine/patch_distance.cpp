@@ -451,6 +451,14 @@ std::int64_t fixed_patch_ssd(const std::uint8_t* a, std::size_t pitch_a, const s
   return patch_kernel_of<std::uint8_t>(kernel)(a, pitch_a, b, pitch_b, rows, n, limit);
 }
 
+std::vector<float> expand_window(const float* window, int radius, int stride) {
+  const int side = 2 * radius + 1;
+  std::vector<float> out;
+  out.reserve(std::size_t(side) * side * stride);
+  for (int i = 0; i < side * side; ++i) out.insert(out.end(), std::size_t(stride), window[i]);
+  return out;
+}
+
 void sample_bilinear(const float* data, int width, int height, int stride, int channels, float x,
                      float y, float* out) {
   x = std::clamp(x, 0.0f, float(width - 1));
@@ -564,21 +572,31 @@ float distance_fixed(const PatchSpace& s, int sx, int sy, int tx, int ty, float 
   return float(std::max(0.0, corrected) * step2);
 }
 
-// Axis-aligned patches under a window: each pixel's SSD is weighted.
+[[gnu::always_inline]] inline float doubly_weighted_ssd(const float* a, const float* b, const float* w,
+                                                        const float* v, int n) {
+  float sum = 0.0f;
+#pragma omp simd reduction(+ : sum)
+  for (int i = 0; i < n; ++i) {
+    const float d = a[i] - b[i];
+    sum += w[i] * v[i] * d * d;
+  }
+  return sum;
+}
+
+// Axis-aligned patches under a window: each patch row is one run weighted by
+// the window expanded to every channel (one pixel's channels at a time were
+// short sums, each reduced on its own: the coherent method's hot loop).
 [[gnu::always_inline]] inline float distance_windowed(const PatchSpace& s, int sx, int sy, int tx, int ty,
                                                       float cutoff) {
   const Window w = clip(s, tx, ty);
-  const int stride = s.source->stride, side = 2 * s.radius + 1;
+  const int stride = s.source->stride, side = 2 * s.radius + 1, n = (w.dx1 - w.dx0 + 1) * stride;
   float sum = 0.0f;
   for (int dy = w.dy0; dy <= w.dy1; ++dy) {
-    const float* row_w = s.window + (dy + s.radius) * side + s.radius;
-    for (int dx = w.dx0; dx <= w.dx1; ++dx) {
-      const float* a = s.source->pixel(sx + dx, sy + dy);
-      const float* b = s.target->pixel(tx + dx, ty + dy);
-      const float d = s.target_weights ? weighted_ssd(a, b, s.target_weights->pixel(tx + dx, ty + dy), stride)
-                                       : ssd(a, b, stride);
-      sum += row_w[dx] * d;
-    }
+    const float* k = s.window_channels + std::size_t(((dy + s.radius) * side + w.dx0 + s.radius) * stride);
+    const float* a = s.source->pixel(sx + w.dx0, sy + dy);
+    const float* b = s.target->pixel(tx + w.dx0, ty + dy);
+    sum += s.target_weights ? doubly_weighted_ssd(a, b, k, s.target_weights->pixel(tx + w.dx0, ty + dy), n)
+                            : weighted_ssd(a, b, k, n);
     if (sum >= cutoff) return sum;
   }
   return sum;
@@ -617,7 +635,8 @@ float patch_distance(const PatchSpace& space, int sx, int sy, int tx, int ty, fl
   if (space.source->quantized())
     return space.source->bytes() ? distance_fixed<std::uint8_t>(space, sx, sy, tx, ty, cutoff)
                                  : distance_fixed<std::int16_t>(space, sx, sy, tx, ty, cutoff);
-  if (space.rotated()) return distance_rotated(space, sx, sy, tx, ty, cutoff);
+  if (space.rotated() || (space.window && !space.window_channels))
+    return distance_rotated(space, sx, sy, tx, ty, cutoff);
   if (space.window) return distance_windowed(space, sx, sy, tx, ty, cutoff);
   if (space.target_weights) return distance_aligned<true>(space, sx, sy, tx, ty, cutoff);
   return distance_aligned<false>(space, sx, sy, tx, ty, cutoff);

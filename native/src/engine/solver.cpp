@@ -264,6 +264,7 @@ struct Solver::Plan {
 struct Solver::Level {
   FeatureImage source, target, target_weights;
   std::vector<std::uint8_t> weighted_pixels, weighted_patches;  // PatchSpace's, with quantized weighted features
+  std::vector<float> window_channels;                           // PatchSpace's, with a window
   SearchConstraints constraints;
   PatchSpace space;
   Image style;          // A' at this level (unweighted), what voting copies
@@ -517,6 +518,10 @@ void Solver::build_level(int l, Level& level, const LevelStart* start) const {
   allocate_features(level, source_writes, target_writes, weighted && !options_.fixed_point_weights);
   level.space.source = &level.source;
   level.space.target = &level.target;
+  if (level.space.window) {
+    level.window_channels = expand_window(level.space.window, level.space.radius, total);
+    level.space.window_channels = level.window_channels.data();
+  }
   level.source.set_channels(source_writes);  // source_writes dangle from here on
   lab = Image();
   if (release) p.source[l] = Image();

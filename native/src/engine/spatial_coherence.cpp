@@ -38,14 +38,16 @@ inline float lane_sum(const float* a) {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
+// Lane j of a group holds column i + j of the row (i = col0, col0 + 8, ...);
+// both kernels add column k's products into lane (k - col0) % 8.
 float patch_sum_scalar(const CoherencePatch& p, float limit) {
   const int side = 2 * p.radius + 1;
   float acc[kLanes] = {};
-  for (int row = 0; row < side; ++row) {
-    const std::size_t at = p.first + std::size_t(row) * p.pitch;
+  for (int row = p.row0; row <= p.row1; ++row) {
+    const std::size_t at = p.first + std::size_t(row - p.row0) * p.pitch - std::size_t(p.col0);  // column 0's index
     const int y = p.source_y - p.radius + row;
-    for (int i = 0; i < side; i += kLanes) {
-      const int n = std::min(kLanes, side - i);
+    for (int i = p.col0; i <= p.col1; i += kLanes) {
+      const int n = std::min(kLanes, p.col1 - i + 1);
       for (int j = 0; j < n; ++j) {
         const int k = i + j;
         if (!p.matched[at + k] || (row == p.radius && k == p.radius)) continue;
@@ -65,16 +67,17 @@ float patch_sum_scalar(const CoherencePatch& p, float limit) {
   const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   const __m256 r_max2 = _mm256_set1_ps(p.r_max2);
   __m256 acc = _mm256_setzero_ps();
-  for (int row = 0; row < side; ++row) {
-    const std::size_t at = p.first + std::size_t(row) * p.pitch;
+  for (int row = p.row0; row <= p.row1; ++row) {
+    const std::size_t at = p.first + std::size_t(row - p.row0) * p.pitch;  // column col0's index
     const __m256i y = _mm256_set1_epi32(p.source_y - p.radius + row);
-    for (int i = 0; i < side; i += kLanes) {
-      const int n = std::min(kLanes, side - i);
+    for (int i = p.col0; i <= p.col1; i += kLanes) {
+      const int n = std::min(kLanes, p.col1 - i + 1);
+      const std::size_t from = at + std::size_t(i - p.col0);
       const __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32(n), lane);
-      const __m256i mx = _mm256_maskload_epi32(p.x + at + i, live);
-      const __m256i my = _mm256_maskload_epi32(p.y + at + i, live);
+      const __m256i mx = _mm256_maskload_epi32(p.x + from, live);
+      const __m256i my = _mm256_maskload_epi32(p.y + from, live);
       const __m256 window = _mm256_maskload_ps(p.window + row * side + i, live);
-      const __m256i flags = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(std::int64_t(matched_bytes(p.matched + at + i, n))));
+      const __m256i flags = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(std::int64_t(matched_bytes(p.matched + from, n))));
       __m256i keep = _mm256_cmpgt_epi32(flags, _mm256_setzero_si256());
       if (row == p.radius)  // the centre is not its own neighbour
         keep = _mm256_andnot_si256(_mm256_cmpeq_epi32(lane, _mm256_set1_epi32(p.radius - i)), keep);
@@ -102,18 +105,20 @@ class SpatialCoherence final : public EnergyTerm {
                   float limit) const override {
     const PatchSpace& s = *c.space;
     const int r = s.radius;
-    if (s.window && !s.rotated() && tx >= r && ty >= r && tx + r < field.width && ty + r < field.height) {
-      const CoherencePatch patch{field.x.data(), field.y.data(), c.constraints->matched().data(),
-                                 std::size_t(field.width), field.index(tx - r, ty - r), s.window, r, sx, sy,
-                                 r_max2_};
-      return weight_ * coherence_patch_sum(patch, limit / weight_);
+    if (s.window && !s.rotated()) {
+      CoherencePatch p{field.x.data(), field.y.data(), c.constraints->matched().data(), std::size_t(field.width)};
+      p.row0 = std::max(0, r - ty), p.row1 = std::min(2 * r, r + field.height - 1 - ty);
+      p.col0 = std::max(0, r - tx), p.col1 = std::min(2 * r, r + field.width - 1 - tx);
+      p.first = field.index(tx - r + p.col0, ty - r + p.row0);
+      p.window = s.window, p.radius = r, p.source_x = sx, p.source_y = sy, p.r_max2 = r_max2_;
+      return weight_ * coherence_patch_sum(p, limit / weight_);
     }
-    return weight_ * clipped_sum(c, field, tx, ty, sx, sy);
+    return weight_ * general_sum(c, field, tx, ty, sx, sy);
   }
 
  private:
-  // Patches over the field's border or rotated, one neighbour at a time.
-  float clipped_sum(const LevelContext& c, const OffsetField& field, int tx, int ty, int sx, int sy) const {
+  // Rotated patches, or patches without a window, one neighbour at a time.
+  float general_sum(const LevelContext& c, const OffsetField& field, int tx, int ty, int sx, int sy) const {
     const PatchSpace& s = *c.space;
     const int r = s.radius, side = 2 * r + 1;
     const float phi = s.rotated() ? s.rotation(sx, sy, tx, ty) : 0.0f;

@@ -146,6 +146,11 @@ struct PatchSpace {
   // Optional weight per patch pixel, (2 radius + 1)^2 row-major, mean 1: a
   // Gaussian window (Bénard et al. 2013, eq. 1). Null = every pixel weighs 1.
   const float* window = nullptr;
+  // The window repeated for each of a pixel's `stride` channels
+  // (expand_window): an axis-aligned patch row is then one weighted run, as
+  // long as the row's features. Without it a windowed patch is summed as the
+  // rotated ones are.
+  const float* window_channels = nullptr;
 
   bool rotated() const { return source_angle || target_angle; }
   // Rotation from target offsets to source offsets: phi = a_src(p) - a_tgt(q).
@@ -160,6 +165,10 @@ struct PatchSpace {
   // source patch, with its bilinear footprint, lies inside the exemplar.
   int source_margin() const { return rotated() ? int(std::ceil(radius * 1.41421356f)) + 1 : radius; }
 };
+
+// The window (side x side weights) with each weight repeated `stride` times,
+// row-major: PatchSpace::window_channels.
+std::vector<float> expand_window(const float* window, int radius, int stride);
 
 // Sum of squared feature differences between the source patch centered at
 // (sx, sy) and the target patch centered at (tx, ty). Target patch pixels

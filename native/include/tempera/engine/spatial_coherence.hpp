@@ -1,6 +1,6 @@
 #pragma once
-// The neighbour sum of Bénard et al. 2013's spatial coherence (eq. 5) for a
-// patch inside the field, unrotated, under a window: the term's hot loop (it
+// The neighbour sum of Bénard et al. 2013's spatial coherence (eq. 5) for an
+// unrotated patch under a window, clipped to the field: the term's hot loop (it
 // was most of the coherent method's time, one sum of 80 neighbours per
 // candidate). Eight neighbours of a row at a time; the AVX2 kernel and the
 // scalar one add the same products in the same order, so they agree to the bit.
@@ -17,7 +17,10 @@ struct CoherencePatch {
   const std::int32_t* y = nullptr;
   const std::uint8_t* matched = nullptr;  // 1 where a neighbour's match counts
   std::size_t pitch = 0;
-  std::size_t first = 0;  // index of the patch's top-left pixel
+  // The patch's rows and columns inside the field, [0, 2 radius] inclusive,
+  // and the field index of its first pixel there (row0, col0).
+  int row0 = 0, row1 = 0, col0 = 0, col1 = 0;
+  std::size_t first = 0;
   const float* window = nullptr;  // (2 radius + 1)^2 weights, row-major
   int radius = 0;
   int source_x = 0, source_y = 0;  // the candidate's source centre
