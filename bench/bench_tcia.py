@@ -25,7 +25,8 @@ with its guides, as bench_warm_start.py reads them; no keys):
 reports, besides the seconds, the warp error (mean colour change along the
 motion where visible: the flicker) and the detail (mean gradient magnitude)
 over the frames, and with --save writes them (frame_NNNN.png) to compare
-revisions.
+revisions. `--set NAME=VALUE` (repeatable) passes an option, e.g.
+`--set guide_variance=0.999`.
 """
 import argparse
 import json
@@ -102,6 +103,8 @@ def main():
     parser.add_argument("--exemplar-pngs", help="with --guides: the painting's guides, ebsynth's PNGs")
     parser.add_argument("--exemplar-shrink", type=int, default=1, help="box-downsample the exemplar k x k")
     parser.add_argument("--save", help="with --guides: write the frames here")
+    parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                        help="a method or engine option (tcia.options), e.g. guide_variance=0.999; repeatable")
     args = parser.parse_args()
     if args.guides:
         style, guides, frames, numbers = rendered_shot(args)
@@ -111,7 +114,8 @@ def main():
         side, args.frames = int(round((args.mpix * 1e6) ** 0.5)), int(args.frames)
         style, guides, frames = panning_shot(side, args.frames, args.speed)
     started, cpu = time.monotonic(), time.process_time()
-    out = tcia.stylize_shot(style, guides, frames, threads=args.threads)
+    values = {k: float(v) for k, v in (item.split("=", 1) for item in args.set)}
+    out = tcia.stylize_shot(style, guides, frames, threads=args.threads, **values)
     wall, cpu = time.monotonic() - started, time.process_time() - cpu
     assert len(out) == args.frames
     quality = shot_quality(out, frames) if args.guides else {}
@@ -121,7 +125,7 @@ def main():
         Path(args.save).mkdir(parents=True, exist_ok=True)
         for f, image in zip(numbers, out):
             write_image(str(Path(args.save) / f"frame_{f:04d}.png"), image)
-    result = dict(**quality, side=side, mpix=side * side / 1e6, frames=args.frames, wall_s=round(wall, 2), cpu_s=round(cpu, 2),
+    result = dict(**values, **quality, side=side, mpix=side * side / 1e6, frames=args.frames, wall_s=round(wall, 2), cpu_s=round(cpu, 2),
                   s_per_frame=round(wall / args.frames, 2),
                   peak_rss_mb=round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024),
                   machine=f"{platform.system()} {platform.machine()}, {__import__('os').cpu_count()} cores")
