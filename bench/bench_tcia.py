@@ -60,13 +60,14 @@ def panning_shot(side, frames, speed):
 
 
 def rendered_shot(args):
-    """(style, guides, frames, motion) of a guide cache and a painting with its guides."""
+    """(style, guides, frames, frame numbers) of a guide cache and a painting with its guides."""
     from tempera import read_image
     from tempera.app import guide_cache
     from tempera.app.frames import parse_frames
+    from tempera.app.settings import LIGHT_PATH_GUIDES
     from bench_warm_start import GUIDES, exemplar_from_pngs, shrink
 
-    weights = dict(FULL=1.0, LDE=2.0, LSE=1.0, LDDE=0.5)  # light_path_guides.hpp's defaults
+    weights = {g["name"]: g["weight"] for g in LIGHT_PATH_GUIDES}  # the default guide weights
     style = np.asarray(read_image(args.exemplar), np.float32)[:, :, :3]
     exemplar = exemplar_from_pngs(args.exemplar_pngs)
     if args.exemplar_shrink > 1:
@@ -108,11 +109,11 @@ def main():
     args = parser.parse_args()
     if args.guides:
         style, guides, frames, numbers = rendered_shot(args)
-        side = int(round((frames[0]["guides"][0].shape[0] * frames[0]["guides"][0].shape[1]) ** 0.5))
         args.frames = len(frames)
     else:
         side, args.frames = int(round((args.mpix * 1e6) ** 0.5)), int(args.frames)
         style, guides, frames = panning_shot(side, args.frames, args.speed)
+    height, width = frames[0]["guides"][0].shape[:2]
     started, cpu = time.monotonic(), time.process_time()
     values = {k: float(v) for k, v in (item.split("=", 1) for item in args.set)}
     out = tcia.stylize_shot(style, guides, frames, threads=args.threads, **values)
@@ -125,13 +126,13 @@ def main():
         Path(args.save).mkdir(parents=True, exist_ok=True)
         for f, image in zip(numbers, out):
             write_image(str(Path(args.save) / f"frame_{f:04d}.png"), image)
-    result = dict(**values, **quality, side=side, mpix=side * side / 1e6, frames=args.frames, wall_s=round(wall, 2), cpu_s=round(cpu, 2),
+    result = dict(**values, **quality, width=width, height=height, mpix=width * height / 1e6, frames=args.frames, wall_s=round(wall, 2), cpu_s=round(cpu, 2),
                   s_per_frame=round(wall / args.frames, 2),
                   peak_rss_mb=round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024),
                   machine=f"{platform.system()} {platform.machine()}, {__import__('os').cpu_count()} cores")
     if args.layers:
-        strips = np.array_split(np.arange(side), args.layers)
-        masks = [np.zeros((side, side), np.float32) for _ in strips]
+        strips = np.array_split(np.arange(width), args.layers)
+        masks = [np.zeros((height, width), np.float32) for _ in strips]
         for m, cols in zip(masks, strips):
             m[:, cols] = 1
         started, cpu = time.monotonic(), time.process_time()
