@@ -2,7 +2,7 @@
 #   make demo    install deps, build, stylize the bundled demo scene in background Blender
 #   make test    install deps, build, run C++, Python, in-Blender (3.4, 4.2, 4.5, 5.0, 5.2, 5.3),
 #                wheel/farm and Flamenco tests
-# Other targets: deps, build, kit, addon-zip, wheel, extension, demo-rigid, demo-fluids, bench, bench-tracer,
+# Other targets: deps, build, kit, addon-zip, wheel, extension, demo-rigid, demo-fluids, bench, bench-shots, bench-tracer,
 #                sanitize, clean.
 
 PYTHON   := /usr/bin/python3
@@ -35,7 +35,7 @@ KIT_SOURCES := scenes/exemplar_kit.py scenes/scene_kit.py addon/tempera/methods/
                addon/tempera/blender/guide_render.py addon/tempera/app/guide_cache.py
 DEMO_OUT ?= out/demo
 
-.PHONY: all deps build kit addon-zip wheel extension test demo demo-rigid demo-fluids demo-fluids-stylize bench bench-tracer sanitize fuzz clean
+.PHONY: all deps build kit addon-zip wheel extension test demo demo-rigid demo-fluids demo-fluids-stylize bench bench-shots bench-tracer sanitize fuzz clean
 
 all: build
 
@@ -136,6 +136,12 @@ ifdef COMPARE
 	PYTHONPATH=addon $(PYTHON) bench/bench_synthesis.py --size 1024 --compare $(COMPARE) --repeats 2 \
 	    --json docs/bench_synthesis_compare.json
 endif
+
+# Every method along a 24-frame shot at 0.25, 1 and 2 Mpix, cold and warm (issue 32; about 3 h
+# on 2 cores); COMPARE=REV runs REV's module side by side.
+bench-shots: build
+	PYTHONPATH=addon $(PYTHON) bench/bench_shots.py --mpix 0.25,1,2 --frames 24 $(if $(COMPARE),--compare $(COMPARE)) \
+	    --json docs/bench_shots.json
 
 bench-tracer: build
 	PYTHONPATH=addon $(PYTHON) bench/bench_tracer.py --size 1024 --samples 64 --json docs/bench_tracer_1024.json
