@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <optional>
 
 #include "tempera/engine/error.hpp"
@@ -91,10 +92,9 @@ class DirectionTerm final : public EnergyTerm {
   float weight_;
 };
 
-// What the method derives from one side's masks and flows (App. A, §3.2-3.3).
-struct Side {
-  std::vector<Image> flow, sign, angle, shape, extent, dist;
-  MotionExtent ext;  // ext+ / ext- in pixels
+// What the method derives from one frame's mask and flow (App. A, §3.2-3.3).
+struct FrameGuides {
+  Image flow, sign, angle, shape, extent, dist;
 };
 
 void check_sequence(const std::vector<ImageView>& masks, const std::vector<ImageView>& flows, const char* what) {
@@ -114,58 +114,107 @@ void check_sequence(const std::vector<ImageView>& masks, const std::vector<Image
   }
 }
 
-Side prepare(const std::vector<ImageView>& masks, const std::vector<ImageView>& flows, const FluidymationOptions& o) {
-  Side s;
-  if (flows.empty()) {
-    s.flow = flow_from_masks(masks, o.flow_smoothing);
-  } else {
-    for (std::size_t i = 0; i < flows.size(); ++i) {
-      Image f = Image::copy_of(flows[i]);
-      for (std::size_t p = 0; p < f.pixel_count(); ++p)
-        if (masks[i].data[p] <= 0.5f) f.data()[2 * p] = f.data()[2 * p + 1] = 0;
-      s.flow.push_back(std::move(f));
-    }
+// The flow inside the mask, zero outside.
+Image masked_flow(const ImageView& flow, const ImageView& mask) {
+  Image f = Image::copy_of(flow);
+  for (std::size_t p = 0; p < f.pixel_count(); ++p)
+    if (mask.data[p] <= 0.5f) f.data()[2 * p] = f.data()[2 * p + 1] = 0;
+  return f;
+}
+
+FrameGuides derive_frame(const ImageView& mask, Image flow, const ImageView& ext_plus, const ImageView& ext_minus,
+                         const FluidymationOptions& o) {
+  FrameGuides s;
+  s.flow = std::move(flow);
+  s.dist = signed_distance(mask);
+  const Image g = gradient(s.dist.view());
+  const std::size_t n = mask.pixel_count();
+  s.sign = Image(mask.width, mask.height, 1);
+  s.angle = Image(mask.width, mask.height, 1);
+  s.extent = Image(mask.width, mask.height, 2);
+  for (std::size_t p = 0; p < n; ++p) {
+    const float fx = s.flow.data()[2 * p], fy = s.flow.data()[2 * p + 1];
+    // The distance gradient points inward: a flow against it spreads the material.
+    const float sg = fx * g.data()[2 * p] + fy * g.data()[2 * p + 1] <= 0.0f ? 1.0f : -1.0f;
+    s.sign.data()[p] = sg;
+    s.angle.data()[p] = std::atan2(sg * fy, sg * fx);
+    const float plus = ext_plus.data[p] / o.extent_scale, minus = ext_minus.data[p] / o.extent_scale;
+    s.extent.data()[2 * p] = sg > 0 ? plus : minus;
+    s.extent.data()[2 * p + 1] = sg > 0 ? minus : plus;
   }
-  std::vector<ImageView> fv;
-  for (const Image& f : s.flow) fv.push_back(f.view());
-  s.ext = motion_extent(fv, masks);
-  const float sigma = o.shape_blur / 3.0f;
-  for (std::size_t i = 0; i < masks.size(); ++i) {
-    s.dist.push_back(signed_distance(masks[i]));
-    const Image g = gradient(s.dist.back().view());
-    const std::size_t n = masks[i].pixel_count();
-    Image sign(masks[i].width, masks[i].height, 1), angle(masks[i].width, masks[i].height, 1),
-        extent(masks[i].width, masks[i].height, 2);
-    for (std::size_t p = 0; p < n; ++p) {
-      const float fx = s.flow[i].data()[2 * p], fy = s.flow[i].data()[2 * p + 1];
-      // The distance gradient points inward: a flow against it spreads the material.
-      const float sg = fx * g.data()[2 * p] + fy * g.data()[2 * p + 1] <= 0.0f ? 1.0f : -1.0f;
-      sign.data()[p] = sg;
-      angle.data()[p] = std::atan2(sg * fy, sg * fx);
-      const float plus = s.ext.forward[i].data()[p] / o.extent_scale, minus = s.ext.backward[i].data()[p] / o.extent_scale;
-      extent.data()[2 * p] = sg > 0 ? plus : minus;
-      extent.data()[2 * p + 1] = sg > 0 ? minus : plus;
-    }
-    s.sign.push_back(std::move(sign));
-    s.angle.push_back(std::move(angle));
-    s.extent.push_back(std::move(extent));
-    s.shape.push_back(gaussian_blur(masks[i], sigma));
-  }
+  s.shape = gaussian_blur(mask, o.shape_blur / 3.0f);
   return s;
 }
+
+// The exemplar's guides, every frame's at once: any frame is matched.
+struct ExemplarGuides {
+  std::vector<FrameGuides> frames;
+  MotionExtent ext;  // ext+ / ext- in pixels
+
+  ExemplarGuides(const std::vector<ImageView>& masks, const std::vector<ImageView>& flows,
+                 const FluidymationOptions& o) {
+    std::vector<Image> flow;
+    if (flows.empty()) flow = flow_from_masks(masks, o.flow_smoothing);
+    for (std::size_t i = 0; i < flows.size(); ++i) flow.push_back(masked_flow(flows[i], masks[i]));
+    std::vector<ImageView> fv;
+    for (const Image& f : flow) fv.push_back(f.view());
+    ext = motion_extent(fv, masks);
+    for (std::size_t i = 0; i < masks.size(); ++i)
+      frames.push_back(derive_frame(masks[i], std::move(flow[i]), ext.forward[i].view(), ext.backward[i].view(), o));
+  }
+};
+
+// The target's guides, derived when a frame is solved and kept for the next
+// (SHIFTNNF reads frame j - 1's): only the motion extents, and a flow made
+// from the masks, span the shot (all of it was held: 40 bytes a pixel and
+// frame, 513 MB for 24 frames of 0.25 Mpix).
+class TargetGuides {
+ public:
+  TargetGuides(const std::vector<ImageView>& masks, const std::vector<ImageView>& flows, const FluidymationOptions& o)
+      : masks_(masks), flows_(flows), o_(o) {
+    if (flows_.empty()) mask_flows_ = flow_from_masks(masks, o.flow_smoothing);
+    ext_ = motion_extent([&](std::size_t i) { return flow(i); }, masks);
+  }
+
+  Image flow(std::size_t j) const {
+    return flows_.empty() ? Image::copy_of(mask_flows_.at(j).view()) : masked_flow(flows_.at(j), masks_.at(j));
+  }
+  const MotionExtent& ext() const { return ext_; }
+
+  std::shared_ptr<const FrameGuides> frame(std::size_t j) const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& [index, guides] : recent_)
+      if (guides && index == j) return guides;
+    auto guides = std::make_shared<const FrameGuides>(
+        derive_frame(masks_.at(j), flow(j), ext_.forward[j].view(), ext_.backward[j].view(), o_));
+    recent_[oldest_] = {j, guides};
+    oldest_ ^= 1;
+    return guides;
+  }
+
+ private:
+  std::vector<ImageView> masks_, flows_;
+  FluidymationOptions o_;
+  std::vector<Image> mask_flows_;  // when the flows are made from the masks (App. A): across frames
+  MotionExtent ext_;
+  mutable std::mutex mutex_;
+  mutable std::pair<std::size_t, std::shared_ptr<const FrameGuides>> recent_[2];
+  mutable int oldest_ = 0;
+};
 
 }  // namespace
 
 struct Fluidymation::Data {
   FluidSequence seq;
   FluidymationOptions o;
-  Side S, T;
+  std::optional<ExemplarGuides> S;
+  std::optional<TargetGuides> T;
   int tw = 0, th = 0;
 
-  Image temporal_weight(int j, const FluidNnf& shifted, const Image& voted) const;
-  SynthesisInput input(int j, const Image* temporal, const Image* weight) const;
-  void read_matches(int j, const Solver& solver, const LevelResult& r, const std::optional<FluidNnf>& shifted,
-                    FluidFrame& out) const;
+  Image temporal_weight(const FrameGuides& target, int j, const FluidNnf& shifted, const Image& voted) const;
+  SynthesisInput input(const FrameGuides& target, int j, const Image* temporal, const Image* weight) const;
+  void read_matches(const FrameGuides& target, int j, const Solver& solver, const LevelResult& r,
+                    const std::optional<FluidNnf>& shifted, FluidFrame& out) const;
 };
 
 Fluidymation::Fluidymation(const FluidSequence& seq, const FluidymationOptions& o) : d_(new Data) {
@@ -184,16 +233,16 @@ Fluidymation::Fluidymation(const FluidSequence& seq, const FluidymationOptions& 
   }
   d_->seq = seq;
   d_->o = o;
-  d_->S = prepare(seq.exemplar_masks, seq.exemplar_flows, o);
-  d_->T = prepare(seq.target_masks, seq.target_flows, o);
+  d_->S.emplace(seq.exemplar_masks, seq.exemplar_flows, o);
+  d_->T.emplace(seq.target_masks, seq.target_flows, o);
   d_->tw = seq.target_masks[0].width;
   d_->th = seq.target_masks[0].height;
 }
 
 Fluidymation::~Fluidymation() = default;
 int Fluidymation::frames() const { return int(d_->seq.target_masks.size()); }
-const Image& Fluidymation::target_flow(int j) const { return d_->T.flow.at(std::size_t(j)); }
-const Image& Fluidymation::exemplar_flow(int i) const { return d_->S.flow.at(std::size_t(i)); }
+Image Fluidymation::target_flow(int j) const { return d_->T->flow(std::size_t(j)); }
+const Image& Fluidymation::exemplar_flow(int i) const { return d_->S->frames.at(std::size_t(i)).flow; }
 
 FluidNnf Fluidymation::shift_nnf(int j, const FluidNnf& prev, Image* shift) const {
   const Data& d = *d_;
@@ -204,20 +253,22 @@ FluidNnf Fluidymation::shift_nnf(int j, const FluidNnf& prev, Image* shift) cons
   const int sw = d.seq.exemplar[0].width, sh = d.seq.exemplar[0].height;
   FluidNnf out = prev;
   if (shift) *shift = Image(d.tw, d.th, 1);
+  const std::shared_ptr<const FrameGuides> before = d.T->frame(std::size_t(j - 1));
+  const std::vector<Image>& target_ext = d.T->ext().forward;
   for (std::size_t q = 0; q < prev.pixel_count(); ++q) {
     const float* m = prev.data() + 4 * q;
     if (m[0] < 0) continue;
     const float i0 = std::clamp(m[0], 0.0f, float(ns - 1));
     const std::size_t p = std::size_t(clamp_index(m[2], sh)) * sw + std::size_t(clamp_index(m[1], sw));
     // Same expansion sense: play the exemplar forward on ext+; opposite: backward on ext-.
-    const bool forward = d.T.sign[std::size_t(j - 1)].data()[q] == d.S.sign[std::size_t(std::lround(i0))].data()[p];
-    const std::vector<Image>& ext = forward ? d.S.ext.forward : d.S.ext.backward;
+    const bool forward = before->sign.data()[q] == d.S->frames[std::size_t(std::lround(i0))].sign.data()[p];
+    const std::vector<Image>& ext = forward ? d.S->ext.forward : d.S->ext.backward;
     const float step = forward ? 1.0f : -1.0f, last = forward ? float(ns - 1) - i0 : i0;
     float best = 0;
     if (d.o.time_shift == TimeShift::One) {
       best = std::min(1.0f, last);
     } else {
-      const float target = d.T.ext.forward[std::size_t(j)].data()[q] - d.T.ext.forward[std::size_t(j - 1)].data()[q];
+      const float target = target_ext[std::size_t(j)].data()[q] - target_ext[std::size_t(j - 1)].data()[q];
       const float from = extent_at(ext, i0, p);
       float best_cost = std::numeric_limits<float>::infinity();
       for (int k = 0; k <= int(std::ceil(last * kTimeSteps)); ++k) {
@@ -308,7 +359,8 @@ OffsetField level_field(const Solver& solver, int l, const FluidNnf& nnf, Candid
 
 // w_t m(q) per target pixel: 0 where the previous mask was empty or nothing
 // voted, else the smoothstep of the distance-field mismatch (or 1 - it).
-Image Fluidymation::Data::temporal_weight(int j, const FluidNnf& shifted, const Image& voted) const {
+Image Fluidymation::Data::temporal_weight(const FrameGuides& target, int j, const FluidNnf& shifted,
+                                          const Image& voted) const {
   Image weight(tw, th, 1);
   const float d_max = float(std::max(tw, th)), lo = o.modulation_lower * d_max, hi = o.modulation_upper * d_max;
   const ImageView& before = seq.target_masks[std::size_t(j - 1)];
@@ -317,7 +369,7 @@ Image Fluidymation::Data::temporal_weight(int j, const FluidNnf& shifted, const 
     const float* m = shifted.data() + 4 * q;
     if (before.data[q] <= 0.5f || voted.data()[q] <= 0 || m[0] < 0) continue;
     const std::size_t p = std::size_t(clamp_index(m[2], sh)) * sw + std::size_t(clamp_index(m[1], sw));
-    const float mismatch = std::abs(T.dist[std::size_t(j)].data()[q] - S.dist[std::size_t(clamp_index(m[0], ns))].data()[p]);
+    const float mismatch = std::abs(target.dist.data()[q] - S->frames[std::size_t(clamp_index(m[0], ns))].dist.data()[p]);
     const float s = smoothstep(mismatch, lo, hi);
     weight.data()[q] = o.modulation == TemporalModulation::Release ? 1.0f - s : s;
   }
@@ -327,11 +379,13 @@ Image Fluidymation::Data::temporal_weight(int j, const FluidNnf& shifted, const 
 // The engine's input of frame j: the exemplar video as the source set with
 // its guides (shape, extent and, with a temporal guide, its RGB), the
 // target's guides, masks, orientations and the method's terms.
-SynthesisInput Fluidymation::Data::input(int j, const Image* temporal, const Image* weight) const {
+SynthesisInput Fluidymation::Data::input(const FrameGuides& target, int j, const Image* temporal,
+                                         const Image* weight) const {
   SynthesisInput in;
   in.style = seq.exemplar[0];
-  in.guides.add("shape", S.shape[0].view(), T.shape[std::size_t(j)].view(), o.boundary_weight);
-  in.guides.add("extent", S.extent[0].view(), T.extent[std::size_t(j)].view(), o.extent_weight);
+  const std::vector<FrameGuides>& source = S->frames;
+  in.guides.add("shape", source[0].shape.view(), target.shape.view(), o.boundary_weight);
+  in.guides.add("extent", source[0].extent.view(), target.extent.view(), o.extent_weight);
   if (temporal) {
     in.guides.add("temporal", seq.exemplar[0], temporal->view(), o.temporal_weight);
     in.target_weight_maps = {ImageView{}, ImageView{}, weight->view()};
@@ -339,18 +393,18 @@ SynthesisInput Fluidymation::Data::input(int j, const Image* temporal, const Ima
   in.source_mask = seq.exemplar_masks[0];
   in.target_mask = seq.target_masks[std::size_t(j)];
   if (o.rotate) {
-    in.source_orientation = S.angle[0].view();
-    in.target_orientation = T.angle[std::size_t(j)].view();
+    in.source_orientation = source[0].angle.view();
+    in.target_orientation = target.angle.view();
   }
   in.sequence = 0;
   in.time = 0;
   for (std::size_t i = 1; i < seq.exemplar.size(); ++i) {
     Exemplar e;
     e.style = seq.exemplar[i];
-    e.guides = {S.shape[i].view(), S.extent[i].view()};
+    e.guides = {source[i].shape.view(), source[i].extent.view()};
     if (temporal) e.guides.push_back(e.style);
     e.mask = seq.exemplar_masks[i];
-    if (o.rotate) e.orientation = S.angle[i].view();
+    if (o.rotate) e.orientation = source[i].angle.view();
     e.sequence = 0;
     e.time = int(i);
     in.exemplars.push_back(e);
@@ -391,7 +445,7 @@ LevelResult solve_levels(const Solver& solver, const std::optional<FluidNnf>& sh
 }  // namespace
 
 // The finest level's matches as (i, x, y, phi), 0 (and i = -1) outside the mask.
-void Fluidymation::Data::read_matches(int j, const Solver& solver, const LevelResult& r,
+void Fluidymation::Data::read_matches(const FrameGuides& target, int j, const Solver& solver, const LevelResult& r,
                                       const std::optional<FluidNnf>& shifted, FluidFrame& out) const {
   const int ns = int(seq.exemplar.size());
   out.energy = r.stats.energy.empty() ? 0.0 : r.stats.energy.back();
@@ -417,8 +471,8 @@ void Fluidymation::Data::read_matches(int j, const Solver& solver, const LevelRe
         m[0] = sm[0];
     }
     if (o.rotate) {
-      const Image& a = S.angle[std::size_t(e.exemplar)];
-      m[3] = a.at(clamp_index(e.x, a.width()), clamp_index(e.y, a.height()), 0) - T.angle[std::size_t(j)].data()[q];
+      const Image& a = S->frames[std::size_t(e.exemplar)].angle;
+      m[3] = a.at(clamp_index(e.x, a.width()), clamp_index(e.y, a.height()), 0) - target.angle.data()[q];
     }
   }
 }
@@ -452,19 +506,20 @@ FluidFrame Fluidymation::solve_frame(int j, const FluidNnf* previous, const Prog
   if (previous && !any_inside(d.seq.target_masks[std::size_t(j - 1)])) previous = nullptr;
   FluidFrame out;
   std::optional<FluidNnf> shifted;
-  if (previous) shifted = shift_nnf(j, *previous, &out.time_shift);
+  if (previous) shifted = shift_nnf(j, *previous, &out.time_shift);  // first: it derives frame j - 1's guides
   else out.time_shift = Image(d.tw, d.th, 1);
+  const std::shared_ptr<const FrameGuides> target = d.T->frame(std::size_t(j));
   Image temporal, weight;
   const bool use_temporal = shifted && d.o.temporal_weight > 0;
   if (use_temporal) {
     Image voted;
     temporal = vote_matches(d.seq, *shifted, d.o.synthesis.patch_size / 2, voted);
-    weight = d.temporal_weight(j, *shifted, voted);
+    weight = d.temporal_weight(*target, j, *shifted, voted);
   }
   SynthesisOptions so = d.o.synthesis;
   so.seed = d.o.synthesis.seed + std::uint64_t(j) * 0x9E3779B97F4A7C15ull;
-  const Solver solver(d.input(j, use_temporal ? &temporal : nullptr, &weight), so);
-  d.read_matches(j, solver, solve_levels(solver, shifted, progress), shifted, out);
+  const Solver solver(d.input(*target, j, use_temporal ? &temporal : nullptr, &weight), so);
+  d.read_matches(*target, j, solver, solve_levels(solver, shifted, progress), shifted, out);
   return out;
 }
 

@@ -156,9 +156,10 @@ struct FluidFrame {
   double energy = 0;
 };
 
-// Everything derived from the sequences once: flows, shapes, extents,
-// distances, orientations. Frames are then solved in order, each from the
-// previous frame's matches.
+// The exemplar's flows, shapes, extents, distances and orientations derived
+// once; the target's frame by frame as frames are solved (its motion extents
+// once: they accumulate along the shot). Frames are solved in order, each
+// from the previous frame's matches.
 class Fluidymation {
  public:
   Fluidymation(const FluidSequence& sequence, const FluidymationOptions& options);
@@ -171,7 +172,7 @@ class Fluidymation {
   // SHIFTNNF: the matches of frame j - 1 advanced in exemplar time to frame
   // j; `shift` gets delta i* per pixel.
   FluidNnf shift_nnf(int j, const FluidNnf& previous, Image* shift = nullptr) const;
-  const Image& target_flow(int j) const;
+  Image target_flow(int j) const;  // inside the mask (made from the masks without flows), zero outside
   const Image& exemplar_flow(int i) const;
 
  private:

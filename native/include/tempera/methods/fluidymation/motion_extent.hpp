@@ -7,6 +7,7 @@
 // each zeroed where the pixel is outside mask i (the accumulation restarts
 // where material reappears); ext = |acc|. Per pixel, not along paths, as in
 // the paper.
+#include <functional>
 #include <vector>
 
 #include "tempera/engine/image.hpp"
@@ -20,5 +21,8 @@ struct MotionExtent {
 // flows: 2 channels per frame (pixels/frame, forward convention), masks: 1
 // channel per frame (> 0.5 = inside), same count and size.
 MotionExtent motion_extent(const std::vector<ImageView>& flows, const std::vector<ImageView>& masks);
+// The same, frame i's flow made when it is read (twice: once each way), so
+// that a shot's flows need not be held at once.
+MotionExtent motion_extent(const std::function<Image(std::size_t)>& flow_of, const std::vector<ImageView>& masks);
 
 }  // namespace tempera
