@@ -251,7 +251,7 @@ class Sweeper {
     return pick_resize(direction > 0 ? f.occlusion_backward : f.occlusion_forward, w, h);
   }
 
-  void visit(int l, int t, int direction, int pair, const std::vector<FrameState>& coarse,
+  void visit(int l, int t, int direction, int pair, std::vector<FrameState>& coarse,
              std::vector<FrameState>& here) {
     const int frames = int(shot_.frames.size()), from = t - direction;
     // The neighbour in sweep order, solved at this level already (forward
@@ -264,7 +264,10 @@ class Sweeper {
     // the coarser level's, upsampled.
     std::optional<OffsetField> own;
     if (state.field) own = *state.field;
-    else if (!coarse.empty() && coarse[std::size_t(t)].field) own = solver->resample(*coarse[std::size_t(t)].field, l + 1, l);
+    else if (!coarse.empty() && coarse[std::size_t(t)].field) {
+      own = solver->resample(*coarse[std::size_t(t)].field, l + 1, l);
+      coarse[std::size_t(t)] = FrameState{};  // read only at this first visit: freed, not held through the level
+    }
     std::optional<OffsetField> advected;
     Image visible, temporal_target;
     Image v_level;

@@ -252,7 +252,7 @@ bool TciaJob::is_current(std::size_t index) const {
   return record_current(record_path(index), kTciaRecordFormat, composite_key(segments_[index]), files);
 }
 
-Shot TciaJob::load_shot(const Segment& segment, std::deque<Image>& keep) const {
+Shot TciaJob::load_shot(const Segment& segment, std::deque<Image>& keep, ScratchImages& frame_inputs) const {
   const std::vector<std::string>& names = shot_.guides();
   Shot shot;
   shot.style = shot_.style().view();
@@ -278,17 +278,17 @@ Shot TciaJob::load_shot(const Segment& segment, std::deque<Image>& keep) const {
     for (int m = from; m < to; ++m) wanted.push_back(kMotion[m]);
     const GuideFrame g = GuideFrame::read(shot_.target_path(f), wanted);
     ShotFrame frame;
-    for (const auto& name : names) frame.guides.push_back(keep.emplace_back(tonemap_guide(g.get(name).view())).view());
-    if (lines) frame.guides.push_back(keep.emplace_back(Image::copy_of(g.get("line_distance").view())).view());
-    if (oriented) frame.orientation = keep.emplace_back(tensor_angle(g)).view();
+    for (const auto& name : names) frame.guides.push_back(frame_inputs.add(tonemap_guide(g.get(name).view())));
+    if (lines) frame.guides.push_back(frame_inputs.add(g.get("line_distance").view()));
+    if (oriented) frame.orientation = frame_inputs.add(tensor_angle(g));
     const Image& first = g.get(names.front());
     ImageView* motion[] = {&frame.velocity_backward, &frame.occlusion_backward, &frame.velocity_forward,
                            &frame.occlusion_forward};
     for (int m = 0; m < 4; ++m) {
       // Unused at the segment's ends (no neighbour there): zero motion, nothing visible.
-      Image image = m >= from && m < to ? Image::copy_of(g.get(kMotion[m]).view())
-                                        : Image(first.width(), first.height(), m % 2 == 0 ? 2 : 1, 0.0f);
-      *motion[m] = keep.emplace_back(std::move(image)).view();
+      *motion[m] = m >= from && m < to
+                       ? frame_inputs.add(g.get(kMotion[m]).view())
+                       : frame_inputs.add(Image(first.width(), first.height(), m % 2 == 0 ? 2 : 1, 0.0f));
     }
     shot.frames.push_back(std::move(frame));
   }
@@ -311,7 +311,11 @@ SegmentResult TciaJob::run_segment(std::size_t index, const SegmentProgress& pro
   }
   const auto t0 = std::chrono::steady_clock::now();
   std::deque<Image> keep;
-  const Shot shot = load_shot(segment, keep);
+  // Every frame's guides and motion, half of what a segment holds, in memory
+  // the kernel can page out (scratch_images.hpp): a segment larger than the
+  // machine's memory then runs, where it was killed.
+  ScratchImages frame_inputs(config_.out);
+  const Shot shot = load_shot(segment, keep, frame_inputs);
   SweepCallback sweeps;
   if (progress)
     sweeps = [&](const SweepProgress& p) {

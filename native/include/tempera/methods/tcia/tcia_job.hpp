@@ -16,6 +16,7 @@
 #include "tempera/app/segments.hpp"
 #include "tempera/app/light_path_guides.hpp"
 #include "tempera/app/light_path_shot.hpp"
+#include "tempera/app/scratch_images.hpp"
 #include "tempera/app/segment_job.hpp"
 #include "tempera/methods/tcia/tcia.hpp"
 
@@ -155,7 +156,7 @@ class TciaJob : public SegmentJob {
  private:
   std::string segment_key(const Segment& segment) const;
   bool is_current(std::size_t index) const;
-  Shot load_shot(const Segment& segment, std::deque<Image>& keep) const;
+  Shot load_shot(const Segment& segment, std::deque<Image>& keep, ScratchImages& frame_inputs) const;
   std::string composite_key(const Segment& segment) const;  // segment_key and the layers
   std::string layer_key(const Segment& segment, std::size_t layer) const;
 
