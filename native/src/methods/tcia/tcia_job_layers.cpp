@@ -175,12 +175,15 @@ std::vector<Image> TciaJob::run_layers(std::size_t index, const Shot& shot, cons
   std::vector<std::string> wanted;
   for (const LayerFile& l : config_.layers) wanted.push_back(l.mask);
   if (config_.layer_order == "depth") wanted.push_back("depth");
-  std::vector<std::vector<Image>> masks(n);  // per layer, per frame of the segment
-  std::vector<Image> depths;
+  // Held through the segment and read now and then, like the shot's inputs:
+  // where the kernel can page them out (scratch_images.hpp).
+  ScratchImages per_frame(config_.out);
+  std::vector<std::vector<ImageView>> masks(n);  // per layer, per frame of the segment
+  std::vector<ImageView> depths;
   for (int f = segment.first; f <= segment.last; ++f) {
     const GuideFrame g = GuideFrame::read(shot_.target_path(f), wanted);
-    for (std::size_t l = 0; l < n; ++l) masks[l].push_back(coverage(g.get(config_.layers[l].mask)));
-    if (config_.layer_order == "depth") depths.push_back(extract_channels(g.get("depth").view(), 0, 1));
+    for (std::size_t l = 0; l < n; ++l) masks[l].push_back(per_frame.add(coverage(g.get(config_.layers[l].mask))));
+    if (config_.layer_order == "depth") depths.push_back(per_frame.add(extract_channels(g.get("depth").view(), 0, 1)));
   }
   for (std::size_t l = 0; l < n; ++l) {
     std::vector<std::string> files;
@@ -188,9 +191,8 @@ std::vector<Image> TciaJob::run_layers(std::size_t index, const Shot& shot, cons
     if (config_.resume &&
         record_current(layer_record_path(index, l), kTciaRecordFormat, layer_key(segment, l), files))
       continue;
-    ShotLayer layer{config_.layers[l].name, {}, layer_paintings_[l].view(), layer_style_masks_[l].view()};
-    for (const Image& m : masks[l]) layer.masks.push_back(m.view());
-    std::deque<Image> keep;
+    ShotLayer layer{config_.layers[l].name, masks[l], layer_paintings_[l].view(), layer_style_masks_[l].view()};
+    ScratchImages layer_inputs(config_.out);  // the layer's own guides and motion, freed with the layer
     SweepCallback progress;
     if (sweeps)
       progress = [&](const SweepProgress& p) {
@@ -199,12 +201,13 @@ std::vector<Image> TciaJob::run_layers(std::size_t index, const Shot& shot, cons
         return sweeps(here);
       };
     const Shot own = with_layer_keys(shot, segment, l);
-    const std::vector<Image> images = stylize_shot_sweeps(layer_shot(own, layer, keep), config_.tcia, progress);
+    const Shot layered = layer_shot(own, layer, [&](Image&& image) { return layer_inputs.add(image); });
+    const std::vector<Image> images = stylize_shot_sweeps(layered, config_.tcia, progress);
     std::error_code ec;
     fs::create_directories(fs::path(files.front()).parent_path(), ec);
     for (std::size_t i = 0; i < files.size(); ++i) {
       const std::size_t t = std::size_t(segment.writes[i] - segment.first);
-      write_image(files[i], with_alpha(images[t].view(), masks[l][t].view()).view());  // atomic
+      write_image(files[i], with_alpha(images[t].view(), masks[l][t]).view());  // atomic
     }
     write_record(layer_record_path(index, l), kTciaRecordFormat, layer_key(segment, l), files);
   }
@@ -225,7 +228,7 @@ std::vector<Image> TciaJob::run_layers(std::size_t index, const Shot& shot, cons
     for (std::size_t l = 0; l < n; ++l) colours.push_back(colour[l].view()), alphas.push_back(alpha[l].view());
     std::vector<int> order(n);
     std::iota(order.begin(), order.end(), 0);
-    if (config_.layer_order == "depth") order = depth_order(depths[t].view(), alphas);
+    if (config_.layer_order == "depth") order = depth_order(depths[t], alphas);
     out[t] = composite_layers(colours, alphas, order);
   }
   return out;

@@ -56,6 +56,10 @@ Image extend_from_mask(const ImageView& image, const ImageView& mask) {
 }
 
 Shot layer_shot(const Shot& shot, const ShotLayer& layer, std::deque<Image>& keep, bool extrapolate) {
+  return layer_shot(shot, layer, [&](Image&& image) { return keep.emplace_back(std::move(image)).view(); }, extrapolate);
+}
+
+Shot layer_shot(const Shot& shot, const ShotLayer& layer, const ImageKeeper& keep, bool extrapolate) {
   check_layer(shot, layer);
   Shot out = shot;
   if (!layer.style.empty()) out.style = layer.style;
@@ -65,20 +69,18 @@ Shot layer_shot(const Shot& shot, const ShotLayer& layer, std::deque<Image>& kee
   for (std::size_t t = 0; t < n; ++t) {
     const Image nearest = nearest_mask_pixel(layer.masks[t], concat("the mask of layer '", layer.name, "'"));
     ShotFrame& f = out.frames[t];
-    for (ImageView* v : {&f.velocity_backward, &f.velocity_forward}) *v = keep.emplace_back(pick_nearest(*v, nearest)).view();
-    for (ImageView& g : f.guides) g = keep.emplace_back(pick_nearest(g, nearest)).view();
-    if (!f.orientation.empty()) f.orientation = keep.emplace_back(pick_nearest(f.orientation, nearest)).view();
+    for (ImageView* v : {&f.velocity_backward, &f.velocity_forward}) *v = keep(pick_nearest(*v, nearest));
+    for (ImageView& g : f.guides) g = keep(pick_nearest(g, nearest));
+    if (!f.orientation.empty()) f.orientation = keep(pick_nearest(f.orientation, nearest));
   }
   // χ of the layer alone, from its own (extrapolated) motion; the shot's
   // ends keep theirs (no neighbour there).
   for (std::size_t t = 0; t < n; ++t) {
     ShotFrame& f = out.frames[t];
     if (t > 0)
-      f.occlusion_backward =
-          keep.emplace_back(occlusion_backward(f.velocity_backward, out.frames[t - 1].velocity_forward)).view();
+      f.occlusion_backward = keep(occlusion_backward(f.velocity_backward, out.frames[t - 1].velocity_forward));
     if (t + 1 < n)
-      f.occlusion_forward =
-          keep.emplace_back(occlusion_forward(f.velocity_forward, out.frames[t + 1].velocity_backward)).view();
+      f.occlusion_forward = keep(occlusion_forward(f.velocity_forward, out.frames[t + 1].velocity_backward));
   }
   return out;
 }

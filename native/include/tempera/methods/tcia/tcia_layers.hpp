@@ -20,6 +20,7 @@
 // says "using the distance transform of the input layer"), the extended
 // guides, the recomputed χ, the median depth and the opaque back-most layer.
 #include <deque>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -42,9 +43,15 @@ struct ShotLayer {
 // no pixel leaves the image as it is.
 Image extend_from_mask(const ImageView& image, const ImageView& mask);
 
-// The shot of one layer; its views point into `keep` and `shot`.
+// Holds an image layer_shot made for as long as the layer's shot is used;
+// returns its view (the coherent job's: a scratch file, app/scratch_images.hpp).
+using ImageKeeper = std::function<ImageView(Image&&)>;
+
+// The shot of one layer; its views point into what `keep` holds and `shot`.
 // `extrapolate` false keeps the shot's motion (the Fig. 10(c) baseline).
 // ValueError naming the layer when its masks or painting do not fit the shot.
+Shot layer_shot(const Shot& shot, const ShotLayer& layer, const ImageKeeper& keep, bool extrapolate = true);
+// The same, holding the images in `keep`.
 Shot layer_shot(const Shot& shot, const ShotLayer& layer, std::deque<Image>& keep, bool extrapolate = true);
 
 // The indices of `masks` from back to front by the median `depth` of each
