@@ -126,6 +126,37 @@ TEST(Solver, LastUseFreesTheLevelAndTakeFieldMovesTheStart) {
   EXPECT_NO_THROW(kept.solve_level(c - 1, {&copied.field}));  // without last_use: any order, again
 }
 
+// em_tolerance: the finest level stops after the first EM iteration that
+// lowers the energy by less than that fraction, with the energies of the full
+// run up to there (the iterations it runs are the same); coarser levels run
+// all of theirs. Off (0), it runs every iteration.
+TEST(Solver, TheFinestLevelStopsOnceAnIterationGainsLittle) {
+  const Image style = smooth_noise(96, 72, 3, 5), sg = coordinate_guide(96, 72), tg = coordinate_guide(88, 64);
+  SynthesisInput in;
+  in.style = style.view();
+  in.guides.add("coords", sg.view(), tg.view(), 2.0f);
+  SynthesisOptions opt = options(PatchUsage::None);
+  opt.em_tolerance = 0;
+  const SynthesisResult full = synthesize(in, opt);
+  const std::vector<double>& e = full.levels.back().energy;
+  ASSERT_EQ(int(e.size()), opt.em_iterations);
+  opt.em_tolerance = 0.05;
+  std::size_t expected = e.size();
+  for (std::size_t i = 1; i < e.size(); ++i)
+    if (e[i] <= e[i - 1] && e[i - 1] - e[i] < opt.em_tolerance * e[i - 1]) {
+      expected = i + 1;
+      break;
+    }
+  ASSERT_LT(expected, e.size()) << "the problem must settle before its last iteration";
+  const SynthesisResult early = synthesize(in, opt);
+  const std::vector<double>& stopped = early.levels.back().energy;
+  ASSERT_EQ(stopped.size(), expected);
+  for (std::size_t i = 0; i < expected; ++i) EXPECT_EQ(stopped[i], e[i]);
+  for (std::size_t l = 0; l + 1 < early.levels.size(); ++l)
+    EXPECT_EQ(int(early.levels[l].energy.size()), opt.em_iterations) << "level " << l;
+  EXPECT_LT(stopped.back(), e.back() * 1.10);
+}
+
 TEST(Solver, WarmStartFromItsOwnFieldIsNoWorseInHalfTheTime) {
   const Image style = smooth_noise(96, 72, 3, 2), sg = coordinate_guide(96, 72), tg = coordinate_guide(88, 64);
   SynthesisInput in;

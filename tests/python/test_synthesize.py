@@ -111,7 +111,7 @@ def test_progress_is_monotone_and_false_cancels():
 
 
 def test_the_gil_is_released_while_solving():
-    style, g = noise(96, 96), coordinate_guide(96, 96)
+    style, g = noise(128, 128), coordinate_guide(128, 128)
     assert_releases_gil(lambda: tempera.synthesize(style, [(g, g[::-1].copy())], threads=1))
 
 

@@ -473,6 +473,16 @@ double mean_energy(const OffsetField& field, const SearchConstraints& cons) {
   return n ? sum / double(n) : 0.0;
 }
 
+// Whether the last EM iteration lowered the energy, by less than `tolerance`
+// of the one before: the iterations left would change little. One that
+// raised it has not settled (the patch usage's reassignment can, and a later
+// iteration then drops it again).
+bool settles(const std::vector<double>& energy, double tolerance) {
+  if (tolerance <= 0 || energy.size() < 2) return false;
+  const double before = energy[energy.size() - 2], after = energy.back();
+  return after <= before && before - after < tolerance * before;
+}
+
 }  // namespace
 
 PatchSpace Solver::geometry(int l, FeatureImage& source, FeatureImage& target) const {
@@ -889,12 +899,15 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
     }
     stats.usage_seconds += seconds_since(t0);
     stats.energy.push_back(mean_energy(field, level.constraints));
+    // Only the finest level stops early: what a coarser level leaves
+    // unsettled is upsampled and compounds, as with converged pixels.
+    const bool settled = l == 0 && settles(stats.energy, options_.em_tolerance);
     t0 = Clock::now();
     VoteParams vp = vote_params;
     vp.stream = stream;
     Image voted = vote(level.style.view(), level.space, level.constraints, field, bprime.view(), vp);
     stats.vote_seconds += seconds_since(t0);
-    if (skip_converged && !bprime.empty()) {
+    if (skip_converged && !bprime.empty() && !settled) {
       t0 = Clock::now();
       mark_moved(field, matches_before, moved);
       to_search = pixels_to_search(field.width, field.height, moved, changed_pixels(bprime.view(), voted.view()),
@@ -902,7 +915,8 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
       stats.search_seconds += seconds_since(t0);
     }
     bprime = std::move(voted);
-    if (progress && !progress(double(it + 1) / em)) throw CancelledError("synthesis cancelled");
+    if (progress && !progress(settled ? 1.0 : double(it + 1) / em)) throw CancelledError("synthesis cancelled");
+    if (settled) break;
   }
   stats.source_coverage = source_coverage(field, level.constraints, level.source.width);
   return out;

@@ -63,6 +63,10 @@ struct SynthesisOptions {
   int em_iterations = 6;
   int pm_iterations = 2;  // measured: 4 gains < 1% energy
   std::vector<int> em_schedule, pm_schedule;  // per level, coarsest first
+  // The finest level stops its EM iterations once one lowers the energy by
+  // less than this fraction (0: all of them). Measured on ebsynth's StyLit
+  // still (docs/benchmarks.md, issue 32 step 21).
+  double em_tolerance = 0.02;
   bool skip_converged = true;  // converged_pixels.hpp; finest level only, within 2% of the full search
   PatchUsage usage = PatchUsage::Budget;
   float style_weight = 1.0f;
@@ -107,6 +111,11 @@ inline const auto& synthesis_option_table() {
             "EM iterations per level, coarsest first; levels past the list use em_iterations", 1, 1000),
       field(&S::pm_schedule, "pm_schedule", "pm-schedule",
             "PatchMatch sweeps per level, coarsest first; levels past the list use pm_iterations", 0, 1000),
+      field(&S::em_tolerance, "em_tolerance", "em-tolerance",
+            "the finest level stops iterating once an EM iteration lowers the energy by less than this fraction: "
+            "0.02 stops ebsynth's StyLit still after 4 of 6, 0.7x the time, judged energy +0.4%; "
+            "0 runs every iteration",
+            0, 1),
       field(&S::skip_converged, "skip_converged", "skip-converged",
             "the forward search skips pixels whose match, neighbours' matches and patch of B' did not change in "
             "the last EM iteration, at the finest level only: about 50% fewer searches there at 1 Mpix, about 0.9x the "

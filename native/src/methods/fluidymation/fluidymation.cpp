@@ -24,6 +24,7 @@ SynthesisOptions fluidymation_defaults() {
   o.feature_precision = FeaturePrecision::Float;  // rotated patches match in float anyway
   o.em_iterations = 3;
   o.pm_iterations = 2;
+  o.em_tolerance = 0;  // every iteration (the early stop is measured for StyLit only)
   return o;
 }
 

@@ -112,6 +112,7 @@ SynthesisOptions lazyfluids_defaults() {
   o.usage = PatchUsage::Uniform;
   o.style_channel_weights = {1, 1, 1, 3};
   o.guide_variance = 1;  // per-pixel λ_q maps need the guides uncompressed anyway
+  o.em_tolerance = 0;    // every iteration of a cold frame (the early stop is measured for StyLit only)
   return o;
 }
 

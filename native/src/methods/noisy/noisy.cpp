@@ -25,6 +25,7 @@ SynthesisOptions noisy_defaults() {
   o.patch_size = 7;
   o.em_iterations = 4;   // "4 iterations of search and vote" per level (§4)
   o.pm_iterations = 2;   // "8 PatchMatch iterations at each pyramid level": 2 per search x 4 searches
+  o.em_tolerance = 0;    // every iteration: the paper's schedule (the early stop is measured for StyLit only)
   o.usage = PatchUsage::None;
   o.output = OutputMode::Mode;  // "the mode of colours" (§3.2)
   o.level_ratio = kRatio;

@@ -91,6 +91,7 @@ Image resynthesize_strokes(const ImageView& drawing, const ImageView& exemplar, 
   SynthesisOptions options;
   options.usage = PatchUsage::None;
   options.patch_size = kPatchSize;
+  options.em_tolerance = 0;  // every iteration (the early stop is measured for StyLit only)
   options.seed = seed;
   const Image made = synthesize(in, options, progress).image;
   for (int y = 0; y < box.height(); ++y)
