@@ -1,10 +1,15 @@
 // Mean voting: the fast loop for a few channels gives the general loop's
-// floats, and both give the mean of the covering patches.
+// floats, and both give the mean of the covering patches. The weighted mode:
+// its AVX2 kernel picks what the scalar one picks, and both pick the mode.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <random>
 
 #include "tempera/engine/voting.hpp"
+#include "tempera/engine/weighted_mode.hpp"
 #include "test_inputs.hpp"
 
 using namespace tempera;
@@ -65,4 +70,55 @@ TEST(Voting, MeanOfAFewChannelsEqualsTheGeneralLoopAndTheMean) {
         EXPECT_NEAR(fast.at(x, y, k), sum / count, 1e-6) << x << "," << y;
       }
     }
+}
+
+// The mode by its definition, in double, over every candidate (duplicates
+// included): the scores of all candidates.
+static std::vector<double> mode_scores(const std::vector<std::array<float, 3>>& v, double h) {
+  std::vector<double> score(v.size(), 0.0);
+  for (std::size_t j = 0; j < v.size(); ++j)
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      if (k == j) continue;
+      double d = 0;
+      for (int ch = 0; ch < 3; ++ch) d += (double(v[j][ch]) - v[k][ch]) * (double(v[j][ch]) - v[k][ch]);
+      score[j] += std::exp(-d / (h * h));
+    }
+  return score;
+}
+
+TEST(Voting, TheWeightedModeKernelsPickTheSameCandidateAndItIsTheMode) {
+  const float h = 0.1f;
+  std::mt19937 rng(5);
+  ModeCandidates c;
+  ModeScratch scalar, avx2;
+  int checked = 0, unambiguous = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    // Up to 49 candidates (a 7x7 patch), drawn from a few colours so that many
+    // repeat, as along a coherent field; some near each other, some far.
+    const std::size_t n = 1 + rng() % 49, colours = 1 + rng() % 30;
+    std::vector<std::array<float, 3>> palette(colours), v(n);
+    for (auto& p : palette)
+      for (float& x : p) x = float(rng() % 1000) / 1000.0f * (trial % 3 == 0 ? 1.0f : 0.3f);
+    c.reset(3, 49);
+    for (auto& x : v) {
+      x = palette[rng() % colours];
+      c.push(x.data());
+    }
+    const std::size_t pick = weighted_mode(c, h, scalar, FixedKernel::Scalar);
+    ASSERT_LT(pick, n);
+    if (fixed_kernel_supported(FixedKernel::Avx2)) {
+      ASSERT_EQ(weighted_mode(c, h, avx2, FixedKernel::Avx2), pick) << "trial " << trial;
+      ++checked;
+    }
+    const std::vector<double> score = mode_scores(v, h);
+    const double best = *std::max_element(score.begin(), score.end());
+    double runner_up = -1;  // the best score of a colour other than the best's
+    for (std::size_t j = 0; j < n; ++j)
+      if (v[j] != v[pick]) runner_up = std::max(runner_up, score[j]);
+    EXPECT_NEAR(score[pick], best, 1e-4 * (1 + best)) << "trial " << trial;
+    if (best - runner_up > 1e-3) ++unambiguous;
+  }
+  EXPECT_GT(unambiguous, 1000);  // the check above is not only among near-ties
+  if (!fixed_kernel_supported(FixedKernel::Avx2)) GTEST_SKIP() << "no AVX2: only the scalar kernel was checked";
+  EXPECT_EQ(checked, 3000);
 }

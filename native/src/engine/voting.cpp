@@ -6,6 +6,7 @@
 
 #include "tempera/engine/parallel.hpp"
 #include "tempera/engine/rng.hpp"
+#include "tempera/engine/weighted_mode.hpp"
 
 namespace tempera {
 namespace {
@@ -33,55 +34,6 @@ struct Voter {
     }
   }
 };
-
-// Index of the candidate with the most similar neighbours (a kernel mode):
-// score(j) = sum over k of exp(-|v_j - v_k|^2 / h^2), the first best wins.
-// This was the whole cost of a Color Me Noisy frame (93%: 49^2 kernels per
-// pixel), so it is computed without changing the answer:
-//  - equal colours (neighbouring patches of a coherent field copy the same
-//    source pixel) are scored once, with their count as weight;
-//  - each pair's kernel is evaluated once, for both ends;
-//  - a kernel below half a float step of 1 is skipped: every score starts at
-//    its own count (>= 1), so adding it could not change the sum.
-struct ModeScratch {
-  std::vector<float> unique, score;
-  std::vector<std::size_t> first, count;
-};
-
-std::size_t weighted_mode(const std::vector<float>& values, int c, std::size_t n, ModeScratch& m) {
-  m.unique.clear(), m.first.clear(), m.count.clear();
-  for (std::size_t j = 0; j < n; ++j) {
-    const float* v = values.data() + j * c;
-    std::size_t u = 0;
-    while (u < m.first.size() && !std::equal(v, v + c, m.unique.data() + u * c)) ++u;
-    if (u == m.first.size()) {
-      m.unique.insert(m.unique.end(), v, v + c);
-      m.first.push_back(j);
-      m.count.push_back(0);
-    }
-    ++m.count[u];
-  }
-  const std::size_t u = m.first.size();
-  const float inv = 1.0f / (kModeBandwidth * kModeBandwidth);
-  constexpr float kNegligible = 17.5f;  // exp(-17.5) < 2^-25
-  m.score.assign(m.count.begin(), m.count.end());
-  for (std::size_t j = 0; j < u; ++j)
-    for (std::size_t k = j + 1; k < u; ++k) {
-      float d = 0.0f;
-      for (int ch = 0; ch < c; ++ch) {
-        const float e = m.unique[j * c + ch] - m.unique[k * c + ch];
-        d += e * e;
-      }
-      if (d * inv > kNegligible) continue;
-      const float kernel = std::exp(-d * inv);
-      m.score[j] += float(m.count[k]) * kernel;
-      m.score[k] += float(m.count[j]) * kernel;
-    }
-  std::size_t best = 0;  // in order of first appearance, so ties go to the first candidate
-  for (std::size_t j = 1; j < u; ++j)
-    if (m.score[j] > m.score[best]) best = j;
-  return m.first[best];
-}
 
 // Calls fn(q, dx, dy) for every voting patch that covers target (tx, ty),
 // row by row: the patch centred at q = (tx - dx, ty - dy), in which the
@@ -143,7 +95,9 @@ Image vote(const ImageView& style, const PatchSpace& space, const SearchConstrai
   }
   const Voter voter{style, space, field};
   parallel_for(th, params.threads, [&](int ty) {
-    std::vector<float> sum(c), sample(c), candidates;
+    std::vector<float> sum(c), sample(c);
+    ModeCandidates candidates;
+    candidates.reset(c, std::size_t(2 * r + 1) * std::size_t(2 * r + 1));
     ModeScratch scratch;
     for (int tx = 0; tx < tw; ++tx) {
       const std::size_t i = field.index(tx, ty);
@@ -163,7 +117,7 @@ Image vote(const ImageView& style, const PatchSpace& space, const SearchConstrai
         if (params.mode == OutputMode::Mean)
           for (int k = 0; k < c; ++k) sum[k] += sample[k];
         else
-          candidates.insert(candidates.end(), sample.begin(), sample.end());
+          candidates.push(sample.data());
       });
       if (count == 0) continue;
       if (params.mode == OutputMode::Mean) {
@@ -174,9 +128,9 @@ Image vote(const ImageView& style, const PatchSpace& space, const SearchConstrai
           Rng rng(params.seed, mix64(params.stream * 0x9E37ull + 17) ^ i);
           pick = std::size_t(rng.below(count));
         } else {
-          pick = weighted_mode(candidates, c, std::size_t(count), scratch);
+          pick = weighted_mode(candidates, kModeBandwidth, scratch);
         }
-        std::copy_n(candidates.data() + pick * c, c, o);
+        candidates.copy(pick, o);
       }
     }
   });
