@@ -5,6 +5,9 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
+#include <cstdint>
+#include <limits>
 #include <cmath>
 #include <random>
 
@@ -121,4 +124,19 @@ TEST(Voting, TheWeightedModeKernelsPickTheSameCandidateAndItIsTheMode) {
   EXPECT_GT(unambiguous, 1000);  // the check above is not only among near-ties
   if (!fixed_kernel_supported(FixedKernel::Avx2)) GTEST_SKIP() << "no AVX2: only the scalar kernel was checked";
   EXPECT_EQ(checked, 3000);
+}
+
+TEST(Voting, TheWeightedModeKernelIsExpWithinTwoFloatSteps) {
+  int worst = 0;
+  for (float x = 0.0f; x <= 17.5f; x = std::nextafter(x + 1e-5f, 18.0f)) {
+    const float exact = float(std::exp(-double(x)));
+    const float k = mode_kernel(x);
+    const int steps = std::abs(std::bit_cast<std::int32_t>(k) - std::bit_cast<std::int32_t>(exact));
+    worst = std::max(worst, steps);
+    ASSERT_LE(steps, 2) << "x = " << x << ": " << k << " against " << exact;
+  }
+  EXPECT_EQ(mode_kernel(17.6f), 0.0f);  // negligible against a score of at least 1
+  EXPECT_EQ(mode_kernel(std::numeric_limits<float>::infinity()), 0.0f);
+  EXPECT_EQ(mode_kernel(std::numeric_limits<float>::quiet_NaN()), 0.0f);
+  EXPECT_EQ(mode_kernel(0.0f), 1.0f);
 }

@@ -3,6 +3,7 @@
 #include <immintrin.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "tempera/engine/error.hpp"
@@ -13,12 +14,14 @@ namespace tempera {
 // pixel at first), so it is computed without changing the answer:
 //  - equal colours (neighbouring patches of a coherent field copy the same
 //    source pixel) are scored once, with their count as weight;
-//  - each pair's kernel is evaluated once, for both ends;
 //  - a kernel below half a float step of 1 counts as 0: every score starts at
 //    its own count (>= 1), so adding it could not change the sum.
-// Every score is its count plus count(k) * kernel(j, k) over k in ascending
-// order (a skipped kernel adds an exact 0), in both variants: the AVX2 one
-// sums eight scores at once in the same order, so their floats are the same.
+// Every score is its count plus count(k) * kernel(j, k) over k != j in
+// ascending order (a skipped kernel adds an exact 0), in both variants: the
+// AVX2 one sums eight scores at once in the same order, with the same floats.
+// The kernel is the engine's own exp (exp_neg below), not the C library's,
+// so that eight are evaluated at once and every CPU and C library gives the
+// same frames.
 
 namespace {
 
@@ -27,8 +30,35 @@ constexpr std::size_t kLanes = 8;
 
 std::size_t round_up(std::size_t n) { return (n + kLanes - 1) / kLanes * kLanes; }
 
-// The kernel of two colours whose squared distance over h^2 is x.
-inline float kernel_of(float x) { return x > kNegligible ? 0.0f : std::exp(-x); }
+// exp(-x) for 0 <= x <= kNegligible, within about 2 float steps (measured in
+// the test): e^-x = 2^-n e^r with n the integer nearest x / ln 2 and
+// r = n ln 2 - x in [-ln 2 / 2, ln 2 / 2] (ln 2 split in two so that n ln 2
+// keeps its bits), e^r by its Taylor series to r^7 (the rest below 0.1 of a
+// float step). Both variants round and multiply the same floats in the same
+// order (the build has no FMA contraction: x86-64-v2, and the AVX2 target
+// does not include FMA).
+constexpr float kLog2e = 1.44269504f;
+constexpr float kLn2Hi = 0.693359375f;  // 9 significant bits: n * kLn2Hi is exact for n < 2^15
+constexpr float kLn2Lo = float(0.69314718055994531 - 0.693359375);
+constexpr float kTaylor[8] = {1.0f, 1.0f, 1.0f / 2, 1.0f / 6, 1.0f / 24, 1.0f / 120, 1.0f / 720, 1.0f / 5040};
+
+float exp_neg(float x) {
+  const float n = std::nearbyint(x * kLog2e);
+  const float r = (n * kLn2Hi - x) + n * kLn2Lo;
+  float p = kTaylor[7];
+  for (int k = 6; k >= 0; --k) p = p * r + kTaylor[k];
+  return p * std::bit_cast<float>((127 - int(n)) << 23);
+}
+
+[[gnu::target("avx2")]] inline __m256 exp_neg(__m256 x) {
+  const __m256 n = _mm256_round_ps(_mm256_mul_ps(x, _mm256_set1_ps(kLog2e)), _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
+  const __m256 r = _mm256_add_ps(_mm256_sub_ps(_mm256_mul_ps(n, _mm256_set1_ps(kLn2Hi)), x),
+                                 _mm256_mul_ps(n, _mm256_set1_ps(kLn2Lo)));
+  __m256 p = _mm256_set1_ps(kTaylor[7]);
+  for (int k = 6; k >= 0; --k) p = _mm256_add_ps(_mm256_mul_ps(p, r), _mm256_set1_ps(kTaylor[k]));
+  const __m256i scale = _mm256_slli_epi32(_mm256_sub_epi32(_mm256_set1_epi32(127), _mm256_cvtps_epi32(n)), 23);
+  return _mm256_mul_ps(p, _mm256_castsi256_ps(scale));
+}
 
 std::size_t first_best(const ModeScratch& m, std::size_t u) {
   std::size_t best = 0;
@@ -43,15 +73,12 @@ inline void add_unique(const ModeCandidates& c, std::size_t j, std::size_t found
     m.count[found] += 1.0f;
     return;
   }
-  float v[64];
-  c.copy(j, v);
-  m.unique.push(v);
+  m.unique.push(c, j);
   m.count.push_back(1.0f);
   m.first.push_back(std::uint32_t(j));
 }
 
 void start(const ModeCandidates& c, ModeScratch& m) {
-  if (c.channels() > 64) throw ValueError("the weighted mode takes at most 64 channels");
   m.unique.reset(c.channels(), c.size());
   m.count.clear(), m.first.clear();
 }
@@ -71,13 +98,13 @@ std::size_t mode_scalar(const ModeCandidates& c, float inv, ModeScratch& m) {
   const std::size_t u = m.unique.size();
   m.score.assign(m.count.begin(), m.count.end());
   for (std::size_t j = 0; j < u; ++j)
-    for (std::size_t k = j + 1; k < u; ++k) {
+    for (std::size_t k = j + 1; k < u; ++k) {  // each pair's kernel once, for both ends
       float d = 0.0f;
       for (int ch = 0; ch < channels; ++ch) {
         const float e = m.unique.plane(ch)[j] - m.unique.plane(ch)[k];
         d += e * e;
       }
-      const float kernel = kernel_of(d * inv);
+      const float kernel = mode_kernel(d * inv);
       m.score[j] += m.count[k] * kernel;
       m.score[k] += m.count[j] * kernel;
     }
@@ -103,36 +130,37 @@ std::size_t mode_scalar(const ModeCandidates& c, float inv, ModeScratch& m) {
     }
     add_unique(c, j, found, m);
   }
-  // The kernel of every pair, both ways (row j, column k), 0 on the diagonal.
-  const std::size_t u = m.unique.size(), row = round_up(u);
-  m.kernel.assign(u * row, 0.0f);
-  const __m256 scale = _mm256_set1_ps(inv);
-  alignas(32) float x[kLanes];
-  for (std::size_t j = 0; j < u; ++j)
-    for (std::size_t k = j + 1; k < u; k += kLanes) {
+  // Scores j .. j + 7 at once, each summed over k in ascending order; the
+  // kernel of (j, k) is that of (k, j) bit for bit (the same squares).
+  const std::size_t u = m.unique.size();
+  m.score.resize(round_up(u));
+  m.count.resize(round_up(u), 0.0f);
+  const __m256 scale = _mm256_set1_ps(inv), negligible = _mm256_set1_ps(kNegligible);
+  for (std::size_t b = 0; b < u; b += kLanes) {
+    const __m256i lane = _mm256_add_epi32(_mm256_set1_epi32(int(b)), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+    __m256 s = _mm256_loadu_ps(m.count.data() + b);
+    for (std::size_t k = 0; k < u; ++k) {
       __m256 d = _mm256_setzero_ps();
       for (int ch = 0; ch < channels; ++ch) {
         const __m256 e =
-            _mm256_sub_ps(_mm256_set1_ps(m.unique.plane(ch)[j]), _mm256_loadu_ps(m.unique.plane(ch) + k));
+            _mm256_sub_ps(_mm256_loadu_ps(m.unique.plane(ch) + b), _mm256_set1_ps(m.unique.plane(ch)[k]));
         d = _mm256_add_ps(d, _mm256_mul_ps(e, e));
       }
-      _mm256_store_ps(x, _mm256_mul_ps(d, scale));
-      for (std::size_t l = 0; l < kLanes && k + l < u; ++l)
-        m.kernel[j * row + k + l] = m.kernel[(k + l) * row + j] = kernel_of(x[l]);
+      const __m256 x = _mm256_mul_ps(d, scale);
+      const __m256 other = _mm256_castsi256_ps(
+          _mm256_xor_si256(_mm256_cmpeq_epi32(lane, _mm256_set1_epi32(int(k))), _mm256_set1_epi32(-1)));
+      const __m256 keep = _mm256_and_ps(_mm256_cmp_ps(x, negligible, _CMP_LE_OQ), other);
+      const __m256 kernel = _mm256_and_ps(exp_neg(_mm256_min_ps(x, negligible)), keep);
+      s = _mm256_add_ps(s, _mm256_mul_ps(_mm256_set1_ps(m.count[k]), kernel));
     }
-  // Eight scores at a time, each summed over k in ascending order.
-  m.score.resize(row);
-  m.count.resize(row, 0.0f);
-  for (std::size_t b = 0; b < u; b += kLanes) {
-    __m256 s = _mm256_loadu_ps(m.count.data() + b);
-    for (std::size_t k = 0; k < u; ++k)
-      s = _mm256_add_ps(s, _mm256_mul_ps(_mm256_set1_ps(m.count[k]), _mm256_loadu_ps(m.kernel.data() + k * row + b)));
     _mm256_storeu_ps(m.score.data() + b, s);
   }
   return first_best(m, u);
 }
 
 }  // namespace
+
+float mode_kernel(float x) { return x <= kNegligible ? exp_neg(x) : 0.0f; }
 
 void ModeCandidates::reset(int channels, std::size_t capacity) {
   channels_ = channels;

@@ -2,7 +2,8 @@
 // The weighted mode of a pixel's vote (OutputMode::Mode, Color Me Noisy
 // §3.2): of the colours that the patches covering the pixel bring along, the
 // one with the most similar others,
-//   score(j) = sum over k != j of exp(-|v_j - v_k|^2 / h^2),
+//   score(j) = sum over k != j of exp(-|v_j - v_k|^2 / h^2)
+// (exp: the engine's own, within about 2 float steps, the same on every CPU),
 // the first best in the order the candidates came.
 #include <cstddef>
 #include <cstdint>
@@ -21,6 +22,10 @@ class ModeCandidates {
   void clear() { n_ = 0; }
   void push(const float* value) {
     for (int ch = 0; ch < channels_; ++ch) planes_[std::size_t(ch) * stride_ + n_] = value[ch];
+    ++n_;
+  }
+  void push(const ModeCandidates& from, std::size_t j) {
+    for (int ch = 0; ch < channels_; ++ch) planes_[std::size_t(ch) * stride_ + n_] = from.plane(ch)[j];
     ++n_;
   }
   std::size_t size() const { return n_; }
@@ -43,6 +48,10 @@ struct ModeScratch {
   std::vector<float> count, score, kernel;
   std::vector<std::uint32_t> first;
 };
+
+// The kernel of two colours whose squared distance over h^2 is x: exp(-x),
+// or 0 where that is below half a float step of 1 (x > 17.5).
+float mode_kernel(float x);
 
 // Index (into `candidates`) of the weighted mode with kernel width `bandwidth`.
 // Every variant gives the same index: the same floats are summed in the same
