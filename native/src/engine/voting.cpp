@@ -21,17 +21,15 @@ struct Voter {
   const OffsetField& field;
 
   // The pixel that the patch of target q (centred at its match) puts at
-  // offset (dx, dy) from its centre.
-  void sample(std::size_t qi, int qx, int qy, int dx, int dy, float* out) const {
+  // offset (dx, dy) from its centre: the style's own pixel, or one sampled
+  // into `buffer` between pixels (rotated patches).
+  const float* sample(std::size_t qi, int qx, int qy, int dx, int dy, float* buffer) const {
     const int px = field.x[qi], py = field.y[qi], c = style.channels;
-    if (space.rotated()) {
-      float ox, oy;
-      rotate_offset(space.rotation(px, py, qx, qy), float(dx), float(dy), ox, oy);
-      sample_bilinear(style.data, style.width, style.height, c, c, px + ox, py + oy, out);
-    } else {
-      const float* s = style.pixel(px + dx, py + dy);
-      std::copy(s, s + c, out);
-    }
+    if (!space.rotated()) return style.pixel(px + dx, py + dy);
+    float ox, oy;
+    rotate_offset(space.rotation(px, py, qx, qy), float(dx), float(dy), ox, oy);
+    sample_bilinear(style.data, style.width, style.height, c, c, px + ox, py + oy, buffer);
+    return buffer;
   }
 };
 
@@ -113,11 +111,11 @@ Image vote(const ImageView& style, const PatchSpace& space, const SearchConstrai
       std::fill(sum.begin(), sum.end(), 0.0f);
       candidates.clear();
       const int count = for_each_covering_patch(field, voters, r, tx, ty, [&](std::size_t qi, int dx, int dy) {
-        voter.sample(qi, tx - dx, ty - dy, dx, dy, sample.data());
+        const float* v = voter.sample(qi, tx - dx, ty - dy, dx, dy, sample.data());
         if (params.mode == OutputMode::Mean)
-          for (int k = 0; k < c; ++k) sum[k] += sample[k];
+          for (int k = 0; k < c; ++k) sum[k] += v[k];
         else
-          candidates.push(sample.data());
+          candidates.push(v);
       });
       if (count == 0) continue;
       if (params.mode == OutputMode::Mean) {

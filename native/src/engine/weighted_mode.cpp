@@ -67,6 +67,12 @@ std::size_t first_best(const ModeScratch& m, std::size_t u) {
   return m.first[best];
 }
 
+inline bool same_colour(const ModeCandidates& c, std::size_t a, std::size_t b) {
+  for (int ch = 0; ch < c.channels(); ++ch)
+    if (!(c.plane(ch)[a] == c.plane(ch)[b])) return false;
+  return true;
+}
+
 // Appends candidate j of `c` to the unique colours, or counts it again.
 inline void add_unique(const ModeCandidates& c, std::size_t j, std::size_t found, ModeScratch& m) {
   if (found < m.unique.size()) {
@@ -114,7 +120,14 @@ std::size_t mode_scalar(const ModeCandidates& c, float inv, ModeScratch& m) {
 [[gnu::target("avx2")]] std::size_t mode_avx2(const ModeCandidates& c, float inv, ModeScratch& m) {
   start(c, m);
   const int channels = c.channels();
+  std::size_t previous = 0;  // the unique colour of candidate j - 1
   for (std::size_t j = 0; j < c.size(); ++j) {
+    // Along a coherent field, neighbouring patches bring the same source
+    // pixel one after the other: then the scan would find the same colour.
+    if (j > 0 && same_colour(c, j, j - 1)) {
+      m.count[previous] += 1.0f;
+      continue;
+    }
     std::size_t found = m.unique.size();
     for (std::size_t b = 0; b < m.unique.size(); b += kLanes) {
       __m256 equal = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
@@ -129,6 +142,7 @@ std::size_t mode_scalar(const ModeCandidates& c, float inv, ModeScratch& m) {
       }
     }
     add_unique(c, j, found, m);
+    previous = std::min(found, m.unique.size() - 1);
   }
   // Scores j .. j + 7 at once, each summed over k in ascending order; the
   // kernel of (j, k) is that of (k, j) bit for bit (the same squares).
