@@ -1,5 +1,7 @@
 #include "frame_loop.hpp"
 
+#include <malloc.h>
+
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -12,6 +14,19 @@ namespace {
 
 volatile std::sig_atomic_t g_interrupted = 0;
 void on_signal(int) { g_interrupted = 1; }
+
+// A frame's large images (stacked guides, pyramids, features: tens of MB at
+// 1 Mpix) are allocated and freed at every frame and level. glibc gives
+// blocks past its mmap threshold (which adapts up to 32 MB) fresh mappings,
+// which the kernel faults in and zeroes page by page at every use: a tenth of
+// the coherent method's CPU at 1 Mpix, more at larger frames. A run over
+// frames keeps them in its heap for reuse (docs/benchmarks.md, issue 32 step
+// 25). Not `tempera synth`: one still reuses little and would peak 15 MB
+// higher; nor the Python module, which leaves its host's allocator alone.
+void keep_large_blocks_for_reuse() {
+  mallopt(M_MMAP_THRESHOLD, 1 << 30);
+  mallopt(M_TRIM_THRESHOLD, 1 << 30);
+}
 
 }  // namespace
 
@@ -46,6 +61,7 @@ std::string clock_text(double seconds) {
 bool run_units(const std::vector<std::size_t>& units, std::size_t total,
                const std::function<FrameResult(std::size_t, const ProgressCallback&)>& run,
                std::vector<FrameResult>& results, const FrameLine& line) {
+  keep_large_blocks_for_reuse();
   double spent = 0;
   int made = 0;
   for (std::size_t k = 0; k < units.size(); ++k) {
