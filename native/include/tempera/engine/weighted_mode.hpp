@@ -30,7 +30,6 @@ class ModeCandidates {
   }
   std::size_t size() const { return n_; }
   int channels() const { return channels_; }
-  std::size_t stride() const { return stride_; }
   const float* plane(int ch) const { return planes_.data() + std::size_t(ch) * stride_; }
   void copy(std::size_t j, float* out) const {
     for (int ch = 0; ch < channels_; ++ch) out[ch] = plane(ch)[j];
@@ -45,7 +44,7 @@ class ModeCandidates {
 // A thread's working memory for weighted_mode (kept between pixels).
 struct ModeScratch {
   ModeCandidates unique;
-  std::vector<float> count, score, kernel;
+  std::vector<float> count, score;
   std::vector<std::uint32_t> first;
 };
 
