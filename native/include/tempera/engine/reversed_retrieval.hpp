@@ -217,7 +217,9 @@ class ReversedRetrieval {
     }
   }
 
-  void prefetch_target(int qx, int qy) const {
+  // Always inlined, as Matcher::prefetch (patchmatch.cpp): GCC deletes calls
+  // to a function that only prefetches.
+  [[gnu::always_inline]] inline void prefetch_target(int qx, int qy) const {
     if (qx < 0 || qy < 0 || qx >= tw_ || qy >= th_) return;
     __builtin_prefetch(&open_[std::size_t(qy) * tw_ + qx]);
     const int r = space_.radius;
