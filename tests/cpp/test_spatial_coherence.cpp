@@ -1,7 +1,7 @@
 // The spatial coherence term's neighbour sum (Bénard et al. 2013, eq. 5):
 // the AVX2 kernel equals the scalar one to the bit, both equal the sum
 // written out neighbour by neighbour, and both stop only once it reaches the
-// limit.
+// limit; sources no neighbour's match reaches need no sum.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -87,6 +87,60 @@ TEST(SpatialCoherence, KernelsAgreeToTheBitAndWithTheSumWrittenOut) {
           ++compared;
         }
     EXPECT_GT(compared, 50);
+  }
+}
+
+// coherence_reach(): both kernels give the same box and value, every source
+// outside the box sums to `outside` to the bit in both kernels, every implied source M(p + d) - d is inside it, and
+// the box is not the whole exemplar (most far sources are outside it).
+TEST(SpatialCoherence, SourcesOutsideTheReachSumToTheCappedValue) {
+  const Field f = random_field(40, 30, 7);
+  for (int r : {1, 2, 4}) {
+    const std::vector<float> window = gaussian_window(r);
+    for (const float r_max2 : {9.0f, 6.25f, 2.0f, 0.0f}) {
+      int outside = 0, inside = 0;
+      for (int ty = 0; ty < f.height; ty += 3)
+        for (int tx = 0; tx < f.width; tx += 2) {
+          CoherencePatch p{f.x.data(), f.y.data(), f.matched.data(), std::size_t(f.width)};
+          p.row0 = std::max(0, r - ty), p.row1 = std::min(2 * r, r + f.height - 1 - ty);
+          p.col0 = std::max(0, r - tx), p.col1 = std::min(2 * r, r + f.width - 1 - tx);
+          p.first = std::size_t(ty - r + p.row0) * f.width + std::size_t(tx - r + p.col0);
+          p.window = window.data(), p.radius = r, p.r_max2 = r_max2;
+          const PairCostBox box = coherence_reach(p, FixedKernel::Scalar);
+          if (fixed_kernel_supported(FixedKernel::Avx2)) {
+            const PairCostBox vector = coherence_reach(p, FixedKernel::Avx2);
+            ASSERT_EQ(box.outside, vector.outside);
+            ASSERT_TRUE(box.x0 == vector.x0 && box.x1 == vector.x1 && box.y0 == vector.y0 && box.y1 == vector.y1);
+          }
+          for (int dy = -r; dy <= r; ++dy)
+            for (int dx = -r; dx <= r; ++dx) {
+              const int nx = tx + dx, ny = ty + dy;
+              if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= f.width || ny >= f.height) continue;
+              const std::size_t i = std::size_t(ny) * f.width + nx;
+              if (f.matched[i] && r_max2 > 0) {
+                ASSERT_TRUE(box.contains(f.x[i] - dx, f.y[i] - dy));
+              }
+            }
+          for (int sy = ty + 3 - 9; sy <= ty + 3 + 9; sy += 3)
+            for (int sx = tx + 7 - 240; sx <= tx + 7 + 240; sx += 5) {
+              p.source_x = sx, p.source_y = sy;
+              if (box.contains(sx, sy)) {
+                ++inside;
+                continue;
+              }
+              ++outside;
+              for (const FixedKernel k : {FixedKernel::Scalar, FixedKernel::Avx2}) {
+                if (fixed_kernel_supported(k)) {
+                  ASSERT_EQ(box.outside, coherence_patch_sum(p, kInf, k));
+                }
+              }
+            }
+        }
+      EXPECT_GT(outside, 2 * inside) << r << " " << r_max2;
+      if (r_max2 > 0) {
+        EXPECT_GT(inside, 0) << r << " " << r_max2;
+      }
+    }
   }
 }
 

@@ -7,6 +7,8 @@
 #include <immintrin.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <cstring>
 
 #include "tempera/engine/energy_term.hpp"
@@ -96,27 +98,107 @@ float patch_sum_scalar(const CoherencePatch& p, float limit) {
   return lane_sum(lanes);
 }
 
+// The box of the counted neighbours' implied sources M(p + d) - d
+// (inclusive; x0 > x1 when none counts) and the sum with every neighbour
+// capped, which the kernels above give any source no neighbour reaches.
+struct Reach {
+  int x0 = std::numeric_limits<int>::max(), y0 = x0, x1 = std::numeric_limits<int>::min(), y1 = x1;
+  float capped = 0.0f;
+};
+
+Reach reach_scalar(const CoherencePatch& p) {
+  Reach q;
+  for (int row = p.row0; row <= p.row1; ++row) {
+    const std::size_t at = p.first + std::size_t(row - p.row0) * p.pitch - std::size_t(p.col0);  // column 0's index
+    for (int k = p.col0; k <= p.col1; ++k) {
+      if (!p.matched[at + k] || (row == p.radius && k == p.radius)) continue;
+      const int qx = p.x[at + k] - (k - p.radius), qy = p.y[at + k] - (row - p.radius);
+      q.x0 = std::min(q.x0, qx), q.x1 = std::max(q.x1, qx), q.y0 = std::min(q.y0, qy), q.y1 = std::max(q.y1, qy);
+    }
+  }
+  CoherencePatch far = p;  // a source beyond r_max of every implied one, if any: every term capped
+  const float reach = std::sqrt(std::max(p.r_max2, 0.0f)) + 1.0f;
+  far.source_x = q.x0 > q.x1 ? 0 : q.x0 - int(reach), far.source_y = q.x0 > q.x1 ? 0 : q.y0 - int(reach);
+  q.capped = patch_sum_scalar(far, kInf);
+  return q;
+}
+
+// One pass: the box by lane-wise min and max, and the capped sum as the
+// kernels add it (window * r_max^2 for the counted lanes, 0 for the others).
+[[gnu::target("avx2")]] Reach reach_avx2(const CoherencePatch& p) {
+  const int side = 2 * p.radius + 1;
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m256i big = _mm256_set1_epi32(std::numeric_limits<int>::max());
+  const __m256i small = _mm256_set1_epi32(std::numeric_limits<int>::min());
+  const __m256 r_max2 = _mm256_set1_ps(p.r_max2);
+  __m256i x0 = big, y0 = big, x1 = small, y1 = small;
+  __m256 acc = _mm256_setzero_ps();
+  for (int row = p.row0; row <= p.row1; ++row) {
+    const std::size_t at = p.first + std::size_t(row - p.row0) * p.pitch;  // column col0's index
+    const __m256i dy = _mm256_set1_epi32(row - p.radius);
+    for (int i = p.col0; i <= p.col1; i += kLanes) {
+      const int n = std::min(kLanes, p.col1 - i + 1);
+      const std::size_t from = at + std::size_t(i - p.col0);
+      const __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32(n), lane);
+      const __m256i mx = _mm256_maskload_epi32(p.x + from, live);
+      const __m256i my = _mm256_maskload_epi32(p.y + from, live);
+      const __m256 window = _mm256_maskload_ps(p.window + row * side + i, live);
+      const __m256i flags = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(std::int64_t(matched_bytes(p.matched + from, n))));
+      __m256i keep = _mm256_cmpgt_epi32(flags, _mm256_setzero_si256());
+      if (row == p.radius)  // the centre is not its own neighbour
+        keep = _mm256_andnot_si256(_mm256_cmpeq_epi32(lane, _mm256_set1_epi32(p.radius - i)), keep);
+      const __m256i qx = _mm256_sub_epi32(mx, _mm256_add_epi32(_mm256_set1_epi32(i - p.radius), lane));
+      const __m256i qy = _mm256_sub_epi32(my, dy);
+      x0 = _mm256_min_epi32(x0, _mm256_blendv_epi8(big, qx, keep));
+      y0 = _mm256_min_epi32(y0, _mm256_blendv_epi8(big, qy, keep));
+      x1 = _mm256_max_epi32(x1, _mm256_blendv_epi8(small, qx, keep));
+      y1 = _mm256_max_epi32(y1, _mm256_blendv_epi8(small, qy, keep));
+      acc = _mm256_add_ps(acc, _mm256_mul_ps(_mm256_and_ps(window, _mm256_castsi256_ps(keep)), r_max2));
+    }
+  }
+  alignas(32) float lanes[kLanes];
+  alignas(32) std::int32_t a[kLanes], b[kLanes], c[kLanes], d[kLanes];
+  _mm256_store_ps(lanes, acc);
+  _mm256_store_si256(reinterpret_cast<__m256i*>(a), x0), _mm256_store_si256(reinterpret_cast<__m256i*>(b), y0);
+  _mm256_store_si256(reinterpret_cast<__m256i*>(c), x1), _mm256_store_si256(reinterpret_cast<__m256i*>(d), y1);
+  Reach q;
+  for (int j = 0; j < kLanes; ++j)
+    q.x0 = std::min(q.x0, a[j]), q.y0 = std::min(q.y0, b[j]), q.x1 = std::max(q.x1, c[j]), q.y1 = std::max(q.y1, d[j]);
+  q.capped = lane_sum(lanes);
+  return q;
+}
+
 class SpatialCoherence final : public EnergyTerm {
  public:
   SpatialCoherence(float weight, float r_max) : weight_(weight), r_max2_(r_max * r_max) {}
   const char* name() const override { return "spatial_coherence"; }
   bool reads_field() const override { return true; }
-  float pair_cost(const LevelContext& c, const OffsetField& field, int tx, int ty, int sx, int sy,
-                  float limit) const override {
-    const PatchSpace& s = *c.space;
-    const int r = s.radius;
-    if (s.window && !s.rotated()) {
-      CoherencePatch p{field.x.data(), field.y.data(), c.constraints->matched().data(), std::size_t(field.width)};
-      p.row0 = std::max(0, r - ty), p.row1 = std::min(2 * r, r + field.height - 1 - ty);
-      p.col0 = std::max(0, r - tx), p.col1 = std::min(2 * r, r + field.width - 1 - tx);
-      p.first = field.index(tx - r + p.col0, ty - r + p.row0);
-      p.window = s.window, p.radius = r, p.source_x = sx, p.source_y = sy, p.r_max2 = r_max2_;
-      return weight_ * coherence_patch_sum(p, limit / weight_);
-    }
-    return weight_ * general_sum(c, field, tx, ty, sx, sy);
+  void prepare_target(const LevelContext& c, const OffsetField& field, int tx, int ty,
+                      PairCostBox& box) const override {
+    if (windowed(c)) box = coherence_reach(patch(c, field, tx, ty, 0, 0));
+  }
+  float pair_cost(const LevelContext& c, const OffsetField& field, const PairCostBox& box, int tx, int ty, int sx,
+                  int sy, float limit) const override {
+    if (!windowed(c)) return weight_ * general_sum(c, field, tx, ty, sx, sy);
+    // As coherence_patch_sum() ends for a sum of `box.outside`: infinity once it reaches the limit.
+    if (!box.contains(sx, sy)) return box.outside >= limit / weight_ ? kInf : weight_ * box.outside;
+    return weight_ * coherence_patch_sum(patch(c, field, tx, ty, sx, sy), limit / weight_);
   }
 
  private:
+  static bool windowed(const LevelContext& c) { return c.space->window && !c.space->rotated(); }
+
+  // Target (tx, ty)'s window clipped to the field, for source (sx, sy).
+  CoherencePatch patch(const LevelContext& c, const OffsetField& field, int tx, int ty, int sx, int sy) const {
+    const int r = c.space->radius;
+    CoherencePatch p{field.x.data(), field.y.data(), c.constraints->matched().data(), std::size_t(field.width)};
+    p.row0 = std::max(0, r - ty), p.row1 = std::min(2 * r, r + field.height - 1 - ty);
+    p.col0 = std::max(0, r - tx), p.col1 = std::min(2 * r, r + field.width - 1 - tx);
+    p.first = field.index(tx - r + p.col0, ty - r + p.row0);
+    p.window = c.space->window, p.radius = r, p.source_x = sx, p.source_y = sy, p.r_max2 = r_max2_;
+    return p;
+  }
+
   // Rotated patches, or patches without a window, one neighbour at a time.
   float general_sum(const LevelContext& c, const OffsetField& field, int tx, int ty, int sx, int sy) const {
     const PatchSpace& s = *c.space;
@@ -150,6 +232,25 @@ float coherence_patch_sum(const CoherencePatch& patch, float limit, FixedKernel 
   static const bool avx2 = fixed_kernel_supported(FixedKernel::Avx2);
   if (kernel == FixedKernel::Avx2 || (kernel == FixedKernel::Best && avx2)) return patch_sum_avx2(patch, limit);
   return patch_sum_scalar(patch, limit);
+}
+
+PairCostBox coherence_reach(const CoherencePatch& p, FixedKernel kernel) {
+  static const bool avx2 = fixed_kernel_supported(FixedKernel::Avx2);
+  const Reach q = kernel == FixedKernel::Avx2 || (kernel == FixedKernel::Best && avx2) ? reach_avx2(p) : reach_scalar(p);
+  PairCostBox box;
+  box.outside = q.capped;
+  if (q.x0 > q.x1) {  // no neighbour counts: every source sums to nothing
+    box.x0 = box.y0 = 1, box.x1 = box.y1 = 0;
+    return box;
+  }
+  // t: the least whole distance whose square reaches the cap, so a source t
+  // or more columns (or rows) from every implied source is capped (ex * ex
+  // >= t * t >= r_max^2 in float, and adding ey * ey cannot lower it).
+  int t = int(std::ceil(std::sqrt(std::max(p.r_max2, 0.0f))));
+  while (float(t) * float(t) < p.r_max2) ++t;
+  while (t > 0 && float(t - 1) * float(t - 1) >= p.r_max2) --t;
+  box.x0 = q.x0 - t + 1, box.x1 = q.x1 + t - 1, box.y0 = q.y0 - t + 1, box.y1 = q.y1 + t - 1;
+  return box;
 }
 
 std::shared_ptr<const EnergyTerm> make_spatial_coherence(float weight, float r_max) {

@@ -12,6 +12,7 @@
 //  - reassign matches after each search (reversed retrieval: uniform usage,
 //    StyLit's error budget).
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -43,6 +44,16 @@ struct UsageStats {
   std::size_t wide_searches = 0;  // sources seeded at random, searched over the whole frame
 };
 
+// Sources (sx, sy) with x0 <= sx <= x1 and y0 <= sy <= y1 need a term's
+// pair_cost() summed; any other costs the term `outside` (before its weight
+// and limit). Bénard's coherence: sources that no neighbour's match reaches.
+struct PairCostBox {
+  int x0 = std::numeric_limits<int>::min(), y0 = std::numeric_limits<int>::min();
+  int x1 = std::numeric_limits<int>::max(), y1 = std::numeric_limits<int>::max();
+  float outside = 0.0f;
+  bool contains(int sx, int sy) const { return sx >= x0 && sx <= x1 && sy >= y0 && sy <= y1; }
+};
+
 // What a term keeps across the EM iterations of one level solve (terms
 // themselves are immutable and shared).
 struct TermState {
@@ -63,11 +74,18 @@ class EnergyTerm {
   virtual bool refresh_each_iteration() const { return false; }
   // Whether pair_cost() is used.
   virtual bool reads_field() const { return false; }
+  // What pair_cost() of target (tx, ty) may reuse across that target's
+  // candidates, computed once before they are tried (the field a sweep reads
+  // does not change meanwhile): a box of sources outside which the term's
+  // cost is one value. The default box holds every source (nothing reused).
+  virtual void prepare_target(const LevelContext&, const OffsetField&, int /*tx*/, int /*ty*/,
+                              PairCostBox& /*box*/) const {}
   // Extra cost of matching target (tx, ty) to source (sx, sy), given the
-  // field at the start of the sweep. A term may stop once the cost reaches
-  // `limit` (the candidate is rejected then) and return infinity instead.
-  virtual float pair_cost(const LevelContext&, const OffsetField&, int /*tx*/, int /*ty*/, int /*sx*/, int /*sy*/,
-                          float /*limit*/) const {
+  // field at the start of the sweep and the target's prepared box. A term may
+  // stop once the cost reaches `limit` (the candidate is rejected then) and
+  // return infinity instead.
+  virtual float pair_cost(const LevelContext&, const OffsetField&, const PairCostBox& /*box*/, int /*tx*/,
+                          int /*ty*/, int /*sx*/, int /*sy*/, float /*limit*/) const {
     return 0.0f;
   }
   // May rewrite matches after a search.

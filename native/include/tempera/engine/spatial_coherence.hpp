@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "tempera/engine/energy_term.hpp"     // PairCostBox
 #include "tempera/engine/patch_distance.hpp"  // FixedKernel
 
 namespace tempera {
@@ -33,5 +34,13 @@ struct CoherencePatch {
 // cannot lower it). Kernel Best picks AVX2 where the CPU has it, else Scalar.
 float coherence_patch_sum(const CoherencePatch& patch, float limit = std::numeric_limits<float>::infinity(),
                           FixedKernel kernel = FixedKernel::Best);
+
+// The sources a counted neighbour's match reaches: neighbour p + d matched to
+// M implies the source M - d for p; within r_max of one of those, its term
+// is below the cap. The box holds them all, widened by r_max; for any source
+// outside it every neighbour is capped, and coherence_patch_sum() is
+// `outside` to the bit (the same products added in the same order), so most
+// random-search candidates need no sum. `patch.source_x/y` are not read.
+PairCostBox coherence_reach(const CoherencePatch& patch, FixedKernel kernel = FixedKernel::Best);
 
 }  // namespace tempera

@@ -64,7 +64,8 @@ class DirectionTerm final : public EnergyTerm {
   explicit DirectionTerm(float weight) : weight_(weight) {}
   const char* name() const override { return "direction"; }
   bool reads_field() const override { return true; }
-  float pair_cost(const LevelContext& c, const OffsetField&, int tx, int ty, int sx, int sy, float) const override {
+  float pair_cost(const LevelContext& c, const OffsetField&, const PairCostBox&, int tx, int ty, int sx, int sy,
+                  float) const override {
     const PatchSpace& s = *c.space;
     if (!s.source_angle || !s.target_angle) return 0.0f;
     const int tw = s.target->width, th = s.target->height, sw = s.source->width, sh = s.source->height;
