@@ -117,6 +117,61 @@ std::size_t mode_scalar(const ModeCandidates& c, float inv, ModeScratch& m) {
   return first_best(m, u);
 }
 
+// The 8 x 8 floats at `from` (rows `pitch` apart), transposed to `to`.
+[[gnu::target("avx2")]] void transpose8(const float* from, float* to, std::size_t pitch) {
+  __m256 r[8], t[8], q[8];
+  for (int i = 0; i < 8; ++i) r[i] = _mm256_loadu_ps(from + std::size_t(i) * pitch);
+  for (int i = 0; i < 8; i += 2) {  // t[i], t[i + 1]: rows i, i + 1 interleaved
+    t[i] = _mm256_unpacklo_ps(r[i], r[i + 1]);
+    t[i + 1] = _mm256_unpackhi_ps(r[i], r[i + 1]);
+  }
+  for (int i = 0; i < 8; i += 4) {  // q: four rows' values of one column per 128-bit half
+    q[i] = _mm256_shuffle_ps(t[i], t[i + 2], 0x44);
+    q[i + 1] = _mm256_shuffle_ps(t[i], t[i + 2], 0xEE);
+    q[i + 2] = _mm256_shuffle_ps(t[i + 1], t[i + 3], 0x44);
+    q[i + 3] = _mm256_shuffle_ps(t[i + 1], t[i + 3], 0xEE);
+  }
+  for (int i = 0; i < 4; ++i) {
+    _mm256_storeu_ps(to + std::size_t(i) * pitch, _mm256_permute2f128_ps(q[i], q[i + 4], 0x20));
+    _mm256_storeu_ps(to + std::size_t(i + 4) * pitch, _mm256_permute2f128_ps(q[i], q[i + 4], 0x31));
+  }
+}
+
+// m.kernel[k * w + j] = the kernel of colours j and k (0 for j = k and where
+// negligible), w = u rounded up to 8. Eight j at a time for each k >= j's
+// block; the blocks of 8 x 8 above those are the transposes of their mirrors
+// (the kernel of (j, k) is that of (k, j) bit for bit: the same squares), so
+// a pair's exp is evaluated once but within the diagonal's blocks.
+[[gnu::target("avx2")]] void pair_kernels(ModeScratch& m, float inv) {
+  const std::size_t u = m.unique.size(), w = round_up(u);
+  const int channels = m.unique.channels();
+  m.kernel.resize(w * w);
+  const __m256 scale = _mm256_set1_ps(inv), negligible = _mm256_set1_ps(kNegligible);
+  for (std::size_t b = 0; b < u; b += kLanes) {
+    const __m256i lane = _mm256_add_epi32(_mm256_set1_epi32(int(b)), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+    for (std::size_t k = 0; k < u; ++k) {
+      if (k < b) continue;  // a block above the diagonal: the mirror's transpose
+      __m256 d = _mm256_setzero_ps();
+      for (int ch = 0; ch < channels; ++ch) {
+        const __m256 e =
+            _mm256_sub_ps(_mm256_loadu_ps(m.unique.plane(ch) + b), _mm256_set1_ps(m.unique.plane(ch)[k]));
+        d = _mm256_add_ps(d, _mm256_mul_ps(e, e));
+      }
+      const __m256 x = _mm256_mul_ps(d, scale);
+      const __m256 other = _mm256_castsi256_ps(
+          _mm256_xor_si256(_mm256_cmpeq_epi32(lane, _mm256_set1_epi32(int(k))), _mm256_set1_epi32(-1)));
+      const __m256 keep = _mm256_and_ps(_mm256_cmp_ps(x, negligible, _CMP_LE_OQ), other);
+      _mm256_storeu_ps(m.kernel.data() + k * w + b, _mm256_and_ps(exp_neg(_mm256_min_ps(x, negligible)), keep));
+    }
+  }
+  // Rows c..c+7 of a later block column b from rows b..b+7 of block column c
+  // (rows from u on are not computed: they land in lanes from u on, whose
+  // scores are never read).
+  for (std::size_t c = 0; c < u; c += kLanes)
+    for (std::size_t b = c + kLanes; b < u; b += kLanes)
+      transpose8(m.kernel.data() + b * w + c, m.kernel.data() + c * w + b, w);
+}
+
 [[gnu::target("avx2")]] std::size_t mode_avx2(const ModeCandidates& c, float inv, ModeScratch& m) {
   start(c, m);
   const int channels = c.channels();
@@ -144,29 +199,16 @@ std::size_t mode_scalar(const ModeCandidates& c, float inv, ModeScratch& m) {
     add_unique(c, j, found, m);
     previous = std::min(found, m.unique.size() - 1);
   }
-  // Scores j .. j + 7 at once, each summed over k in ascending order; the
-  // kernel of (j, k) is that of (k, j) bit for bit (the same squares).
-  const std::size_t u = m.unique.size();
-  m.score.resize(round_up(u));
-  m.count.resize(round_up(u), 0.0f);
-  const __m256 scale = _mm256_set1_ps(inv), negligible = _mm256_set1_ps(kNegligible);
+  // Scores j .. j + 7 at once, each summed over k in ascending order, from
+  // the pair kernels (pair_kernels above).
+  const std::size_t u = m.unique.size(), w = round_up(u);
+  m.score.resize(w);
+  m.count.resize(w, 0.0f);
+  pair_kernels(m, inv);
   for (std::size_t b = 0; b < u; b += kLanes) {
-    const __m256i lane = _mm256_add_epi32(_mm256_set1_epi32(int(b)), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
     __m256 s = _mm256_loadu_ps(m.count.data() + b);
-    for (std::size_t k = 0; k < u; ++k) {
-      __m256 d = _mm256_setzero_ps();
-      for (int ch = 0; ch < channels; ++ch) {
-        const __m256 e =
-            _mm256_sub_ps(_mm256_loadu_ps(m.unique.plane(ch) + b), _mm256_set1_ps(m.unique.plane(ch)[k]));
-        d = _mm256_add_ps(d, _mm256_mul_ps(e, e));
-      }
-      const __m256 x = _mm256_mul_ps(d, scale);
-      const __m256 other = _mm256_castsi256_ps(
-          _mm256_xor_si256(_mm256_cmpeq_epi32(lane, _mm256_set1_epi32(int(k))), _mm256_set1_epi32(-1)));
-      const __m256 keep = _mm256_and_ps(_mm256_cmp_ps(x, negligible, _CMP_LE_OQ), other);
-      const __m256 kernel = _mm256_and_ps(exp_neg(_mm256_min_ps(x, negligible)), keep);
-      s = _mm256_add_ps(s, _mm256_mul_ps(_mm256_set1_ps(m.count[k]), kernel));
-    }
+    for (std::size_t k = 0; k < u; ++k)
+      s = _mm256_add_ps(s, _mm256_mul_ps(_mm256_set1_ps(m.count[k]), _mm256_loadu_ps(m.kernel.data() + k * w + b)));
     _mm256_storeu_ps(m.score.data() + b, s);
   }
   return first_best(m, u);

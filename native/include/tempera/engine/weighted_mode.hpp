@@ -46,6 +46,7 @@ struct ModeScratch {
   ModeCandidates unique;
   std::vector<float> count, score;
   std::vector<std::uint32_t> first;
+  std::vector<float> kernel;  // the AVX2 variant's pair kernels, a row of 8-aligned columns per colour
 };
 
 // The kernel of two colours whose squared distance over h^2 is x: exp(-x),
