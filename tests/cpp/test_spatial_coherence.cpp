@@ -144,5 +144,40 @@ TEST(SpatialCoherence, SourcesOutsideTheReachSumToTheCappedValue) {
   }
 }
 
+// coherence_reach_row(): each target's box holds coherence_reach()'s (it may
+// be wider, never narrower) and its `outside` is the same to the bit, inside
+// the field, at its borders and around unmatched pixels.
+TEST(SpatialCoherence, TheRowsBoxesHoldEachTargetsReach) {
+  for (const unsigned seed : {3u, 11u}) {
+    Field f = random_field(37, 23, seed);
+    if (seed == 11u) std::fill(f.matched.begin(), f.matched.end(), std::uint8_t(1));  // every window whole
+    for (int r : {1, 2, 4}) {
+      const std::vector<float> window = gaussian_window(r);
+      const CoherenceField field{f.x.data(), f.y.data(), f.matched.data(), f.width, f.height, window.data(), r, 9.0f};
+      std::vector<PairCostBox> row(std::size_t(f.width));
+      int wider = 0;
+      for (int ty = 0; ty < f.height; ++ty) {
+        coherence_reach_row(field, ty, row.data());
+        for (int tx = 0; tx < f.width; ++tx) {
+          CoherencePatch p{f.x.data(), f.y.data(), f.matched.data(), std::size_t(f.width)};
+          p.row0 = std::max(0, r - ty), p.row1 = std::min(2 * r, r + f.height - 1 - ty);
+          p.col0 = std::max(0, r - tx), p.col1 = std::min(2 * r, r + f.width - 1 - tx);
+          p.first = std::size_t(ty - r + p.row0) * f.width + std::size_t(tx - r + p.col0);
+          p.window = window.data(), p.radius = r, p.r_max2 = 9.0f;
+          const PairCostBox exact = coherence_reach(p), got = row[std::size_t(tx)];
+          ASSERT_EQ(exact.outside, got.outside) << seed << " " << r << " " << tx << " " << ty;
+          if (exact.x0 > exact.x1) continue;  // no neighbour counts: nothing to hold
+          ASSERT_TRUE(got.x0 <= exact.x0 && got.x1 >= exact.x1 && got.y0 <= exact.y0 && got.y1 >= exact.y1)
+              << seed << " " << r << " " << tx << " " << ty;
+          wider += got.x0 < exact.x0 || got.x1 > exact.x1 || got.y0 < exact.y0 || got.y1 > exact.y1;
+        }
+      }
+      if (seed == 11u) {
+        EXPECT_GT(wider, 0) << r;  // the row's own boxes were taken (they count the centre)
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace tempera

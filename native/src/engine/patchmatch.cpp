@@ -50,11 +50,13 @@ struct Matcher {
       : space(s), cons(c), params(p), snapshot(snap), sw(s.source->width), sh(s.source->height),
         margin(s.source_margin()) {}
 
-  // Each field term's box for target (tx, ty), into `boxes`.
-  void prepare_target(int tx, int ty, std::vector<PairCostBox>& boxes) const {
-    boxes.assign(params.field_terms.size(), PairCostBox{});
-    for (std::size_t k = 0; k < boxes.size(); ++k)
-      params.field_terms[k]->prepare_target(*params.context, *snapshot, tx, ty, boxes[k]);
+  // Each field term's boxes for row ty: term k's box of target tx at
+  // row_boxes[k * width + tx].
+  void prepare_row(int ty, std::vector<PairCostBox>& row_boxes) const {
+    const std::size_t width = std::size_t(snapshot->width);
+    row_boxes.assign(params.field_terms.size() * width, PairCostBox{});
+    for (std::size_t k = 0; k < params.field_terms.size(); ++k)
+      params.field_terms[k]->prepare_row(*params.context, *snapshot, ty, row_boxes.data() + k * width);
   }
 
   // The field terms' cost, or infinity once it reaches `limit`.
@@ -214,9 +216,10 @@ void patchmatch(const PatchSpace& space, const SearchConstraints& cons, OffsetFi
     parallel_for(bands, params.threads, [&](int band) {
       const int y0 = band * params.band_rows, y1 = std::min(th, y0 + params.band_rows);
       Rng rng(params.seed, mix64(stream * 1000003ull + iter) ^ std::uint64_t(band));
-      std::vector<PairCostBox> boxes;
+      std::vector<PairCostBox> row_boxes, boxes(params.field_terms.size());
       for (int row = 0; row < y1 - y0; ++row) {
         const int ty = forward ? y0 + row : y1 - 1 - row;
+        if (!params.field_terms.empty()) m.prepare_row(ty, row_boxes);
         for (int col = 0; col < tw; ++col) {
           const int tx = forward ? col : tw - 1 - col;
           const std::size_t i = field.index(tx, ty);
@@ -225,7 +228,7 @@ void patchmatch(const PatchSpace& space, const SearchConstraints& cons, OffsetFi
           Best b{field.x[i], field.y[i], field.rx[i], field.ry[i], field.dist[i], 0.0f};
           b.cost = b.dist + cons.cost(std::size_t(b.y) * m.sw + b.x);
           if (!params.field_terms.empty()) {
-            m.prepare_target(tx, ty, boxes);
+            for (std::size_t k = 0; k < boxes.size(); ++k) boxes[k] = row_boxes[k * std::size_t(tw) + tx];
             b.cost += m.field_cost(boxes, tx, ty, b.x, b.y);
           }
           // Propagation from the neighbours already visited in this sweep.

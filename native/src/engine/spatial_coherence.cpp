@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 #include <cstring>
+#include <vector>
 
 #include "tempera/engine/energy_term.hpp"
 #include "tempera/engine/patchmatch.hpp"
@@ -173,9 +174,11 @@ class SpatialCoherence final : public EnergyTerm {
   SpatialCoherence(float weight, float r_max) : weight_(weight), r_max2_(r_max * r_max) {}
   const char* name() const override { return "spatial_coherence"; }
   bool reads_field() const override { return true; }
-  void prepare_target(const LevelContext& c, const OffsetField& field, int tx, int ty,
-                      PairCostBox& box) const override {
-    if (windowed(c)) box = coherence_reach(patch(c, field, tx, ty, 0, 0));
+  void prepare_row(const LevelContext& c, const OffsetField& field, int ty, PairCostBox* boxes) const override {
+    if (!windowed(c)) return;
+    const CoherenceField f{field.x.data(), field.y.data(), c.constraints->matched().data(), field.width,
+                           field.height, c.space->window, c.space->radius, r_max2_};
+    coherence_reach_row(f, ty, boxes);
   }
   float pair_cost(const LevelContext& c, const OffsetField& field, const PairCostBox& box, int tx, int ty, int sx,
                   int sy, float limit) const override {
@@ -234,6 +237,16 @@ float coherence_patch_sum(const CoherencePatch& patch, float limit, FixedKernel 
   return patch_sum_scalar(patch, limit);
 }
 
+// t: the least whole distance whose square reaches the cap, so a source t
+// or more columns (or rows) from every implied source is capped (ex * ex
+// >= t * t >= r_max^2 in float, and adding ey * ey cannot lower it).
+int capped_distance(float r_max2) {
+  int t = int(std::ceil(std::sqrt(std::max(r_max2, 0.0f))));
+  while (float(t) * float(t) < r_max2) ++t;
+  while (t > 0 && float(t - 1) * float(t - 1) >= r_max2) --t;
+  return t;
+}
+
 PairCostBox coherence_reach(const CoherencePatch& p, FixedKernel kernel) {
   static const bool avx2 = fixed_kernel_supported(FixedKernel::Avx2);
   const Reach q = kernel == FixedKernel::Avx2 || (kernel == FixedKernel::Best && avx2) ? reach_avx2(p) : reach_scalar(p);
@@ -243,14 +256,80 @@ PairCostBox coherence_reach(const CoherencePatch& p, FixedKernel kernel) {
     box.x0 = box.y0 = 1, box.x1 = box.y1 = 0;
     return box;
   }
-  // t: the least whole distance whose square reaches the cap, so a source t
-  // or more columns (or rows) from every implied source is capped (ex * ex
-  // >= t * t >= r_max^2 in float, and adding ey * ey cannot lower it).
-  int t = int(std::ceil(std::sqrt(std::max(p.r_max2, 0.0f))));
-  while (float(t) * float(t) < p.r_max2) ++t;
-  while (t > 0 && float(t - 1) * float(t - 1) >= p.r_max2) --t;
+  const int t = capped_distance(p.r_max2);
   box.x0 = q.x0 - t + 1, box.x1 = q.x1 + t - 1, box.y0 = q.y0 - t + 1, box.y1 = q.y1 + t - 1;
   return box;
+}
+
+namespace {
+
+// The capped sum of a whole window whose neighbours all count: that of every
+// target inside the field whose window is all matched (the same products
+// in the same lanes whatever the matches).
+float full_window_capped(const CoherenceField& f) {
+  const int side = 2 * f.radius + 1;
+  const std::vector<std::int32_t> zero(std::size_t(side) * side, 0);
+  const std::vector<std::uint8_t> all(std::size_t(side) * side, 1);
+  CoherencePatch p{zero.data(), zero.data(), all.data(), std::size_t(side)};
+  p.row0 = p.col0 = 0, p.row1 = p.col1 = side - 1;
+  p.window = f.window, p.radius = f.radius, p.r_max2 = f.r_max2;
+  return coherence_reach(p).outside;
+}
+
+}  // namespace
+
+void coherence_reach_row(const CoherenceField& f, int ty, PairCostBox* boxes) {
+  const int r = f.radius, w = f.width, side = 2 * r + 1;
+  const int y0 = std::max(0, ty - r), y1 = std::min(f.height - 1, ty + r);
+  constexpr int kBig = std::numeric_limits<int>::max(), kSmall = std::numeric_limits<int>::min();
+  // Per column x (at x + r: r columns of padding either side), over the
+  // window's rows: the offsets' minima and maxima among matched pixels and
+  // how many are matched; then the same over each target's 2r + 1 columns.
+  const std::size_t n = std::size_t(w) + 2 * r;
+  thread_local std::vector<int> scratch;
+  scratch.resize(10 * n);
+  int *lx = scratch.data(), *hx = lx + n, *ly = hx + n, *hy = ly + n, *count = hy + n;
+  int *wlx = count + n, *whx = wlx + n, *wly = whx + n, *why = wly + n, *wcount = why + n;
+  std::fill_n(lx, n, kBig), std::fill_n(hx, n, kSmall), std::fill_n(ly, n, kBig), std::fill_n(hy, n, kSmall);
+  std::fill_n(count, n, 0);
+  for (int y = y0; y <= y1; ++y) {
+    const std::size_t row = std::size_t(y) * w;
+    const std::int32_t *mx = f.x + row, *my = f.y + row;
+    const std::uint8_t* m = f.matched + row;
+    for (int x = 0; x < w; ++x) {
+      const int ox = mx[x] - x, oy = my[x] - y, k = x + r;
+      const bool on = m[x] != 0;
+      lx[k] = on ? std::min(lx[k], ox) : lx[k], hx[k] = on ? std::max(hx[k], ox) : hx[k];
+      ly[k] = on ? std::min(ly[k], oy) : ly[k], hy[k] = on ? std::max(hy[k], oy) : hy[k];
+      count[k] += on;
+    }
+  }
+  std::copy_n(lx, w, wlx), std::copy_n(hx, w, whx), std::copy_n(ly, w, wly), std::copy_n(hy, w, why);
+  std::copy_n(count, w, wcount);
+  for (int c = 1; c < side; ++c)
+    for (int x = 0; x < w; ++x) {
+      wlx[x] = std::min(wlx[x], lx[x + c]), whx[x] = std::max(whx[x], hx[x + c]);
+      wly[x] = std::min(wly[x], ly[x + c]), why[x] = std::max(why[x], hy[x + c]);
+      wcount[x] += count[x + c];
+    }
+  const bool rows_inside = y0 == ty - r && y1 == ty + r;
+  const float full = rows_inside ? full_window_capped(f) : 0.0f;
+  const int t = capped_distance(f.r_max2);
+  for (int tx = 0; tx < w; ++tx) {
+    PairCostBox& box = boxes[tx];
+    if (rows_inside && tx >= r && tx + r < w && wcount[tx] == side * side) {
+      box.x0 = tx + wlx[tx] - t + 1, box.x1 = tx + whx[tx] + t - 1;
+      box.y0 = ty + wly[tx] - t + 1, box.y1 = ty + why[tx] + t - 1;
+      box.outside = full;
+      continue;
+    }
+    CoherencePatch p{f.x, f.y, f.matched, std::size_t(w)};
+    p.row0 = std::max(0, r - ty), p.row1 = std::min(2 * r, r + f.height - 1 - ty);
+    p.col0 = std::max(0, r - tx), p.col1 = std::min(2 * r, r + w - 1 - tx);
+    p.first = std::size_t(ty - r + p.row0) * w + std::size_t(tx - r + p.col0);
+    p.window = f.window, p.radius = r, p.r_max2 = f.r_max2;
+    box = coherence_reach(p);
+  }
 }
 
 std::shared_ptr<const EnergyTerm> make_spatial_coherence(float weight, float r_max) {

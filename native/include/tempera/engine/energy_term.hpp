@@ -74,12 +74,12 @@ class EnergyTerm {
   virtual bool refresh_each_iteration() const { return false; }
   // Whether pair_cost() is used.
   virtual bool reads_field() const { return false; }
-  // What pair_cost() of target (tx, ty) may reuse across that target's
-  // candidates, computed once before they are tried (the field a sweep reads
-  // does not change meanwhile): a box of sources outside which the term's
-  // cost is one value. The default box holds every source (nothing reused).
-  virtual void prepare_target(const LevelContext&, const OffsetField&, int /*tx*/, int /*ty*/,
-                              PairCostBox& /*box*/) const {}
+  // What pair_cost() of each target of row ty may reuse across that target's
+  // candidates, computed once before the row is searched (the field a sweep
+  // reads does not change meanwhile): boxes[tx], a box of sources outside
+  // which the term's cost is one value. The default box holds every source
+  // (nothing reused).
+  virtual void prepare_row(const LevelContext&, const OffsetField&, int /*ty*/, PairCostBox* /*boxes*/) const {}
   // Extra cost of matching target (tx, ty) to source (sx, sy), given the
   // field at the start of the sweep and the target's prepared box. A term may
   // stop once the cost reaches `limit` (the candidate is rejected then) and

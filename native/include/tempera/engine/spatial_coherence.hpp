@@ -43,4 +43,24 @@ float coherence_patch_sum(const CoherencePatch& patch, float limit = std::numeri
 // random-search candidates need no sum. `patch.source_x/y` are not read.
 PairCostBox coherence_reach(const CoherencePatch& patch, FixedKernel kernel = FixedKernel::Best);
 
+// What coherence_reach_row() reads: the field at the start of the sweep.
+struct CoherenceField {
+  const std::int32_t* x = nullptr;  // matches, row-major, `width` per row
+  const std::int32_t* y = nullptr;
+  const std::uint8_t* matched = nullptr;
+  int width = 0, height = 0;
+  const float* window = nullptr;  // (2 radius + 1)^2 weights
+  int radius = 0;
+  float r_max2 = 0.0f;
+};
+
+// coherence_reach() of every target of row ty (boxes[tx]), at a few
+// operations a target: from minima and maxima of the matches' offsets
+// M(n) - n, per column of the window's rows and then over its columns. A
+// box may be wider than coherence_reach()'s (it counts the target's own
+// match too), never narrower, so a source outside it is outside that one
+// too; `outside` is the same to the bit. Targets whose window is clipped by
+// the field or holds an unmatched pixel take coherence_reach() itself.
+void coherence_reach_row(const CoherenceField& field, int ty, PairCostBox* boxes);
+
 }  // namespace tempera
