@@ -89,12 +89,27 @@ struct Matcher {
     }
   }
 
+  // Whether a field term whose box leaves (cx, cy) out costs it b.cost or
+  // more alone: a known value, read before the candidate's source data (its
+  // validity and usage cost, two likely cache misses for a random candidate).
+  // The full test below rejects such a candidate too: every cost is >= 0, and
+  // its limit there is at most b.cost.
+  bool rejected_outside_boxes(const std::vector<PairCostBox>& boxes, int tx, int ty, int cx, int cy,
+                              float cost) const {
+    for (std::size_t k = 0; k < boxes.size(); ++k)
+      if (!boxes[k].contains(cx, cy) &&
+          params.field_terms[k]->pair_cost(*params.context, *snapshot, boxes[k], tx, ty, cx, cy, cost) == kInf)
+        return true;
+    return false;
+  }
+
   // Tries source (cx, cy) (remainder rx, ry) for target (tx, ty); keeps it if
   // it lowers the cost.
   inline void try_candidate(int cx, int cy, float rx, float ry, int tx, int ty, int segment,
                             const std::vector<PairCostBox>& boxes, Best& b) const {
     if (cx < margin || cy < margin || cx >= sw - margin || cy >= sh - margin) return;
     if (cx == b.x && cy == b.y) return;
+    if (rejected_outside_boxes(boxes, tx, ty, cx, cy, b.cost)) return;
     const std::size_t si = std::size_t(cy) * sw + cx;
     if (!cons.allowed(si, segment)) return;
     float extra = cons.cost(si);
