@@ -99,76 +99,6 @@ float patch_sum_scalar(const CoherencePatch& p, float limit) {
   return lane_sum(lanes);
 }
 
-// The box of the counted neighbours' implied sources M(p + d) - d
-// (inclusive; x0 > x1 when none counts) and the sum with every neighbour
-// capped, which the kernels above give any source no neighbour reaches.
-struct Reach {
-  int x0 = std::numeric_limits<int>::max(), y0 = x0, x1 = std::numeric_limits<int>::min(), y1 = x1;
-  float capped = 0.0f;
-};
-
-Reach reach_scalar(const CoherencePatch& p) {
-  Reach q;
-  for (int row = p.row0; row <= p.row1; ++row) {
-    const std::size_t at = p.first + std::size_t(row - p.row0) * p.pitch - std::size_t(p.col0);  // column 0's index
-    for (int k = p.col0; k <= p.col1; ++k) {
-      if (!p.matched[at + k] || (row == p.radius && k == p.radius)) continue;
-      const int qx = p.x[at + k] - (k - p.radius), qy = p.y[at + k] - (row - p.radius);
-      q.x0 = std::min(q.x0, qx), q.x1 = std::max(q.x1, qx), q.y0 = std::min(q.y0, qy), q.y1 = std::max(q.y1, qy);
-    }
-  }
-  CoherencePatch far = p;  // a source beyond r_max of every implied one, if any: every term capped
-  const float reach = std::sqrt(std::max(p.r_max2, 0.0f)) + 1.0f;
-  far.source_x = q.x0 > q.x1 ? 0 : q.x0 - int(reach), far.source_y = q.x0 > q.x1 ? 0 : q.y0 - int(reach);
-  q.capped = patch_sum_scalar(far, kInf);
-  return q;
-}
-
-// One pass: the box by lane-wise min and max, and the capped sum as the
-// kernels add it (window * r_max^2 for the counted lanes, 0 for the others).
-[[gnu::target("avx2")]] Reach reach_avx2(const CoherencePatch& p) {
-  const int side = 2 * p.radius + 1;
-  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  const __m256i big = _mm256_set1_epi32(std::numeric_limits<int>::max());
-  const __m256i small = _mm256_set1_epi32(std::numeric_limits<int>::min());
-  const __m256 r_max2 = _mm256_set1_ps(p.r_max2);
-  __m256i x0 = big, y0 = big, x1 = small, y1 = small;
-  __m256 acc = _mm256_setzero_ps();
-  for (int row = p.row0; row <= p.row1; ++row) {
-    const std::size_t at = p.first + std::size_t(row - p.row0) * p.pitch;  // column col0's index
-    const __m256i dy = _mm256_set1_epi32(row - p.radius);
-    for (int i = p.col0; i <= p.col1; i += kLanes) {
-      const int n = std::min(kLanes, p.col1 - i + 1);
-      const std::size_t from = at + std::size_t(i - p.col0);
-      const __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32(n), lane);
-      const __m256i mx = _mm256_maskload_epi32(p.x + from, live);
-      const __m256i my = _mm256_maskload_epi32(p.y + from, live);
-      const __m256 window = _mm256_maskload_ps(p.window + row * side + i, live);
-      const __m256i flags = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(std::int64_t(matched_bytes(p.matched + from, n))));
-      __m256i keep = _mm256_cmpgt_epi32(flags, _mm256_setzero_si256());
-      if (row == p.radius)  // the centre is not its own neighbour
-        keep = _mm256_andnot_si256(_mm256_cmpeq_epi32(lane, _mm256_set1_epi32(p.radius - i)), keep);
-      const __m256i qx = _mm256_sub_epi32(mx, _mm256_add_epi32(_mm256_set1_epi32(i - p.radius), lane));
-      const __m256i qy = _mm256_sub_epi32(my, dy);
-      x0 = _mm256_min_epi32(x0, _mm256_blendv_epi8(big, qx, keep));
-      y0 = _mm256_min_epi32(y0, _mm256_blendv_epi8(big, qy, keep));
-      x1 = _mm256_max_epi32(x1, _mm256_blendv_epi8(small, qx, keep));
-      y1 = _mm256_max_epi32(y1, _mm256_blendv_epi8(small, qy, keep));
-      acc = _mm256_add_ps(acc, _mm256_mul_ps(_mm256_and_ps(window, _mm256_castsi256_ps(keep)), r_max2));
-    }
-  }
-  alignas(32) float lanes[kLanes];
-  alignas(32) std::int32_t a[kLanes], b[kLanes], c[kLanes], d[kLanes];
-  _mm256_store_ps(lanes, acc);
-  _mm256_store_si256(reinterpret_cast<__m256i*>(a), x0), _mm256_store_si256(reinterpret_cast<__m256i*>(b), y0);
-  _mm256_store_si256(reinterpret_cast<__m256i*>(c), x1), _mm256_store_si256(reinterpret_cast<__m256i*>(d), y1);
-  Reach q;
-  for (int j = 0; j < kLanes; ++j)
-    q.x0 = std::min(q.x0, a[j]), q.y0 = std::min(q.y0, b[j]), q.x1 = std::max(q.x1, c[j]), q.y1 = std::max(q.y1, d[j]);
-  q.capped = lane_sum(lanes);
-  return q;
-}
-
 class SpatialCoherence final : public EnergyTerm {
  public:
   SpatialCoherence(float weight, float r_max) : weight_(weight), r_max2_(r_max * r_max) {}
@@ -237,6 +167,8 @@ float coherence_patch_sum(const CoherencePatch& patch, float limit, FixedKernel 
   return patch_sum_scalar(patch, limit);
 }
 
+namespace {
+
 // t: the least whole distance whose square reaches the cap, so a source t
 // or more columns (or rows) from every implied source is capped (ex * ex
 // >= t * t >= r_max^2 in float, and adding ey * ey cannot lower it).
@@ -247,17 +179,29 @@ int capped_distance(float r_max2) {
   return t;
 }
 
-PairCostBox coherence_reach(const CoherencePatch& p, FixedKernel kernel) {
-  static const bool avx2 = fixed_kernel_supported(FixedKernel::Avx2);
-  const Reach q = kernel == FixedKernel::Avx2 || (kernel == FixedKernel::Best && avx2) ? reach_avx2(p) : reach_scalar(p);
+}  // namespace
+
+PairCostBox coherence_reach(const CoherencePatch& p) {
+  // The counted neighbours' implied sources M(p + d) - d: their box.
+  int x0 = std::numeric_limits<int>::max(), y0 = x0, x1 = std::numeric_limits<int>::min(), y1 = x1;
+  for (int row = p.row0; row <= p.row1; ++row) {
+    const std::size_t at = p.first + std::size_t(row - p.row0) * p.pitch - std::size_t(p.col0);  // column 0's index
+    for (int k = p.col0; k <= p.col1; ++k) {
+      if (!p.matched[at + k] || (row == p.radius && k == p.radius)) continue;
+      const int qx = p.x[at + k] - (k - p.radius), qy = p.y[at + k] - (row - p.radius);
+      x0 = std::min(x0, qx), x1 = std::max(x1, qx), y0 = std::min(y0, qy), y1 = std::max(y1, qy);
+    }
+  }
   PairCostBox box;
-  box.outside = q.capped;
-  if (q.x0 > q.x1) {  // no neighbour counts: every source sums to nothing
+  if (x0 > x1) {  // no neighbour counts: every source sums to nothing
     box.x0 = box.y0 = 1, box.x1 = box.y1 = 0;
     return box;
   }
   const int t = capped_distance(p.r_max2);
-  box.x0 = q.x0 - t + 1, box.x1 = q.x1 + t - 1, box.y0 = q.y0 - t + 1, box.y1 = q.y1 + t - 1;
+  box.x0 = x0 - t + 1, box.x1 = x1 + t - 1, box.y0 = y0 - t + 1, box.y1 = y1 + t - 1;
+  CoherencePatch far = p;  // a source just outside the box: every neighbour capped
+  far.source_x = x0 - t, far.source_y = y0 - t;
+  box.outside = coherence_patch_sum(far);
   return box;
 }
 

@@ -41,7 +41,7 @@ float coherence_patch_sum(const CoherencePatch& patch, float limit = std::numeri
 // outside it every neighbour is capped, and coherence_patch_sum() is
 // `outside` to the bit (the same products added in the same order), so most
 // random-search candidates need no sum. `patch.source_x/y` are not read.
-PairCostBox coherence_reach(const CoherencePatch& patch, FixedKernel kernel = FixedKernel::Best);
+PairCostBox coherence_reach(const CoherencePatch& patch);
 
 // What coherence_reach_row() reads: the field at the start of the sweep.
 struct CoherenceField {
