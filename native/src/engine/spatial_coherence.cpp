@@ -99,37 +99,41 @@ float patch_sum_scalar(const CoherencePatch& p, float limit) {
   return lane_sum(lanes);
 }
 
+// Target (tx, ty)'s window clipped to the field (source_x/y left at 0).
+CoherencePatch clipped_patch(const CoherenceField& f, int tx, int ty) {
+  const int r = f.radius;
+  CoherencePatch p{f.x, f.y, f.matched, std::size_t(f.width)};
+  p.row0 = std::max(0, r - ty), p.row1 = std::min(2 * r, r + f.height - 1 - ty);
+  p.col0 = std::max(0, r - tx), p.col1 = std::min(2 * r, r + f.width - 1 - tx);
+  p.first = std::size_t(ty - r + p.row0) * f.width + std::size_t(tx - r + p.col0);
+  p.window = f.window, p.radius = r, p.r_max2 = f.r_max2;
+  return p;
+}
+
 class SpatialCoherence final : public EnergyTerm {
  public:
   SpatialCoherence(float weight, float r_max) : weight_(weight), r_max2_(r_max * r_max) {}
   const char* name() const override { return "spatial_coherence"; }
   bool reads_field() const override { return true; }
   void prepare_row(const LevelContext& c, const OffsetField& field, int ty, PairCostBox* boxes) const override {
-    if (!windowed(c)) return;
-    const CoherenceField f{field.x.data(), field.y.data(), c.constraints->matched().data(), field.width,
-                           field.height, c.space->window, c.space->radius, r_max2_};
-    coherence_reach_row(f, ty, boxes);
+    if (windowed(c)) coherence_reach_row(view(c, field), ty, boxes);
   }
   float pair_cost(const LevelContext& c, const OffsetField& field, const PairCostBox& box, int tx, int ty, int sx,
                   int sy, float limit) const override {
     if (!windowed(c)) return weight_ * general_sum(c, field, tx, ty, sx, sy);
     // As coherence_patch_sum() ends for a sum of `box.outside`: infinity once it reaches the limit.
     if (!box.contains(sx, sy)) return box.outside >= limit / weight_ ? kInf : weight_ * box.outside;
-    return weight_ * coherence_patch_sum(patch(c, field, tx, ty, sx, sy), limit / weight_);
+    CoherencePatch p = clipped_patch(view(c, field), tx, ty);
+    p.source_x = sx, p.source_y = sy;
+    return weight_ * coherence_patch_sum(p, limit / weight_);
   }
 
  private:
   static bool windowed(const LevelContext& c) { return c.space->window && !c.space->rotated(); }
 
-  // Target (tx, ty)'s window clipped to the field, for source (sx, sy).
-  CoherencePatch patch(const LevelContext& c, const OffsetField& field, int tx, int ty, int sx, int sy) const {
-    const int r = c.space->radius;
-    CoherencePatch p{field.x.data(), field.y.data(), c.constraints->matched().data(), std::size_t(field.width)};
-    p.row0 = std::max(0, r - ty), p.row1 = std::min(2 * r, r + field.height - 1 - ty);
-    p.col0 = std::max(0, r - tx), p.col1 = std::min(2 * r, r + field.width - 1 - tx);
-    p.first = field.index(tx - r + p.col0, ty - r + p.row0);
-    p.window = c.space->window, p.radius = r, p.source_x = sx, p.source_y = sy, p.r_max2 = r_max2_;
-    return p;
+  CoherenceField view(const LevelContext& c, const OffsetField& field) const {
+    return {field.x.data(), field.y.data(), c.constraints->matched().data(), field.width,
+            field.height, c.space->window, c.space->radius, r_max2_};
   }
 
   // Rotated patches, or patches without a window, one neighbour at a time.
@@ -267,12 +271,7 @@ void coherence_reach_row(const CoherenceField& f, int ty, PairCostBox* boxes) {
       box.outside = full;
       continue;
     }
-    CoherencePatch p{f.x, f.y, f.matched, std::size_t(w)};
-    p.row0 = std::max(0, r - ty), p.row1 = std::min(2 * r, r + f.height - 1 - ty);
-    p.col0 = std::max(0, r - tx), p.col1 = std::min(2 * r, r + w - 1 - tx);
-    p.first = std::size_t(ty - r + p.row0) * w + std::size_t(tx - r + p.col0);
-    p.window = f.window, p.radius = r, p.r_max2 = f.r_max2;
-    box = coherence_reach(p);
+    box = coherence_reach(clipped_patch(f, tx, ty));
   }
 }
 
