@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "tempera/engine/patch_usage.hpp"
-#include "tempera/engine/radix_sort.hpp"
+#include "tempera/engine/order_statistics.hpp"
 #include "tempera/engine/reversed_retrieval.hpp"
 
 namespace tempera {
@@ -45,20 +45,29 @@ std::pair<double, double> fit_hyperbola(const std::vector<double>& xs, const std
   return {a, b};
 }
 
+constexpr std::size_t kKneeSamples = 1024;
+
 }  // namespace
 
-std::size_t error_knee(const std::vector<float>& sorted) {
-  const std::size_t n = sorted.size();
-  if (n < 8) return n;
-  const double top = sorted.back();
+std::vector<std::size_t> knee_sample_ranks(std::size_t n) {
+  if (n < 8) return {};
+  // An even subsample of the curve, its last error included.
+  const std::size_t m = std::min(n, kKneeSamples);
+  std::vector<std::size_t> ranks(m);
+  for (std::size_t i = 0; i < m; ++i) ranks[i] = i * (n - 1) / (m - 1);
+  return ranks;
+}
+
+std::size_t error_knee(std::size_t n, const std::vector<float>& samples) {
+  if (n < 8 || samples.size() != std::min(n, kKneeSamples)) return n;
+  const double top = samples.back();
   if (!(top > 0)) return n;
-  // Normalized axes on an even subsample: x in [0, 1], y = error / max error.
-  const std::size_t m = std::min<std::size_t>(n, 1024);
+  // Normalized axes: x in [0, 1], y = error / max error.
+  const std::size_t m = samples.size();
   std::vector<double> xs(m), ys(m);
   for (std::size_t i = 0; i < m; ++i) {
-    const std::size_t j = i * (n - 1) / (m - 1);
-    xs[i] = double(j) / double(n - 1);
-    ys[i] = std::max(double(sorted[j]) / top, 1e-4);
+    xs[i] = double(i * (n - 1) / (m - 1)) / double(n - 1);
+    ys[i] = std::max(double(samples[i]) / top, 1e-4);
   }
   // The paper's knee: where the fitted hyperbola's slope reaches 1.
   const auto [a, b] = fit_hyperbola(xs, ys);
@@ -85,6 +94,12 @@ std::size_t error_knee(const std::vector<float>& sorted) {
   return std::clamp<std::size_t>(std::size_t(std::ceil(knee * double(n - 1))), 1, n);
 }
 
+std::size_t error_knee(const std::vector<float>& sorted) {
+  std::vector<float> samples;
+  for (std::size_t j : knee_sample_ranks(sorted.size())) samples.push_back(sorted[j]);
+  return error_knee(sorted.size(), samples);
+}
+
 UsageStats retrieve_with_budget(const PatchSpace& space, const SearchConstraints& cons, OffsetField& nnf,
                                 const ReversedRetrievalParams& params, std::uint64_t stream,
                                 const std::vector<std::int32_t>* earlier_sources) {
@@ -92,21 +107,20 @@ UsageStats retrieve_with_budget(const PatchSpace& space, const SearchConstraints
   rr.set_earlier_sources(earlier_sources);
   rr.eligible() = cons.source_valid;
   UsageStats stats;
-  // Kept across rounds with its scratch, to spare a million-entry allocation
-  // each; sized once, as a growing vector holds its old and new buffers.
-  std::vector<float> errors;
-  errors.reserve(rr.candidate().size());
-  std::vector<std::uint32_t> sort_scratch;
+  // The round's candidate errors, read in place: the knee needs about a
+  // thousand of their ranks, not a sorted copy (order_statistics.hpp).
+  const auto errors_in = [&rr](std::size_t begin, std::size_t end, auto&& f) {
+    for (std::size_t p = begin; p < end; ++p)
+      if (rr.eligible()[p] && rr.candidate()[p] != kNoTarget) f(rr.candidate_dist()[p]);
+  };
   while (stats.rounds < params.max_rounds &&
          double(rr.assigned_count()) < params.coverage_goal * double(rr.active())) {
     rr.search(stats.rounds++);
-    // The knee of this round's sorted candidate errors.
-    errors.clear();
-    for (std::size_t p = 0; p < rr.candidate().size(); ++p)
-      if (rr.eligible()[p] && rr.candidate()[p] != kNoTarget) errors.push_back(rr.candidate_dist()[p]);
-    if (errors.empty()) break;
-    radix_sort(errors, sort_scratch);
-    const float knee_error = errors[error_knee(errors) - 1];
+    const RadixSelect errors(errors_in, rr.candidate().size(), params.threads);
+    const std::size_t n = errors.size();
+    if (n == 0) break;
+    const std::size_t knee = error_knee(n, errors.values_at(knee_sample_ranks(n)));
+    const float knee_error = errors.values_at({knee - 1}).front();
     // Sources whose best open target is already past the knee only get worse
     // as targets fill up: retire them.
     for (std::size_t p = 0; p < rr.candidate().size(); ++p)

@@ -40,6 +40,10 @@ UsageStats retrieve_with_budget(const PatchSpace& space, const SearchConstraints
 // Knee of ascending `sorted_errors`: fits f(x) = 1 / (a - b x) to the curve in
 // normalized axes and returns how many leading errors lie before f'(x) = 1.
 std::size_t error_knee(const std::vector<float>& sorted_errors);
+// The same from n errors' values at knee_sample_ranks(n) of their ascending
+// order (an even subsample of at most 1024, the largest included; none below 8).
+std::vector<std::size_t> knee_sample_ranks(std::size_t n);
+std::size_t error_knee(std::size_t n, const std::vector<float>& samples);
 
 // Occurrence penalty per source center: weight * typical distance * use / fair use.
 std::vector<float> occurrence_penalty(const OffsetField& field, const SearchConstraints& constraints,

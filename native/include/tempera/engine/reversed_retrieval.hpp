@@ -60,7 +60,6 @@ class ReversedRetrieval {
   // seeds like the forward match's.
   void set_earlier_sources(const std::vector<std::int32_t>* earlier) {
     earlier_ = earlier && earlier->size() == open_.size() ? earlier : nullptr;
-    if (earlier_) earlier_dist_.assign(open_.size(), kNoDistance);
   }
   std::size_t active() const { return active_; }
   std::size_t assigned_count() const { return assigned_count_; }
@@ -199,20 +198,32 @@ class ReversedRetrieval {
   // target and skip the wide search.
   void adopt_earlier() {
     const auto& earlier = *earlier_;
-    parallel_for(th_, params_.threads, [&](int qy) {
-      for (int qx = 0; qx < tw_; ++qx) {
-        const std::size_t q = std::size_t(qy) * tw_ + qx;
-        const std::int32_t p = earlier[q];
-        const bool usable = open_[q] && p >= 0 && p < std::int32_t(eligible_.size()) && eligible_[p] &&
-                            cons_.segment_of_source(std::size_t(p)) == cons_.segment_of_target(q);
-        earlier_dist_[q] = usable ? scaled_distance(p % sw_, p / sw_, qx, qy, kNoDistance) : kNoDistance;
-      }
-    });
-    for (std::size_t q = 0; q < earlier.size(); ++q) {
-      const std::int32_t p = earlier[q];
-      if (earlier_dist_[q] < kNoDistance && earlier_dist_[q] < candidate_dist_[p]) {
-        candidate_[p] = std::int32_t(q);
-        candidate_dist_[p] = earlier_dist_[q];
+    // The distances are computed in parallel a band of rows at a time and
+    // adopted in target order (a tie keeps the lower target): a band's
+    // distances are held, not a frame's (4 bytes a target at the peak of the
+    // still's memory).
+    constexpr int kBandRows = 64;
+    std::vector<float> band_dist(std::size_t(std::min(kBandRows, th_)) * tw_);
+    for (int y0 = 0; y0 < th_; y0 += kBandRows) {
+      const int rows = std::min(kBandRows, th_ - y0);
+      parallel_for(rows, params_.threads, [&](int row) {
+        const int qy = y0 + row;
+        for (int qx = 0; qx < tw_; ++qx) {
+          const std::size_t q = std::size_t(qy) * tw_ + qx;
+          const std::int32_t p = earlier[q];
+          const bool usable = open_[q] && p >= 0 && p < std::int32_t(eligible_.size()) && eligible_[p] &&
+                              cons_.segment_of_source(std::size_t(p)) == cons_.segment_of_target(q);
+          band_dist[std::size_t(row) * tw_ + qx] =
+              usable ? scaled_distance(p % sw_, p / sw_, qx, qy, kNoDistance) : kNoDistance;
+        }
+      });
+      const std::size_t first = std::size_t(y0) * tw_;
+      for (std::size_t i = 0; i < std::size_t(rows) * tw_; ++i) {
+        const std::int32_t p = earlier[first + i];
+        if (band_dist[i] < kNoDistance && band_dist[i] < candidate_dist_[p]) {
+          candidate_[p] = std::int32_t(first + i);
+          candidate_dist_[p] = band_dist[i];
+        }
       }
     }
   }
@@ -356,7 +367,6 @@ class ReversedRetrieval {
   std::vector<float> candidate_dist_;
   std::vector<std::vector<std::int32_t>> unassigned_;
   const std::vector<std::int32_t>* earlier_ = nullptr;
-  std::vector<float> earlier_dist_;
   static constexpr std::uint32_t kNoSource = ~0u;
   std::vector<std::atomic<std::uint32_t>> best_source_;  // resolve_collisions' per-target minimum, kept across rounds
   std::size_t active_ = 0, assigned_count_ = 0, wide_searches_ = 0;
