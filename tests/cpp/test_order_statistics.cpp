@@ -79,6 +79,16 @@ TEST(OrderStatistics, SelectsNegativeValuesLikeStdSort) {
   expect_selects_like_std_sort({2.0f});
 }
 
+TEST(OrderStatistics, ARankPastTheSetIsAnError) {
+  const std::vector<float> values = {3.0f, 1.0f, 2.0f};
+  const auto values_in = [&values](std::size_t begin, std::size_t end, auto&& f) {
+    for (std::size_t i = begin; i < end; ++i) f(values[i]);
+  };
+  const RadixSelect select(values_in, values.size(), 1);
+  EXPECT_EQ(select.values_at({2}).front(), 3.0f);
+  EXPECT_THROW(select.values_at({3}), ValueError);
+}
+
 TEST(OrderStatistics, KneeSamplesSpanTheCurve) {
   EXPECT_TRUE(knee_sample_ranks(7).empty());
   const auto few = knee_sample_ranks(8);

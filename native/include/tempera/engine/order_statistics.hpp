@@ -9,6 +9,7 @@
 #include <cstring>
 #include <vector>
 
+#include "tempera/engine/error.hpp"
 #include "tempera/engine/parallel.hpp"
 
 namespace tempera {
@@ -51,6 +52,8 @@ class RadixSelect {
   // The values at `ranks` (each below size()), in the order of `ranks`.
   std::vector<float> values_at(const std::vector<std::size_t>& ranks) const {
     const std::size_t wanted = ranks.size();
+    for (std::size_t r : ranks)
+      if (r >= size_) throw ValueError("internal: order statistic rank past the set's size");
     // Per wanted rank: the node of its key's prefix so far (the distinct
     // prefixes of the wanted ranks, numbered per depth), its rank among that
     // node's values, and the key's bits found.
