@@ -63,16 +63,18 @@ class RadixSelect {
     std::uint32_t nodes = 1;
     for (int depth = 0; depth < 4; ++depth) {
       const std::vector<std::uint32_t> count = depth == 0 ? top_count_ : count_bytes(depth, child, nodes);
-      std::vector<std::uint32_t> next(std::size_t(nodes) * kRadix, kNone);
+      const bool last = depth == 3;  // the key is whole: no nodes below to number
+      std::vector<std::uint32_t> next(last ? 0 : std::size_t(nodes) * kRadix, kNone);
       std::uint32_t next_nodes = 0;
       for (std::size_t i = 0; i < wanted; ++i) {
         const std::uint32_t* c = &count[std::size_t(node[i]) * kRadix];
         std::uint32_t b = 0;
         while (rank_in_node[i] >= c[b]) rank_in_node[i] -= c[b++];  // stops below 256 for a rank in the set
+        key[i] |= b << shift(depth);
+        if (last) continue;
         std::uint32_t& id = next[std::size_t(node[i]) * kRadix + b];
         if (id == kNone) id = next_nodes++;
         node[i] = id;
-        key[i] |= b << shift(depth);
       }
       child.push_back(std::move(next));
       nodes = next_nodes;
