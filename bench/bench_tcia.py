@@ -115,7 +115,7 @@ def main():
         style, guides, frames = panning_shot(side, args.frames, args.speed)
     height, width = frames[0]["guides"][0].shape[:2]
     started, cpu = time.monotonic(), time.process_time()
-    values = {k: float(v) for k, v in (item.split("=", 1) for item in args.set)}
+    values = {k: int(v) if v.lstrip("-").isdigit() else float(v) for k, v in (item.split("=", 1) for item in args.set)}
     out = tcia.stylize_shot(style, guides, frames, threads=args.threads, **values)
     wall, cpu = time.monotonic() - started, time.process_time() - cpu
     assert len(out) == args.frames

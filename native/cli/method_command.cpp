@@ -57,7 +57,8 @@ std::string method_help(const MethodEntry& m) {
                 "  --format F              png (default) | exr\n"
                 "  --no-resume             make every frame again, even if current\n"
                 "  --max-image-pixels N    refuse images declaring more pixels (default 50000000)\n",
-                m.light_path_guides ? "\naround the frames (a light-path method's):\n" + light_path_extras_help() : "",
+                m.light_path_guides ? "\naround the frames (a light-path method's):\n" + light_path_extras_help()
+                                    : "  --no-video              accepted: this method writes frames, no video\n",
                 "\nmethod options:\n", m.options_help.empty() ? "  (none)\n" : m.options_help,
                 "\nExit status: 0 done, 1 error (files, Blender), 2 bad usage or bad values, 130 interrupted.\n");
 }
@@ -124,6 +125,7 @@ Request parse(const MethodEntry& method, const Args& args) {
     else if (flag == "--blender") q.render.blender.blender = r.value(flag);
     else if (flag == "--addon-path") q.render.blender.addon = r.value(flag);
     else if (method.light_path_guides && take_light_path_flag(q.extras, flag, r)) continue;
+    else if (flag == "--no-video") continue;  // the other methods write no video: a farm script passes it to all
     else q.options.emplace_back(flag.substr(2), r.optional_value() ? r.value(flag) : "");  // the method names unknown ones
   }
   if (config.guides.empty() && !q.scene.empty() && !config.out.empty())

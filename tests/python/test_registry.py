@@ -34,6 +34,20 @@ def test_the_native_command_runs_every_method(cli_path):
         assert result.returncode == 0 and f"usage: tempera stylize --method {m['name']}" in result.stdout, result.stderr
 
 
+def test_every_method_takes_no_video(cli_path, tmp_path):
+    """A farm script passes --no-video to every method: those that write no
+    video accept it too (the scene form stops at the missing Blender, after
+    every option was read)."""
+    blend = tmp_path / "shot.blend"
+    blend.write_bytes(b"BLENDER")  # never opened
+    for m in registry.METHODS:
+        guides = ("--exemplar-guides", tmp_path) if m["light_path_guides"] else ()
+        result = _native_stylize(cli_path, blend, "--method", m["name"], "--exemplar", tmp_path / "x.png", *guides,
+                                 "--frames", "1-2", "--out", tmp_path / "o", "--no-video",
+                                 "--blender", tmp_path / "no_blender")
+        assert result.returncode == 1 and "cannot run" in result.stderr, (m["name"], result.stderr)
+
+
 def test_an_unknown_method_is_refused_naming_every_method(cli_path):
     result = _native_stylize(cli_path, "--method", "ebsynth", "--help")
     assert result.returncode == 2 and "unknown --method 'ebsynth'" in result.stderr

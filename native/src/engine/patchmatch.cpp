@@ -227,7 +227,8 @@ void patchmatch(const PatchSpace& space, const SearchConstraints& cons, OffsetFi
       std::copy_n(field.ry.begin() + from, tw, edges.ry.begin() + to);
     }
     const Matcher m(space, cons, params, &snapshot);
-    const int max_radius = std::max(m.sw, m.sh);
+    const int whole = std::max(m.sw, m.sh);
+    const int max_radius = params.search_radius > 0 ? std::min(params.search_radius, whole) : whole;
     parallel_for(bands, params.threads, [&](int band) {
       const int y0 = band * params.band_rows, y1 = std::min(th, y0 + params.band_rows);
       Rng rng(params.seed, mix64(stream * 1000003ull + iter) ^ std::uint64_t(band));

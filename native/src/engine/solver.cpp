@@ -843,6 +843,9 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
   const LevelContext context{l, &level.space, &level.constraints, &p.layout[std::size_t(l)], options_.seed,
                              options_.threads, &sources_before_search};
   PatchMatchParams pm{pm_iters, options_.seed, options_.threads};
+  // The coarsest level searches the whole exemplar; finer ones refine the
+  // matches it found, within search_radius when one is set.
+  pm.search_radius = l == coarsest() ? 0 : options_.search_radius;
   pm.candidates = start.candidates;
   pm.context = &context;
   for (const auto& t : terms_)

@@ -63,6 +63,11 @@ struct SynthesisOptions {
   int em_iterations = 6;
   int pm_iterations = 2;  // measured: 4 gains < 1% energy
   std::vector<int> em_schedule, pm_schedule;  // per level, coarsest first
+  // PatchMatch's random search below the coarsest level: at most this many
+  // pixels from a pixel's match (the coarsest searches the whole exemplar,
+  // and finer levels refine what it found). 0 = the whole exemplar at every
+  // level, whose scales grow with its size: log2(side) candidates a pixel.
+  int search_radius = 0;
   // The finest level stops its EM iterations once one lowers the energy by
   // less than this fraction (0: all of them). Measured on ebsynth's StyLit
   // still (docs/benchmarks.md, issue 32 step 21).
@@ -111,6 +116,10 @@ inline const auto& synthesis_option_table() {
             "EM iterations per level, coarsest first; levels past the list use em_iterations", 1, 1000),
       field(&S::pm_schedule, "pm_schedule", "pm-schedule",
             "PatchMatch sweeps per level, coarsest first; levels past the list use pm_iterations", 0, 1000),
+      field(&S::search_radius, "search_radius", "search-radius",
+            "random search below the coarsest level: at most this many pixels from a pixel's match (the coarsest "
+            "searches the whole exemplar); 0 = the whole exemplar at every level",
+            0, 1e6),
       field(&S::em_tolerance, "em_tolerance", "em-tolerance",
             "the finest level stops iterating once an EM iteration lowers the energy by less than this fraction: "
             "0.02 stops ebsynth's StyLit still after 4 of 6, 0.7x the time, judged energy +0.4%; "

@@ -1,0 +1,58 @@
+// PatchMatch's random search within search_radius (PatchMatchParams,
+// SynthesisOptions::search_radius): a pixel with no neighbours to propagate
+// from moves at most the radius in one sweep, and without a radius it jumps
+// across the exemplar.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <random>
+
+#include "tempera/engine/patchmatch.hpp"
+
+using namespace tempera;
+
+namespace {
+
+FeatureImage random_features(int w, int h, int channels, unsigned seed) {
+  std::mt19937 rng(seed);
+  FeatureImage f(w, h, channels);
+  for (float& v : f.data) v = float(rng() % 1000) * 1e-3f;
+  return f;
+}
+
+// How far (per axis, the larger) one sweep moves the match of a lone target
+// pixel that starts at (100, 75), over `seeds` seeds: the widest move.
+int widest_move(int radius, int seeds) {
+  const int w = 200, h = 150;
+  const FeatureImage s = random_features(w, h, 3, 1), t = random_features(1, 1, 3, 2);
+  PatchSpace space;
+  space.source = &s, space.target = &t;
+  SearchConstraints cons;
+  cons.source_valid.assign(std::size_t(w) * h, 0);
+  for (int y = 2; y < h - 2; ++y)
+    for (int x = 2; x < w - 2; ++x) cons.source_valid[std::size_t(y) * w + x] = 1;
+  cons.target_active.assign(1, 1);
+  cons.finalize();
+  int widest = 0;
+  for (int seed = 1; seed <= seeds; ++seed) {
+    OffsetField field(1, 1);
+    field.x[0] = 100, field.y[0] = 75;
+    refresh_distances(space, cons, field, 1);
+    const float before = field.dist[0];
+    PatchMatchParams pm;
+    pm.iterations = 1, pm.seed = std::uint64_t(seed), pm.threads = 1, pm.search_radius = radius;
+    patchmatch(space, cons, field, pm, 0);
+    EXPECT_LE(field.dist[0], before);
+    widest = std::max({widest, std::abs(field.x[0] - 100), std::abs(field.y[0] - 75)});
+  }
+  return widest;
+}
+
+}  // namespace
+
+TEST(SearchRadius, OneSweepMovesAMatchAtMostTheRadius) {
+  EXPECT_LE(widest_move(8, 60), 8);
+  EXPECT_GT(widest_move(8, 60), 0);  // it did search
+  EXPECT_GT(widest_move(0, 60), 8);  // 0: the whole exemplar
+}
