@@ -506,6 +506,27 @@ TEST(Fluidymation, WarmStartFromThePreviousFrameBeatsAColdStart) {
   EXPECT_LT(warm.energy, cold.energy);   // same seed: ignoring the previous matches would give cold exactly
 }
 
+// D_dir's point cost without tanf: min(|tan a|, 1) to float precision over
+// every angle the term forms (source and target angles and the rotation:
+// up to 4 pi either way), the same 1 past 45 degrees from an axis.
+TEST(Fluidymation, ClampedTangentIsTanfsWithinItsPrecision) {
+  double worst = 0, worst_relative = 0;
+  for (int i = -400000; i <= 400000; ++i) {
+    const float a = float(i) * 3.2e-5f;  // -12.8 .. 12.8 rad
+    const double exact = std::min(std::abs(std::tan(double(a))), 1.0);
+    const double ours = clamped_abs_tan(a);
+    worst = std::max(worst, std::abs(ours - exact));
+    if (exact > 1e-2) worst_relative = std::max(worst_relative, std::abs(ours - exact) / exact);
+    ASSERT_LE(ours, 1.0) << a;
+  }
+  EXPECT_LT(worst, 3e-7);  // a few float steps of the cost (in [0, 1])
+  EXPECT_LT(worst_relative, 3e-7);
+  EXPECT_EQ(clamped_abs_tan(0.0f), 0.0f);
+  EXPECT_EQ(clamped_abs_tan(1.0f), 1.0f);   // 57 degrees
+  EXPECT_EQ(clamped_abs_tan(-2.0f), 1.0f);  // tan is -2.19 there
+  EXPECT_NEAR(clamped_abs_tan(3.5f), std::tan(3.5 - 3.14159265358979), 1e-6);
+}
+
 TEST(Fluidymation, BadInputIsAValueError) {
   const SmallShot shot;
   FluidSequence s = shot.seq();

@@ -57,6 +57,27 @@ float extent_at(const std::vector<Image>& ext, float t, std::size_t p) {
   return (1 - f) * ext[std::size_t(a)].data()[p] + f * ext[std::size_t(b)].data()[p];
 }
 
+}  // namespace
+
+// Without tanf, which took 13% of the method's time (perf at 1 Mpix): tan
+// has period pi, so a folds into [0, pi/2], where past pi/4 |tan| >= 1;
+// below, tan x = x + x^3 P(x^2), P a least-squares fit of degree 5 on
+// [0, pi/4] (relative error under 1e-7 in float, about tanf's). pi is
+// subtracted in two parts, the first exact in a few bits, so that k pi is
+// exact and the fold loses nothing near the axes.
+float clamped_abs_tan(float a) {
+  constexpr float kPiHigh = 3.140625f, kPiLow = 9.67653589793e-4f;  // kPiHigh + kPiLow = pi
+  const float k = std::nearbyint(a * 0.318309886f);
+  const float x = std::abs((a - k * kPiHigh) - k * kPiLow);
+  if (x >= 0.785398163f) return 1.0f;
+  const float z = x * x;
+  const float p =
+      ((((0.00935359f * z + 0.00317561f) * z + 0.02439438f) * z + 0.05342145f) * z + 0.13338679f) * z + 0.3333316f;
+  return std::min(x + x * z * p, 1.0f);
+}
+
+namespace {
+
 // D_dir (Platkevič et al. 2021, §3.2) per candidate: what the rotation about
 // the patch centre leaves misaligned across the patch.
 class DirectionTerm final : public EnergyTerm {
@@ -84,7 +105,7 @@ class DirectionTerm final : public EnergyTerm {
         const int px = std::clamp(int(std::floor(sx + cs * dx - sn * dy + 0.5f)), 0, sw - 1);
         const int py = std::clamp(int(std::floor(sy + sn * dx + cs * dy + 0.5f)), 0, sh - 1);
         const float a = s.source_angle[std::size_t(py) * sw + px] - phi - s.target_angle[std::size_t(qy) * tw + qx];
-        sum += std::min(std::abs(std::tan(a)), 1.0f);  // |tan| is axial; clamped (it diverges at 90 degrees)
+        sum += clamped_abs_tan(a);  // |tan| is axial; clamped (it diverges at 90 degrees)
         ++count;
       }
     return count ? weight_ * sum / float(count) : 0.0f;

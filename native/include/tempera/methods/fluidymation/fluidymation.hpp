@@ -189,4 +189,7 @@ std::vector<FluidFrame> stylize_fluid_sequence(const FluidSequence& sequence, co
 // corners and edge midpoints of min(|tan(a_src(p') - phi - a_tgt(q'))|, 1).
 std::shared_ptr<const EnergyTerm> make_direction_term(float weight);
 
+// min(|tan a|, 1) for any angle a (radians): D_dir's cost at one point.
+float clamped_abs_tan(float a);
+
 }  // namespace tempera
