@@ -1,7 +1,7 @@
 // PatchMatch's random search within search_radius (PatchMatchParams,
-// SynthesisOptions::search_radius): a pixel with no neighbours to propagate
-// from moves at most the radius in one sweep, and without a radius it jumps
-// across the exemplar.
+// SynthesisOptions::search_radius): after a search's first sweep, a pixel
+// with no neighbours to propagate from moves at most the radius in a sweep;
+// the first sweep, and any sweep without a radius, jump across the exemplar.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -21,9 +21,10 @@ FeatureImage random_features(int w, int h, int channels, unsigned seed) {
   return f;
 }
 
-// How far (per axis, the larger) one sweep moves the match of a lone target
-// pixel that starts at (100, 75), over `seeds` seeds: the widest move.
-int widest_move(int radius, int seeds) {
+// How far (per axis, the larger) one sweep (the search's `sweep`th) moves
+// the match of a lone target pixel that starts at (100, 75), over `seeds`
+// seeds: the widest move.
+int widest_move(int radius, int sweep, int seeds) {
   const int w = 200, h = 150;
   const FeatureImage s = random_features(w, h, 3, 1), t = random_features(1, 1, 3, 2);
   PatchSpace space;
@@ -41,7 +42,8 @@ int widest_move(int radius, int seeds) {
     refresh_distances(space, cons, field, 1);
     const float before = field.dist[0];
     PatchMatchParams pm;
-    pm.iterations = 1, pm.seed = std::uint64_t(seed), pm.threads = 1, pm.search_radius = radius;
+    pm.iterations = 1, pm.first_iteration = sweep, pm.seed = std::uint64_t(seed), pm.threads = 1;
+    pm.search_radius = radius;
     patchmatch(space, cons, field, pm, 0);
     EXPECT_LE(field.dist[0], before);
     widest = std::max({widest, std::abs(field.x[0] - 100), std::abs(field.y[0] - 75)});
@@ -51,8 +53,10 @@ int widest_move(int radius, int seeds) {
 
 }  // namespace
 
-TEST(SearchRadius, OneSweepMovesAMatchAtMostTheRadius) {
-  EXPECT_LE(widest_move(8, 60), 8);
-  EXPECT_GT(widest_move(8, 60), 0);  // it did search
-  EXPECT_GT(widest_move(0, 60), 8);  // 0: the whole exemplar
+TEST(SearchRadius, SweepsAfterTheFirstMoveAMatchAtMostTheRadius) {
+  EXPECT_LE(widest_move(8, 1, 60), 8);
+  EXPECT_LE(widest_move(8, 3, 60), 8);
+  EXPECT_GT(widest_move(8, 1, 60), 0);  // it did search
+  EXPECT_GT(widest_move(8, 0, 60), 8);  // the first sweep reaches the whole exemplar
+  EXPECT_GT(widest_move(0, 1, 60), 8);  // 0: the whole exemplar in every sweep
 }

@@ -228,7 +228,9 @@ void patchmatch(const PatchSpace& space, const SearchConstraints& cons, OffsetFi
     }
     const Matcher m(space, cons, params, &snapshot);
     const int whole = std::max(m.sw, m.sh);
-    const int max_radius = params.search_radius > 0 ? std::min(params.search_radius, whole) : whole;
+    // The first sweep of a search reaches the whole exemplar; with a radius
+    // the later ones stay near the matches it and propagation found.
+    const int max_radius = params.search_radius > 0 && iter > 0 ? std::min(params.search_radius, whole) : whole;
     parallel_for(bands, params.threads, [&](int band) {
       const int y0 = band * params.band_rows, y1 = std::min(th, y0 + params.band_rows);
       Rng rng(params.seed, mix64(stream * 1000003ull + iter) ^ std::uint64_t(band));

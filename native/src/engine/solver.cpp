@@ -844,7 +844,7 @@ LevelResult Solver::solve_level(int l, const LevelStart& start, const std::funct
                              options_.threads, &sources_before_search};
   PatchMatchParams pm{pm_iters, options_.seed, options_.threads};
   // The coarsest level searches the whole exemplar; finer ones refine the
-  // matches it found, within search_radius when one is set.
+  // matches it found, within search_radius after a first wide sweep.
   pm.search_radius = l == coarsest() ? 0 : options_.search_radius;
   pm.candidates = start.candidates;
   pm.context = &context;

@@ -82,8 +82,10 @@ struct PatchMatchParams {
   int threads = 0;
   int band_rows = 32;
   int random_tries_per_scale = 1;
-  // The random search's widest window: at most this many pixels from the
-  // match; 0 = the whole source (SynthesisOptions::search_radius).
+  // The random search's widest window from the second sweep of a search on
+  // (first_iteration + k > 0): at most this many pixels from the match; the
+  // first sweep, and every sweep with 0, reach the whole source
+  // (SynthesisOptions::search_radius).
   int search_radius = 0;
   const CandidateList* candidates = nullptr;
   // Terms that read the field (EnergyTerm::reads_field), with their context.

@@ -63,10 +63,11 @@ struct SynthesisOptions {
   int em_iterations = 6;
   int pm_iterations = 2;  // measured: 4 gains < 1% energy
   std::vector<int> em_schedule, pm_schedule;  // per level, coarsest first
-  // PatchMatch's random search below the coarsest level: at most this many
-  // pixels from a pixel's match (the coarsest searches the whole exemplar,
-  // and finer levels refine what it found). 0 = the whole exemplar at every
-  // level, whose scales grow with its size: log2(side) candidates a pixel.
+  // PatchMatch's random search below the coarsest level, from the second
+  // sweep of each search on: at most this many pixels from a pixel's match
+  // (the coarsest level, and each search's first sweep, reach the whole
+  // exemplar: finer sweeps refine what they found). 0 = the whole exemplar
+  // in every sweep, whose scales grow with its size: log2(side) candidates.
   int search_radius = 0;
   // The finest level stops its EM iterations once one lowers the energy by
   // less than this fraction (0: all of them). Measured on ebsynth's StyLit
@@ -117,8 +118,9 @@ inline const auto& synthesis_option_table() {
       field(&S::pm_schedule, "pm_schedule", "pm-schedule",
             "PatchMatch sweeps per level, coarsest first; levels past the list use pm_iterations", 0, 1000),
       field(&S::search_radius, "search_radius", "search-radius",
-            "random search below the coarsest level: at most this many pixels from a pixel's match (the coarsest "
-            "searches the whole exemplar); 0 = the whole exemplar at every level",
+            "random search below the coarsest level, after each search's first sweep: at most this many pixels "
+            "from a pixel's match (the coarsest level and first sweeps reach the whole exemplar); 0 = the whole "
+            "exemplar in every sweep",
             0, 1e6),
       field(&S::em_tolerance, "em_tolerance", "em-tolerance",
             "the finest level stops iterating once an EM iteration lowers the energy by less than this fraction: "

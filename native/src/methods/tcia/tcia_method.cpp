@@ -69,8 +69,8 @@ std::string options_help() {
       flags_help<TciaOptions>(tcia_option_table(), true), flags_help<TciaLineOptions>(tcia_line_option_table(), true),
       flags_help<TciaOrientationOptions>(tcia_orientation_option_table(), true),
       "  (any engine option of 'tempera synth --help'; the method's engine defaults: 9x9 Gaussian\n"
-      "  window, centre output, histogram usage, automatic levels. Resume, Ctrl-C and SIGTERM work\n"
-      "  per segment.)\n");
+      "  window, centre output, histogram usage, automatic levels, --search-radius 64. Resume, Ctrl-C\n"
+      "  and SIGTERM work per segment.)\n");
 }
 
 }  // namespace
