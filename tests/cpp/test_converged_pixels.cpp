@@ -14,7 +14,9 @@
 #include "test_inputs.hpp"
 
 using namespace tempera;
+using tempera::test_inputs::inner_sources;
 using tempera::test_inputs::noise_texture;
+using tempera::test_inputs::random_features;
 
 namespace {
 
@@ -26,15 +28,6 @@ OffsetField random_offsets(int w, int h, unsigned seed) {
 }
 
 std::size_t count(const std::vector<std::uint8_t>& v) { return std::size_t(std::count(v.begin(), v.end(), 1)); }
-
-FeatureImage random_features(int w, int h, int channels, unsigned seed) {
-  std::mt19937 rng(seed);
-  FeatureImage f(w, h, channels);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      for (int c = 0; c < channels; ++c) f.pixel(x, y)[c] = float(rng() % 1000) * 1e-3f;
-  return f;
-}
 
 }  // namespace
 
@@ -85,12 +78,7 @@ TEST(ConvergedPixels, PatchMatchLeavesUnsearchedPixelsAlone) {
   const FeatureImage s = random_features(w, h, channels, 1), t = random_features(w, h, channels, 2);
   PatchSpace space;
   space.source = &s, space.target = &t;
-  SearchConstraints cons;
-  cons.source_valid.assign(std::size_t(w) * h, 0);
-  for (int y = 2; y < h - 2; ++y)
-    for (int x = 2; x < w - 2; ++x) cons.source_valid[std::size_t(y) * w + x] = 1;
-  cons.target_active.assign(std::size_t(w) * h, 1);
-  cons.finalize();
+  const SearchConstraints cons = inner_sources(w, h, 2, std::size_t(w) * h);
   OffsetField start;
   random_field(space, cons, start, 5, 2);
   std::vector<std::uint8_t> searched(start.x.size(), 0);

@@ -6,6 +6,8 @@
 
 #include "tempera/tracer/embree_tracer.hpp"
 #include "tempera/engine/image.hpp"
+#include "tempera/engine/patch_distance.hpp"
+#include "tempera/engine/patchmatch.hpp"
 
 namespace tempera::test_inputs {
 
@@ -16,6 +18,27 @@ inline Image noise_texture(int w, int h, int c, unsigned seed) {
   Image img(w, h, c);
   for (std::size_t i = 0; i < img.pixel_count() * c; ++i) img.data()[i] = u(rng);
   return img;
+}
+
+// Features of values k / 1000 (k in 0..999), reproducible from the seed.
+inline FeatureImage random_features(int w, int h, int channels, unsigned seed) {
+  std::mt19937 rng(seed);
+  FeatureImage f(w, h, channels);
+  for (float& v : f.data) v = float(rng() % 1000) * 1e-3f;
+  return f;
+}
+
+// Search constraints where every source pixel at least `border` from the
+// edge of a w x h exemplar may be a patch centre, and `targets` target
+// pixels are active.
+inline SearchConstraints inner_sources(int w, int h, int border, std::size_t targets) {
+  SearchConstraints cons;
+  cons.source_valid.assign(std::size_t(w) * h, 0);
+  for (int y = border; y < h - border; ++y)
+    for (int x = border; x < w - border; ++x) cons.source_valid[std::size_t(y) * w + x] = 1;
+  cons.target_active.assign(targets, 1);
+  cons.finalize();
+  return cons;
 }
 
 // A UV sphere of outward-facing triangles.

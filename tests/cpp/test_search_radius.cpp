@@ -6,20 +6,15 @@
 
 #include <algorithm>
 #include <cstdlib>
-#include <random>
 
 #include "tempera/engine/patchmatch.hpp"
+#include "test_inputs.hpp"
 
 using namespace tempera;
+using tempera::test_inputs::inner_sources;
+using tempera::test_inputs::random_features;
 
 namespace {
-
-FeatureImage random_features(int w, int h, int channels, unsigned seed) {
-  std::mt19937 rng(seed);
-  FeatureImage f(w, h, channels);
-  for (float& v : f.data) v = float(rng() % 1000) * 1e-3f;
-  return f;
-}
 
 // How far (per axis, the larger) one sweep (the search's `sweep`th) moves
 // the match of a lone target pixel that starts at (100, 75), over `seeds`
@@ -29,12 +24,7 @@ int widest_move(int radius, int sweep, int seeds) {
   const FeatureImage s = random_features(w, h, 3, 1), t = random_features(1, 1, 3, 2);
   PatchSpace space;
   space.source = &s, space.target = &t;
-  SearchConstraints cons;
-  cons.source_valid.assign(std::size_t(w) * h, 0);
-  for (int y = 2; y < h - 2; ++y)
-    for (int x = 2; x < w - 2; ++x) cons.source_valid[std::size_t(y) * w + x] = 1;
-  cons.target_active.assign(1, 1);
-  cons.finalize();
+  const SearchConstraints cons = inner_sources(w, h, 2, 1);
   int widest = 0;
   for (int seed = 1; seed <= seeds; ++seed) {
     OffsetField field(1, 1);
