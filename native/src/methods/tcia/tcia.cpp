@@ -24,9 +24,9 @@ SynthesisOptions tcia_defaults() {
   o.pm_iterations = 4;  // "3 or 4 full iterations" of parallel PatchMatch (§3.3)
   o.guide_variance = 1.0;
   // Each visit starts from the advected and upsampled matches: past its
-  // first sweep, the random search stays within 64 px of them. Measured on
-  // a real shot (issue 32, step 34): 0.87-0.95x the time at 1-2 Mpix, warp
-  // error +0.5-0.9% and detail +0.3-0.5% over three seeds.
+  // first sweep, the random search stays within 64 px of them (issue 32,
+  // step 34): 0.87-0.95x the time on bench_shots' shots at 1-2 Mpix; on a
+  // real shot, warp error +0.5-0.9% and detail +0.3-0.5% over three seeds.
   o.search_radius = 64;
   // Eq. 8's h_s, h_tau and blur, which the paper does not give, measured for
   // this schedule (one search per visit, centre output) on the hotspot shot of
